@@ -1,0 +1,29 @@
+# Two commands on a fresh machine (python3 + make):
+#   make demo   set up a virtualenv and run a sample program
+#   make test   set up a virtualenv and run the test suite
+PYTHON ?= python3
+VENV   ?= .venv
+BIN     = $(VENV)/bin
+
+.PHONY: demo test bench setup clean
+
+$(BIN)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+setup: $(BIN)/.installed
+
+demo: setup
+	$(BIN)/plcrt run programs/seal_in.awl --scans 3 --set I0.0=1 --watch I0.0 --watch Q0.0
+	$(BIN)/plcrt run programs/timers.awl --seconds 2.5 --set I0.0=1 --watch T37 --watch Q0.0
+
+test: setup
+	$(BIN)/python -m pytest -q
+
+bench: setup
+	$(BIN)/python bench/run.py
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache .hypothesis

@@ -1,0 +1,27 @@
+"""plcrt: run S7-200 (STEP 7-Micro/WIN) STL programs in Python, scan by scan.
+
+Public API::
+
+    import plcrt
+    plc = plcrt.load("programs/seal_in.awl", scan_ms=10)
+    plc["I0.0"] = 1
+    plc.scan()            # one scan cycle
+    plc.run(seconds=2.0)  # simulated time, deterministic
+    plc["Q0.0"], plc["VW100"], plc.time
+
+Everything else is internal and may change.
+"""
+
+from __future__ import annotations
+
+from .engine.runtime import Plc, load
+from .errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError,
+                     PlcError, PlcRuntimeError, PlcSyntaxError, SourceLoc)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "load", "Plc", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",
+    "PlcCompileError", "PlcRuntimeError", "PlcAddressError", "PlcConfigError",
+    "__version__",
+]

@@ -1,0 +1,422 @@
+"""Compile a checked program to Python: one function per network (piece).
+
+Pipeline: for each POU the instruction stream is split into *pieces*: one per
+network, with extra cuts where control flow lands inside a network (after
+``LBL`` / ``FOR`` / ``NEXT`` / ``SCRE``).  Each piece becomes one generated
+function ``def n_SBR3_7(L, ...)`` that returns ``None`` to fall through or a
+piece index to continue at (``-1`` returns from the POU).  A POU without
+control flow gets a straight-line runner; a POU with jumps or loops gets a
+small program-counter loop that also feeds the watchdog.
+
+The generated module text is kept for ``plcrt dump``; only validated numbers
+from the program ever reach it (names are built from block kind + number).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from ..errors import DiagnosticSink, SourceLoc
+from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
+from ..lang import ir
+from ..memory.cpu import CpuModel
+from .emit import CodegenError, Gen
+from .resolve import LocalVar, ResolveError, Resolver, layout_locals
+
+#: S7-200: subroutines nest at most eight levels (System Manual, CALL).
+MAX_NESTING = 8
+MAX_FOR_NESTING = 8
+
+# Flow kinds that start a new piece at the instruction / after it.
+_CUT_BEFORE = {"label"}
+_CUT_AFTER = {"for", "next", "scre"}
+
+
+@dataclass
+class Piece:
+    pou: ir.Pou
+    network: ir.Network
+    insns: list[ir.Insn]
+    start_depth: int = 0
+    index: int = 0
+    suffix: str = ""
+
+
+@dataclass
+class PouInfo:
+    pou: ir.Pou
+    fname: str                      #: runner function name
+    local_vars: dict[str, LocalVar]
+    pieces: list[Piece] = field(default_factory=list)
+    labels: dict[int, int] = field(default_factory=dict)
+    loops: dict[int, tuple[int, int, Any]] = field(default_factory=dict)  # for piece -> (body, exit, for insn)
+    next_of: dict[int, int] = field(default_factory=dict)  # next piece -> for piece
+    scr_exit: dict[int, int] = field(default_factory=dict)  # piece -> exit piece of its SCR segment
+    scr_bit: dict[int, Any] = field(default_factory=dict)   # piece -> resolved S bit of the segment
+    scr_pieces: dict[int, list[int]] = field(default_factory=dict)  # LSCR piece -> pieces in segment
+    calls: set[str] = field(default_factory=set)
+    flow: bool = False
+    cost: list[int] = field(default_factory=list)
+
+
+class Unit:
+    """Everything shared while compiling one program."""
+
+    def __init__(self, program: ir.Program, model: CpuModel, symbols: Any,
+                 system_symbols: dict[str, str], diag: DiagnosticSink) -> None:
+        self.program = program
+        self.model = model
+        self.symbols = symbols
+        self.system_symbols = system_symbols
+        self.diag = diag
+        self.bindings: dict[str, Any] = {}
+        self._ids: dict[int, str] = {}
+        self._counter = 0
+        self.locs: list[SourceLoc] = []       #: instruction id -> location
+        self.texts: list[str] = []            #: instruction id -> mnemonic
+        self.pous: dict[str, PouInfo] = {}    #: ident -> info
+        self.by_name: dict[str, PouInfo] = {}
+        self.timer_use: dict[int, list[tuple[str, SourceLoc]]] = {}
+        self.counter_use: dict[int, list[tuple[str, SourceLoc]]] = {}
+        self.edge_count = 0
+        self.hooks: dict[str, Any] = {}       #: family-specific run-time tables
+        self.current: PouInfo | None = None
+        self.current_piece: Piece | None = None
+
+    def fresh(self, hint: str) -> str:
+        self._counter += 1
+        return f"_{hint}{self._counter}"
+
+    def bind(self, obj: object, hint: str = "o") -> str:
+        key = id(obj)
+        name = self._ids.get(key)
+        if name is None:
+            name = self.fresh(hint)
+            self._ids[key] = name
+            self.bindings[name] = obj
+        return name
+
+    def callee(self, name: str) -> PouInfo | None:
+        key = name.strip().upper()
+        return self.pous.get(key) or self.by_name.get(key)
+
+
+def _pou_fname(p: ir.Pou) -> str:
+    return f"pou_{p.kind}{p.number}"
+
+
+class Compiled:
+    """Output of code generation: module source plus per-POU runners."""
+
+    def __init__(self, source: str, namespace: dict[str, Any], unit: Unit,
+                 line_locs: dict[int, SourceLoc]) -> None:
+        self.source = source
+        self.namespace = namespace
+        self.unit = unit
+        self.line_locs = line_locs
+
+    def runner(self, ident: str) -> Callable[[bytearray], Any] | None:
+        info = self.unit.pous.get(ident)
+        return self.namespace.get(info.fname) if info else None
+
+
+def split_pieces(info: PouInfo, diag: DiagnosticSink) -> None:
+    """Cut a POU into pieces and match labels, loops and SCR segments."""
+    pieces: list[Piece] = []
+    for net in info.pou.networks:
+        cur = Piece(info.pou, net, [])
+        pieces.append(cur)
+        for insn in net.insns:
+            spec = lookup(insn.mnemonic)
+            flow = spec.flow if spec else ""
+            if flow in _CUT_BEFORE and cur.insns:
+                cur = Piece(info.pou, net, [])
+                pieces.append(cur)
+            cur.insns.append(insn)
+            if flow in _CUT_AFTER:
+                cur = Piece(info.pou, net, [])
+                pieces.append(cur)
+    # drop empty trailing pieces created by cuts (keep one per network)
+    kept: list[Piece] = []
+    seen_nets: set[int] = set()
+    for p in pieces:
+        if p.insns or id(p.network) not in seen_nets:
+            kept.append(p)
+            seen_nets.add(id(p.network))
+    counts: dict[int, int] = {}
+    for i, p in enumerate(kept):
+        p.index = i
+        k = counts.get(id(p.network), 0)
+        counts[id(p.network)] = k + 1
+        p.suffix = "" if k == 0 else "_" + "abcdefghijklmnopqrstuvwxyz"[min(k - 1, 25)] + (str(k) if k > 26 else "")
+    info.pieces = kept
+    info.cost = [len(p.insns) for p in kept]
+
+    for_stack: list[tuple[int, ir.Insn]] = []
+    scr_open: tuple[int, ir.Insn] | None = None
+    scr_members: list[int] = []
+    for p in kept:
+        for insn in p.insns:
+            spec = lookup(insn.mnemonic)
+            flow = spec.flow if spec else ""
+            if flow:
+                info.flow = info.flow or flow not in ("label",)
+            if flow == "label":
+                n = _label_number(insn)
+                if n is None:
+                    continue
+                if n in info.labels:
+                    diag.error(f"label {n} is defined twice in {info.pou.ident}", insn.loc)
+                info.labels[n] = p.index
+            elif flow == "for":
+                if len(for_stack) >= MAX_FOR_NESTING:
+                    diag.error(f"FOR loops nest deeper than {MAX_FOR_NESTING} levels", insn.loc)
+                for_stack.append((p.index, insn))
+            elif flow == "next":
+                if not for_stack:
+                    diag.error("NEXT without a matching FOR", insn.loc)
+                    continue
+                fp, finsn = for_stack.pop()
+                info.loops[fp] = (fp + 1, p.index + 1, finsn)
+                info.next_of[p.index] = fp
+            elif flow == "lscr":
+                if scr_open is not None:
+                    diag.error("LSCR inside an open SCR segment (SCR segments cannot nest)", insn.loc)
+                scr_open = (p.index, insn)
+                scr_members = [p.index]
+            elif flow in ("scre", "cscre", "scrt") and scr_open is None:
+                diag.error(f"{insn.mnemonic} outside an SCR segment (no LSCR before it)", insn.loc)
+            elif flow == "scre":
+                assert scr_open is not None
+                start = scr_open[0]
+                if p.index not in scr_members:
+                    scr_members.append(p.index)
+                for m in scr_members:
+                    info.scr_exit[m] = p.index + 1
+                info.scr_pieces[start] = list(scr_members)
+                scr_open = None
+        if scr_open is not None and p.index not in scr_members:
+            scr_members.append(p.index)
+    for fp, finsn in for_stack:
+        diag.error("FOR without a matching NEXT", finsn.loc)
+    if scr_open is not None:
+        diag.error("LSCR without a matching SCRE", scr_open[1].loc)
+
+
+def _label_number(insn: ir.Insn) -> int | None:
+    if len(insn.operands) != 1:
+        return None
+    t = insn.operands[0].text.strip()
+    return int(t) if t.isdigit() and int(t) <= 255 else None
+
+
+def check_calls(unit: Unit) -> None:
+    """Reject recursion and nesting deeper than the S7-200 allows."""
+    depth_memo: dict[str, int] = {}
+
+    def depth(ident: str, stack: tuple[str, ...]) -> int:
+        if ident in stack:
+            return 10**6
+        if ident in depth_memo:
+            return depth_memo[ident]
+        info = unit.pous[ident]
+        d = 0
+        for c in info.calls:
+            d = max(d, 1 + depth(c, stack + (ident,)))
+        depth_memo[ident] = d
+        return d
+
+    for ident, info in unit.pous.items():
+        if info.pou.kind == "SBR":
+            continue
+        d = depth(ident, ())
+        if d >= 10**6:
+            unit.diag.error(f"{ident} starts a recursive chain of subroutine calls; "
+                            f"the S7-200 nests calls at most {MAX_NESTING} levels",
+                            info.pou.loc.within(ident, None))
+        elif d > MAX_NESTING:
+            unit.diag.error(f"subroutine calls from {ident} nest {d} levels deep; "
+                            f"the S7-200 allows {MAX_NESTING}", info.pou.loc.within(ident, None))
+    for ident, info in unit.pous.items():
+        if info.pou.kind == "SBR" and depth(ident, ()) >= 10**6:
+            unit.diag.error(f"subroutine {ident} ({info.pou.name}) calls itself "
+                            f"(directly or indirectly); recursion exceeds the nesting limit "
+                            f"of {MAX_NESTING}", info.pou.loc.within(ident, None))
+
+
+def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
+    """Emit the module source for all POUs (diagnostics go to ``unit.diag``)."""
+    out: list[str] = []
+    line_locs: dict[int, SourceLoc] = {}
+    for p in unit.program.pous:
+        info = unit.pous[p.ident]
+        unit.current = info
+        resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars)
+        fnames: list[str] = []
+        returns_flow: list[bool] = []
+        for piece in info.pieces:
+            unit.current_piece = piece
+            fname = f"n_{p.ident}_{piece.network.number}{piece.suffix}_{piece.index}"
+            gen = Gen(unit, piece.network.loc, 0)
+            loop_body = next((fp for fp, (body, _e, _f) in info.loops.items()
+                              if body == piece.index), None)
+            if loop_body is not None:
+                # A loop body is entered only when FOR's enable was 1: the
+                # stack continues with ones (only relevant when the body
+                # shares the FOR's network).
+                for_piece = info.pieces[loop_body]
+                d = unit.hooks.get(("depth_after", p.ident, for_piece.index), 0)
+                for _ in range(d):
+                    gen.push("1")
+            emit_piece(unit, gen, piece, resolver)
+            if piece.index in unit.hooks.get("depth_at_end_needed", ()):  # pragma: no cover
+                pass
+            unit.hooks[("depth_after", p.ident, piece.index)] = gen.depth
+            args = ["L"] + [f"{n}={n}" for n in sorted(gen.used)]
+            header = f"def {fname}({', '.join(args)}):"
+            base = len(out)
+            out.append(header)
+            if gen.eno_used if hasattr(gen, "eno_used") else False:
+                pass
+            body = gen.lines or ["    pass"]
+            out.extend(body)
+            for rel, insn_id in gen.line_map:
+                line_locs[base + 2 + rel] = unit.locs[insn_id]
+            out.append("")
+            fnames.append(fname)
+            returns_flow.append(True)
+        out.extend(_runner(unit, info, fnames))
+        out.append("")
+    return "\n".join(out) + "\n", line_locs
+
+
+def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
+    if not info.flow:
+        lines = [f"def {info.fname}(L):"]
+        lines += [f"    {f}(L)" for f in fnames] or ["    pass"]
+        return lines
+    costs = ", ".join(str(c) for c in info.cost)
+    return [
+        f"_pieces_{info.fname} = ({', '.join(fnames)},)",
+        f"_costs_{info.fname} = ({costs},)",
+        f"def {info.fname}(L, P=_pieces_{info.fname}, C=_costs_{info.fname}, WD=WD):",
+        "    pc = 0",
+        f"    n = {len(fnames)}",
+        "    while pc < n:",
+        "        WD[0] += C[pc]",
+        "        r = P[pc](L)",
+        "        if r is None:",
+        "            pc += 1",
+        "        elif r < 0:",
+        "            return",
+        "        else:",
+        "            if r <= pc and WD[0] > WD[1]:",
+        f"                _watchdog({info.pou.kind!r}, {info.pou.number})",
+        "            pc = r",
+    ]
+
+
+def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
+    """Emit the instructions of one piece into ``gen``."""
+    block = piece.pou.ident
+    for insn in piece.insns:
+        loc = insn.loc.within(block, piece.network.number) if insn.loc.block is None else insn.loc
+        spec = lookup(insn.mnemonic)
+        if spec is None:
+            if insn.mnemonic in KNOWN_UNIMPLEMENTED:
+                unit.diag.error(f"instruction {insn.mnemonic} is not implemented yet",
+                                loc, "unimplemented")
+            else:
+                unit.diag.error(f"unknown instruction '{insn.mnemonic}'", loc, "unknown")
+            continue
+        ops = _resolve_ops(unit, spec, insn, resolver, loc)
+        if ops is None:
+            continue
+        insn_id = len(unit.locs)
+        unit.locs.append(loc)
+        unit.texts.append(insn.mnemonic)
+        gen.loc = loc
+        gen.insn_id = insn_id
+        gen.line_map.append((len(gen.lines), insn_id))
+        # The comment carries only the validated mnemonic-id and line number.
+        gen.line(f"# [{insn_id}] line {int(loc.line)}")
+        saved = (list(gen.lines), gen.depth, gen.indent)
+        try:
+            spec.emit(gen, *ops) if not spec.variadic else spec.emit(gen, insn, resolver, *ops)
+        except CodegenError as e:
+            gen.lines, gen.depth, gen.indent = saved
+            unit.diag.error(f"{insn.mnemonic}: {e}", loc)
+        except ResolveError as e:
+            gen.lines, gen.depth, gen.indent = saved
+            unit.diag.error(f"{insn.mnemonic}: {e}", loc)
+        if not spec.may_fail and spec.family != "stack":
+            gen.eno_valid = False
+
+
+def _resolve_ops(unit: Unit, spec: InsnSpec, insn: ir.Insn, resolver: Resolver,
+                 loc: SourceLoc) -> list[Any] | None:
+    roles = spec.roles
+    n = len(insn.operands)
+    if spec.variadic:
+        if n < len(roles):
+            unit.diag.error(f"{insn.mnemonic} needs at least {len(roles)} operand(s), "
+                            f"got {n}", loc)
+            return None
+        fixed = insn.operands[:len(roles)]
+    else:
+        if n != len(roles):
+            unit.diag.error(f"{insn.mnemonic} takes {len(roles)} operand(s), got {n}", loc)
+            return None
+        fixed = insn.operands
+    ops: list[Any] = []
+    ok = True
+    for i, (operand, role) in enumerate(zip(fixed, roles)):
+        try:
+            ops.append(resolver.resolve(operand, role))
+        except ResolveError as e:
+            unit.diag.error(f"{insn.mnemonic} operand {i + 1}: {e}", operand.loc.within(
+                loc.block, loc.network) if operand.loc.block is None else operand.loc)
+            ok = False
+    return ops if ok else None
+
+
+def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
+               system_symbols: dict[str, str], diag: DiagnosticSink) -> Unit:
+    """Index POUs, lay out locals, split pieces and check the call graph."""
+    unit = Unit(program, model, symbols, system_symbols, diag)
+    ob_count = 0
+    for p in program.pous:
+        ident = p.ident
+        if ident in unit.pous:
+            diag.error(f"block {ident} is defined twice", p.loc.within(ident, None))
+            continue
+        if p.kind == "OB":
+            ob_count += 1
+            if p.number != 1:
+                diag.error(f"organization block {ident}: the S7-200 has only OB1",
+                           p.loc.within(ident, None))
+        try:
+            local_vars = layout_locals(p, model.l_bytes)
+        except ResolveError as e:
+            diag.error(str(e), p.loc.within(ident, None))
+            local_vars = {}
+        info = PouInfo(p, _pou_fname(p), local_vars)
+        unit.pous[ident] = info
+        if p.name and p.name.upper() != ident:
+            if p.name.upper() in unit.by_name:
+                diag.error(f"block name '{p.name}' is used twice", p.loc.within(ident, None))
+            unit.by_name[p.name.upper()] = info
+    if ob_count == 0 and program.pous:
+        diag.error("the program has no main program block (ORGANIZATION_BLOCK OB1)",
+                   program.pous[0].loc)
+    for info in unit.pous.values():
+        split_pieces(info, diag)
+        for net in info.pou.networks:
+            for insn in net.insns:
+                if insn.mnemonic == "CALL" and insn.operands:
+                    callee = unit.callee(insn.operands[0].text.split(":")[0])
+                    if callee is not None:
+                        info.calls.add(callee.pou.ident)
+    check_calls(unit)
+    return unit

@@ -1,0 +1,280 @@
+"""The code generator's per-function context (:class:`Gen`).
+
+Instruction emitters (``plcrt.isa.*``) write Python source through this
+object: it owns the statically allocated logic stack (``s1`` .. ``s9`` as
+locals), turns resolved operands into constant-offset buffer expressions, and
+binds run-time objects (timers, helpers) as fast locals.
+
+Nothing from program text is ever formatted into the source here: operands
+arrive resolved (:mod:`plcrt.compiler.operands`) and only their validated
+integers and floats are printed, with ``repr`` for floats.
+
+It is not the driver: splitting programs into functions, control flow and
+``compile()`` live in :mod:`plcrt.compiler.codegen`.
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+from typing import Any, Iterator
+
+from ..errors import SourceLoc
+from .operands import Addr, Const, Indirect, Pointer
+
+MAX_STACK = 9  #: S7-200 logic stack depth (System Manual, "logic stack")
+
+# Memory areas and the local names their buffers have in generated code.
+BUFFER_NAME = {
+    "I": "I", "Q": "Q", "M": "M", "V": "V", "SM": "SM", "S": "S", "L": "L",
+    "AI": "AI", "AQ": "AQ", "AC": "AC", "HC": "HC", "PI": "PI", "PQ": "PQ",
+}
+
+VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
+
+
+class CodegenError(Exception):
+    """An instruction cannot be generated; becomes a diagnostic at its location."""
+
+
+class Gen:
+    """Source builder for one generated function (one network or network piece).
+
+    Attributes:
+        depth: current static logic-stack depth (0 = empty).
+        used: names of bound objects the function body refers to.
+    """
+
+    def __init__(self, unit: Any, loc: SourceLoc | None = None, depth: int = 0) -> None:
+        self.unit = unit
+        self.lines: list[str] = []
+        self.indent = 1
+        self.depth = depth
+        self.used: set[str] = set()
+        self.loc = loc            #: location of the instruction being emitted
+        self.insn_id = -1         #: index of that instruction in unit.locs
+        self.eno_valid = False    #: the previous box set ``eno``
+        self.line_map: list[tuple[int, int]] = []  #: (first line index, insn id)
+
+    # -- source ---------------------------------------------------------
+    def line(self, text: str) -> None:
+        """Append one statement at the current indentation."""
+        self.lines.append("    " * self.indent + text)
+
+    @contextmanager
+    def block(self, header: str) -> Iterator[None]:
+        """``with g.block("if s1:"):`` emits an indented suite."""
+        self.line(header)
+        self.indent += 1
+        n = len(self.lines)
+        yield
+        if len(self.lines) == n:
+            self.line("pass")
+        self.indent -= 1
+
+    @contextmanager
+    def box(self) -> Iterator[None]:
+        """Body of a box instruction: executes only when the top of stack is 1."""
+        with self.block(f"if {self.top}:"):
+            yield
+
+    def use(self, name: str) -> str:
+        self.used.add(name)
+        return name
+
+    def bind(self, obj: object, hint: str = "o") -> str:
+        """Bind a run-time object as a fast local; returns its generated name."""
+        name = self.unit.bind(obj, hint)
+        self.used.add(name)
+        return name
+
+    def tmp(self, hint: str = "t") -> str:
+        """A fresh local variable name."""
+        return self.unit.fresh(hint)
+
+    def warn(self, message: str, code: str = "") -> None:
+        self.unit.diag.warning(message, self.loc, code)
+
+    def fail(self, message: str) -> None:
+        raise CodegenError(message)
+
+    # -- logic stack ----------------------------------------------------
+    @property
+    def top(self) -> str:
+        if self.depth < 1:
+            self.fail("the logic stack is empty here: start the network with a "
+                      "load (LD, LDN, LDx=, ...)")
+        return f"s{self.depth}"
+
+    def level(self, n: int) -> str:
+        """Stack level ``n`` counted from the top (0 = top)."""
+        if self.depth - n < 1:
+            self.fail(f"needs {n + 1} values on the logic stack, it holds {self.depth}")
+        return f"s{self.depth - n}"
+
+    def push(self, expr: str) -> None:
+        """Push ``expr`` (0/1).  Beyond nine levels the bottom level is lost."""
+        if self.depth == MAX_STACK:
+            self.warn("logic stack overflow: a tenth level is pushed and the bottom "
+                      "level is lost, as on the S7-200", "stack-overflow")
+            lhs = ", ".join(f"s{i}" for i in range(1, MAX_STACK + 1))
+            rhs = ", ".join(f"s{i}" for i in range(2, MAX_STACK + 1))
+            self.line(f"{lhs} = {rhs}, {expr}")
+            return
+        self.depth += 1
+        self.line(f"s{self.depth} = {expr}")
+
+    def pop(self, n: int = 1) -> None:
+        if self.depth < n:
+            self.fail(f"needs {n + 1 if n == 1 else n} values on the logic stack, "
+                      f"it holds {self.depth}")
+        self.depth -= n
+
+    # -- operands -------------------------------------------------------
+    def _buf(self, area: str) -> str:
+        return self.use(BUFFER_NAME[area])
+
+    def rbit(self, op: Addr) -> str:
+        """Expression (0/1) reading a bit operand."""
+        if op.area in ("T", "C"):
+            buf = self.use("TB" if op.area == "T" else "CB")
+            byte, bit = op.offset >> 3, op.offset & 7
+        else:
+            buf, byte, bit = self._buf(op.area), op.offset, op.bit
+        if bit == 0:
+            return f"({buf}[{byte}] & 1)"
+        return f"({buf}[{byte}] >> {bit} & 1)"
+
+    def wbit(self, op: Addr, expr: str) -> None:
+        """Statements writing ``expr`` (0/1, evaluated once) to a bit."""
+        buf = self._buf(op.area)
+        mask = 1 << op.bit
+        if expr.isidentifier():
+            with self.block(f"if {expr}:"):
+                self.line(f"{buf}[{op.offset}] |= {mask}")
+            with self.block("else:"):
+                self.line(f"{buf}[{op.offset}] &= {~mask & 0xFF}")
+        else:
+            self.line(f"{buf}[{op.offset}] = {buf}[{op.offset}] & {~mask & 0xFF} "
+                      f"| ({expr}) << {op.bit}")
+
+    def set_bit(self, op: Addr, value: int) -> None:
+        buf = self._buf(op.area)
+        mask = 1 << op.bit
+        if value:
+            self.line(f"{buf}[{op.offset}] |= {mask}")
+        else:
+            self.line(f"{buf}[{op.offset}] &= {~mask & 0xFF}")
+
+    def _place(self, op: Addr, width: int) -> tuple[str, int]:
+        if op.area == "T":
+            return self.use("TV"), op.offset * 2
+        if op.area == "C":
+            return self.use("CV"), op.offset * 2
+        if op.area == "AC":
+            return self.use("AC"), op.offset * 4 + 4 - width
+        if op.area == "HC":
+            return self.use("HC"), op.offset * 4
+        return self._buf(op.area), op.offset
+
+    def rd(self, op: Any, kind: str) -> str:
+        """Expression reading a value.
+
+        Args:
+            op: resolved operand (Addr, Const, Pointer or Indirect).
+            kind: ``B`` (unsigned byte), ``W``/``D`` (signed INT/DINT),
+                ``WU``/``DU`` (unsigned), ``R`` (REAL as float).
+        """
+        width = VALUE_WIDTH[kind[0]]
+        if isinstance(op, Const):
+            return const_expr(op, kind)
+        if isinstance(op, Pointer):
+            return str(op.value)
+        if isinstance(op, Indirect):
+            pbuf, poff = self._place(op.ptr, 4)
+            sign = "r" if kind == "R" else ("u" if kind.endswith("U") else "s")
+            return (f"{self.use('_ird')}({pbuf}, {poff}, {width}, '{sign}', "
+                    f"{self.insn_id})")
+        buf, off = self._place(op, width)
+        if width == 1:
+            return f"{buf}[{off}]"
+        codec = {"W": "_rh", "WU": "_rH", "D": "_ri", "DU": "_rI", "R": "_rf"}[kind]
+        return f"{self.use(codec)}({buf}, {off})[0]"
+
+    def wr(self, op: Any, kind: str, expr: str) -> None:
+        """Statements writing ``expr`` to a value operand.
+
+        Integer values are masked to the width, so callers may pass signed or
+        oversized results.  REAL values must already be finite single
+        precision numbers.
+        """
+        width = VALUE_WIDTH[kind[0]]
+        if isinstance(op, Indirect):
+            pbuf, poff = self._place(op.ptr, 4)
+            self.line(f"{self.use('_iwr')}({pbuf}, {poff}, {width}, {expr}, "
+                      f"{self.insn_id})")
+            return
+        buf, off = self._place(op, width)
+        if kind == "R":
+            self.line(f"{self.use('_wf')}({buf}, {off}, {expr})")
+        elif width == 1:
+            self.line(f"{buf}[{off}] = ({expr}) & 255")
+        elif width == 2:
+            self.line(f"{self.use('_wH')}({buf}, {off}, ({expr}) & 65535)")
+        else:
+            self.line(f"{self.use('_wI')}({buf}, {off}, ({expr}) & 4294967295)")
+
+    def copy(self, src: Any, dst: Any, kind: str) -> None:
+        """Move a value; plain byte-slice copy where both are direct (perf)."""
+        width = VALUE_WIDTH[kind[0]]
+        if (isinstance(src, Addr) and isinstance(dst, Addr) and width > 1
+                and src.area not in ("AC",) and dst.area not in ("AC",)):
+            sbuf, soff = self._place(src, width)
+            dbuf, doff = self._place(dst, width)
+            # perf: slice copy avoids decode/encode (big-endian bytes move as is)
+            self.line(f"{dbuf}[{doff}:{doff + width}] = {sbuf}[{soff}:{soff + width}]")
+            return
+        self.wr(dst, kind, self.rd(src, kind))
+
+    # -- status flags (SMB1) ---------------------------------------------
+    def flags_zn(self, value: str) -> None:
+        """SM1.0 (zero) and SM1.2 (negative) from a result; SM1.1 cleared."""
+        sm = self.use("SM")
+        self.line(f"{sm}[1] = {sm}[1] & 248 | ({value} == 0) | ({value} < 0) << 2")
+
+    def flag_overflow(self) -> None:
+        """SM1.1 set (result out of range, output unchanged); SM1.0/SM1.2 cleared."""
+        sm = self.use("SM")
+        self.line(f"{sm}[1] = {sm}[1] & 248 | 2")
+
+    def eno(self, expr: str) -> None:
+        """Record the box's ENO (for a following AENO)."""
+        self.line(f"eno = {expr}")
+        self.eno_valid = True
+
+
+def const_expr(c: Const, kind: str) -> str:
+    """Source text of a validated constant converted to ``kind``."""
+    v = c.value
+    if isinstance(v, bytes):
+        n = int.from_bytes(v[:4].ljust(VALUE_WIDTH[kind[0]], b"\0")[:VALUE_WIDTH[kind[0]]], "big")
+        v = n
+    if kind == "R":
+        return repr(float(v))
+    if isinstance(v, float):
+        if kind[0] == "D" and not c.is_real:
+            v = int(v)
+        else:
+            import struct
+            v = int.from_bytes(struct.pack(">f", v), "big")
+    v = int(v)
+    if kind == "B":
+        return str(v & 0xFF)
+    if kind == "WU":
+        return str(v & 0xFFFF)
+    if kind == "DU":
+        return str(v & 0xFFFFFFFF)
+    if kind == "W":
+        v &= 0xFFFF
+        return str(v - 0x10000 if v & 0x8000 else v)
+    v &= 0xFFFFFFFF
+    return str(v - 0x100000000 if v & 0x80000000 else v)

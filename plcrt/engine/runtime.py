@@ -1,0 +1,316 @@
+"""The scan engine: a compiled program bound to a memory image and a clock.
+
+One scan, as on the S7-200 (System Manual, "The scan cycle"):
+
+1. copy the physical inputs (PI) into the input image I;
+2. special memory: SM0.0, SM0.1/SM0.3 on the first scan, the SM0.4/SM0.5
+   clocks and SM0.6 scan clock from simulated time, scan-time words;
+3. advance running 1 ms / 10 ms timers (100 ms timers advance in their box);
+4. execute OB1 (and the subroutines it calls);
+5. step simulated devices;
+6. copy the output image Q to the physical outputs (PQ);
+7. a STOP instruction executed in this scan switches to STOP mode now.
+
+Simulated time is integer microseconds, advanced by a fixed scan time after
+each scan: deterministic, no sleeping.  ``pace="realtime"`` sleeps to keep
+wall-clock pace (for demos); it never changes results.
+"""
+
+from __future__ import annotations
+
+import sys
+import time as _time
+from pathlib import Path
+from typing import Any, Iterable
+
+from ..compiler import compile_program
+from ..compiler.operands import Addr, OperandError, parse_operand
+from ..compiler.rt import CODECS, make_indirect
+from ..errors import (PlcAddressError, PlcConfigError, PlcError,
+                      PlcRuntimeError, SourceLoc)
+from ..lang import ir
+from ..memory import MemoryImage, cpu_model
+from .counters import CounterBank
+from .timers import TimerBank
+
+#: Estimated execution time per instruction for the watchdog (µs).
+WATCHDOG_US_PER_INSN = 0.5
+WATCHDOG_MS = 500  #: S7-200 watchdog time (System Manual, WDR)
+
+
+class Plc:
+    """A loaded program, ready to scan.  Create it with :func:`plcrt.load`."""
+
+    def __init__(self, program: ir.Program, *, symbols: Any = None, data: Any = None,
+                 scan_ms: float = 10.0, cpu: str | None = None,
+                 system_symbols: dict[str, str] | None = None,
+                 watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated") -> None:
+        if not (isinstance(scan_ms, (int, float)) and 0.001 <= scan_ms <= 60000):
+            raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
+        if pace not in ("simulated", "realtime"):
+            raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
+        self.program = program
+        self.symbols = symbols
+        self.model = cpu_model(cpu)
+        self.mem = MemoryImage(self.model)
+        self.scan_us = int(round(scan_ms * 1000))
+        self.pace = pace
+        self.mode = "RUN"
+        self.fault: PlcError | None = None
+        self.scans = 0
+        self._t_us = 0
+        self._prev_start: int | None = None
+        self.stop_requested = False
+        self.timers = TimerBank(self.mem.areas["TV"], self.mem.areas["TB"], self.model.timers)
+        self.counters = CounterBank(self.mem.areas["CV"], self.mem.areas["CB"], self.model.counters)
+        self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0]
+        self.devices: list[Any] = []
+        if system_symbols is None:
+            from ..lang.symbols import SYSTEM_SYMBOLS
+            system_symbols = dict(SYSTEM_SYMBOLS)
+
+        def setup(unit: Any) -> None:
+            unit.hooks["plc"] = self
+            unit.hooks["timers"] = self.timers
+            unit.hooks["counters"] = self.counters
+
+        self.unit, self.source, self.line_locs = compile_program(
+            program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup)
+        self.diagnostics = list(self.unit.diag.items)
+        self._filename = f"<plcrt {program.file}>"
+        ns: dict[str, Any] = dict(CODECS)
+        ns.update(self.mem.areas)
+        ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
+        ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
+                  _watchdog=self._watchdog)
+        ns.update(self.unit.bindings)
+        code = compile(self.source, self._filename, "exec")
+        exec(code, ns)  # noqa: S102 - source built only from validated numbers
+        self._ns = ns
+        self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
+        if data is not None:
+            data.apply(self.mem.areas["V"])
+
+    # -- time -----------------------------------------------------------
+    @property
+    def time(self) -> float:
+        """Simulated time in seconds since power-up."""
+        return self._t_us / 1e6
+
+    # -- scanning -------------------------------------------------------
+    def scan(self, n: int = 1) -> None:
+        """Run ``n`` scan cycles (nothing happens in STOP mode).
+
+        Raises:
+            PlcRuntimeError: on a fatal fault; the CPU is left in STOP.
+        """
+        for _ in range(n):
+            if self.mode != "RUN":
+                return
+            t0 = _time.perf_counter() if self.pace == "realtime" else 0.0
+            self._scan_once()
+            if self.pace == "realtime":
+                left = self.scan_us / 1e6 - (_time.perf_counter() - t0)
+                if left > 0:
+                    _time.sleep(left)
+
+    def run(self, seconds: float | None = None, scans: int | None = None) -> None:
+        """Run for a simulated duration or a number of scans."""
+        if (seconds is None) == (scans is None):
+            raise PlcConfigError("give exactly one of seconds= or scans=")
+        if scans is None:
+            assert seconds is not None
+            if seconds < 0:
+                raise PlcConfigError("seconds must not be negative")
+            scans = -(-int(round(seconds * 1e6)) // self.scan_us)
+        self.scan(scans)
+
+    def _scan_once(self) -> None:
+        m = self.mem.areas
+        now = self._t_us
+        m["I"][:] = m["PI"]
+        sm = m["SM"]
+        first = self.scans == 0
+        b0 = 1 | (0x0A if first else 0) | 0x80
+        if now % 60_000_000 >= 30_000_000:
+            b0 |= 0x10
+        if now % 1_000_000 >= 500_000:
+            b0 |= 0x20
+        if self.scans % 2 == 0:
+            b0 |= 0x40
+        sm[0] = b0
+        ms = min(self.scan_us // 1000, 0xFFFF)
+        sm[22:24] = ms.to_bytes(2, "big")
+        sm[24:26] = ms.to_bytes(2, "big")
+        sm[26:28] = ms.to_bytes(2, "big")
+        self.timers.start_scan(self._prev_start, now)
+        self._prev_start = now
+        self.wd[0] = 0
+        self.wd[2] = 0
+        try:
+            if self._ob1 is not None:
+                self._ob1(m["L"])
+            for dev in self.devices:
+                dev.step(self, self.scan_us)
+        except PlcError as e:
+            self._fail(e)
+        except Exception as e:  # an internal fault: map it to the program location
+            self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
+                                       self._loc_from_tb(e)), e)
+        m["PQ"][:] = m["Q"]
+        self.scans += 1
+        self._t_us += self.scan_us
+        if self.stop_requested:
+            self.mode = "STOP"
+
+    def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
+        self.mode = "STOP"
+        self.fault = err
+        m = self.mem.areas
+        m["PQ"][:] = bytes(len(m["PQ"]))  # outputs go to their STOP state (off)
+        raise err from cause
+
+    def _loc_from_tb(self, exc: BaseException) -> SourceLoc | None:
+        tb = exc.__traceback__
+        loc = None
+        while tb is not None:
+            if tb.tb_frame.f_code.co_filename == self._filename:
+                lineno = tb.tb_lineno
+                # the nearest instruction comment above the failing line
+                for ln in range(lineno, 0, -1):
+                    if ln in self.line_locs:
+                        loc = self.line_locs[ln]
+                        break
+            tb = tb.tb_next
+        return loc
+
+    def _watchdog(self, kind: str, number: int) -> None:
+        raise PlcRuntimeError(
+            f"watchdog: the scan ran longer than {WATCHDOG_MS} ms "
+            f"(about {self.wd[0]} instructions in loops of {kind}{number}); "
+            f"the CPU goes to STOP", None)
+
+    def request_stop(self) -> None:
+        """STOP instruction: finish this scan, then go to STOP mode."""
+        self.stop_requested = True
+
+    # -- address access (slow path, for tests, CLI and tools) -------------
+    def _addr(self, address: str) -> Addr:
+        text = address.strip()
+        try:
+            op = parse_operand(text, self.model)
+        except OperandError as e:
+            raise PlcAddressError(str(e)) from None
+        if not isinstance(op, Addr):
+            from ..compiler.resolve import Resolver
+            try:
+                op = Resolver(self.model, self.symbols, _system_symbols()).parse(text)
+            except Exception as e:  # noqa: BLE001 - reported as an address error
+                raise PlcAddressError(f"{address!r}: {e}") from None
+        if not isinstance(op, Addr):
+            raise PlcAddressError(f"{address!r} is not an address")
+        return op
+
+    def __getitem__(self, address: str) -> int:
+        return self.read(address)
+
+    def __setitem__(self, address: str, value: int | float | bool) -> None:
+        self.write(address, value)
+
+    def read(self, address: str, kind: str | None = None) -> int | float:
+        """Read an address: bits 0/1, bytes unsigned, words/dwords signed,
+        ``T37``/``C5`` their current value; ``kind="REAL"`` reads a float."""
+        a = self._addr(address)
+        buf, off, width, bit = self._locate(a)
+        if width == 0:
+            return buf[off] >> bit & 1
+        if kind and kind.upper() in ("REAL", "R"):
+            if width != 4:
+                raise PlcAddressError(f"{address}: a REAL needs a double word")
+            return CODECS["_rf"](buf, off)[0]
+        if width == 1:
+            return buf[off]
+        raw = int.from_bytes(buf[off:off + width], "big", signed=True)
+        return raw
+
+    def write(self, address: str, value: int | float | bool) -> None:
+        """Write an address.  Writing an input sets the physical input too,
+        so it keeps its value over the next scans (a switch left on)."""
+        a = self._addr(address)
+        buf, off, width, bit = self._locate(a)
+        targets = [buf]
+        if a.area == "I":
+            targets.append(self.mem.areas["PI"])
+        for b in targets:
+            if width == 0:
+                if value:
+                    b[off] |= 1 << bit
+                else:
+                    b[off] &= ~(1 << bit) & 0xFF
+            elif isinstance(value, float) and width == 4:
+                CODECS["_wf"](b, off, value)
+            else:
+                v = int(value)
+                lo, hi = -(1 << (8 * width - 1)), (1 << (8 * width)) - 1
+                if not lo <= v <= hi:
+                    raise PlcAddressError(f"{address}: value {v} does not fit in "
+                                          f"{width} byte(s)")
+                b[off:off + width] = (v & ((1 << 8 * width) - 1)).to_bytes(width, "big")
+
+    def _locate(self, a: Addr) -> tuple[bytearray, int, int, int]:
+        """(buffer, byte offset, width, bit) of an address; T/C by name
+        give their current value (as Micro/WIN's status chart shows)."""
+        m = self.mem.areas
+        if a.area in ("T", "C"):
+            if a.width == 0:
+                return m["TB" if a.area == "T" else "CB"], a.offset >> 3, 0, a.offset & 7
+            return m["TV" if a.area == "T" else "CV"], a.offset * 2, 2, 0
+        if a.area in ("AC", "HC"):
+            return m[a.area], a.offset * 4, 4, 0
+        return m[a.area], a.offset, a.width or 0, a.bit
+
+
+def _system_symbols() -> dict[str, str]:
+    from ..lang.symbols import SYSTEM_SYMBOLS
+    return dict(SYSTEM_SYMBOLS)
+
+
+def load(source: str | Path, *, symbols: Any = None, data: Any = None,
+         scan_ms: float = 10.0, cpu: str | None = None, **kw: Any) -> Plc:
+    """Parse, compile and bind a program.
+
+    Args:
+        source: a path to a ``.awl`` file, or program text (anything with a
+            newline or starting with a block keyword is taken as text).
+        symbols: path or text of a symbol table, or a parsed table.
+        data: path or text of a data block, or a parsed one.
+    """
+    from ..lang import parse_datablock, parse_program, parse_symbols, read_source
+
+    def text_or_path(x: Any) -> tuple[str, str] | None:
+        if x is None or not isinstance(x, (str, Path)):
+            return None
+        s = str(x)
+        if isinstance(x, Path) or ("\n" not in s and len(s) < 4096 and Path(s).suffix
+                                   and not s.lstrip().upper().startswith(
+                                       ("ORGANIZATION_BLOCK", "SUBROUTINE_BLOCK"))):
+            return read_source(s), s
+        return s, "<string>"
+
+    t = text_or_path(source)
+    if t is None:
+        raise PlcConfigError("load() needs a path or program text")
+    program = parse_program(t[0], t[1])
+    if isinstance(symbols, (str, Path)):
+        st = text_or_path(symbols)
+        assert st is not None
+        symbols = parse_symbols(st[0], st[1])
+    if isinstance(data, (str, Path)):
+        dt = text_or_path(data)
+        assert dt is not None
+        data = parse_datablock(dt[0], dt[1])
+    return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, **kw)
+
+
+__all__ = ["Plc", "load"]
+_ = (sys, Iterable)

@@ -1,0 +1,187 @@
+"""S7-200 timers (TON, TONR, TOF) with the resolution rules of the manual.
+
+S7-200 System Manual, "Timer instructions" / "Understanding how resolution
+affects the timer action".  The resolution is fixed by the timer number:
+
+=========  =========================  ===========================
+           TONR                       TON / TOF
+=========  =========================  ===========================
+1 ms       T0, T64                    T32, T96
+10 ms      T1-T4, T65-T68             T33-T36, T97-T100
+100 ms     T5-T31, T69-T95            T37-T63, T101-T255
+=========  =========================  ===========================
+
+Update rules, as plcrt implements them (time is integer microseconds):
+
+* 100 ms: the current value changes only when the timer instruction runs; it
+  adds the 100 ms ticks that elapsed between the previous scan start and this
+  scan start.  Skipped instruction -> time lost; executed twice -> time
+  gained (the manual's warning, reproduced on purpose)::
+
+      scan starts   |     |     |     |        (scan 100 ms)
+      IN            __/‾‾‾‾‾‾‾‾‾‾‾‾‾‾‾‾‾‾
+      CV (PT=2)     0  0  1  2            bit on at CV >= PT
+
+* 10 ms: running timers advance at the start of every scan by the 10 ms
+  ticks since the previous scan start, whether or not the instruction runs;
+  the instruction only starts, stops or resets them.
+* 1 ms: on the hardware they advance every millisecond, asynchronously.
+  Simulated program execution takes no time, so the milliseconds of a scan
+  are applied at its start, like the 10 ms timers (see docs/decisions.md).
+
+The visible state (current value words ``TV`` and bits ``TB``) lives in the
+memory image, so ``LD T37`` and ``MOVW T37, VW0`` are plain reads; this class
+keeps only the hidden state (running, preset, previous IN).
+"""
+
+from __future__ import annotations
+
+from struct import Struct
+
+_H = Struct(">h")
+_UH = Struct(">H")
+
+MAX_CV = 32767
+
+TONR_RES = {0: 1, 64: 1, **{n: 10 for n in (1, 2, 3, 4, 65, 66, 67, 68)}}
+TON_RES = {32: 1, 96: 1, **{n: 10 for n in (33, 34, 35, 36, 97, 98, 99, 100)}}
+
+
+def timer_kind_ok(kind: str, n: int) -> bool:
+    """Whether timer number ``n`` may be used by a ``kind`` box (TON/TOF/TONR)."""
+    tonr = n < 32 or 64 <= n < 96
+    return tonr if kind == "TONR" else not tonr
+
+
+def resolution_ms(n: int) -> int:
+    """Resolution of timer ``n`` in milliseconds (1, 10 or 100)."""
+    if n < 32 or 64 <= n < 96:
+        return TONR_RES.get(n, 100)
+    return TON_RES.get(n, 100)
+
+
+class TimerBank:
+    """Hidden state of all timers plus the per-scan tick deltas."""
+
+    def __init__(self, tv: bytearray, tb: bytearray, count: int = 256) -> None:
+        self.tv = tv
+        self.tb = tb
+        self.running = [False] * count
+        self.preset = [0] * count
+        self.prev_in = [0] * count
+        self.kind = [""] * count
+        self.res = [resolution_ms(n) for n in range(count)]
+        self.d1 = self.d10 = self.d100 = 0  #: ticks since previous scan start
+        self._fast: set[int] = set()        #: running 1 ms / 10 ms timers
+
+    # -- engine side ----------------------------------------------------
+    def start_scan(self, prev_us: int | None, now_us: int) -> None:
+        """Compute tick deltas and advance running 1 ms / 10 ms timers."""
+        if prev_us is None:
+            self.d1 = self.d10 = self.d100 = 0
+        else:
+            self.d1 = now_us // 1000 - prev_us // 1000
+            self.d10 = now_us // 10000 - prev_us // 10000
+            self.d100 = now_us // 100000 - prev_us // 100000
+        if self._fast:
+            for n in list(self._fast):
+                self._advance(n, self.d1 if self.res[n] == 1 else self.d10)
+
+    def _set(self, n: int, cv: int, bit: int) -> None:
+        _UH.pack_into(self.tv, n * 2, cv & 0xFFFF)
+        mask = 1 << (n & 7)
+        if bit:
+            self.tb[n >> 3] |= mask
+        else:
+            self.tb[n >> 3] &= ~mask & 0xFF
+
+    def _cv(self, n: int) -> int:
+        return _H.unpack_from(self.tv, n * 2)[0]
+
+    def _advance(self, n: int, d: int) -> None:
+        cv = self._cv(n)
+        if cv < 0:  # a program wrote a negative value: treat like the CPU, count up from it
+            pass
+        cv = min(cv + d, MAX_CV)
+        kind = self.kind[n]
+        if kind == "TOF":
+            if cv >= self.preset[n]:
+                self._set(n, cv, 0)
+                self._stop(n)
+            else:
+                self._set(n, cv, 1)
+        else:
+            self._set(n, cv, cv >= self.preset[n])
+
+    def _stop(self, n: int) -> None:
+        self.running[n] = False
+        self._fast.discard(n)
+
+    def _start(self, n: int) -> None:
+        self.running[n] = True
+        if self.res[n] != 100:
+            self._fast.add(n)
+
+    def reset(self, n: int) -> None:
+        """``R Tn``: clear current value and bit, stop timing."""
+        self._stop(n)
+        self.prev_in[n] = 0
+        self._set(n, 0, 0)
+
+    # -- instruction side -----------------------------------------------
+    def ton(self, n: int, en: int, pt: int) -> None:
+        """TON: on-delay.  IN=0 clears the current value and the bit."""
+        self.preset[n] = pt
+        self.kind[n] = "TON"
+        if not en:
+            if self.running[n] or self.tb[n >> 3] >> (n & 7) & 1 or self._cv(n):
+                self._stop(n)
+                self._set(n, 0, 0)
+            return
+        if not self.running[n]:
+            self._start(n)
+            self._set(n, self._cv(n), self._cv(n) >= pt)
+            return
+        cv = self._cv(n)
+        if self.res[n] == 100:
+            cv = min(cv + self.d100, MAX_CV)
+        self._set(n, cv, cv >= pt)
+
+    def tonr(self, n: int, en: int, pt: int) -> None:
+        """TONR: retentive on-delay; IN=0 keeps the value, only R clears it."""
+        self.preset[n] = pt
+        self.kind[n] = "TONR"
+        if not en:
+            if self.running[n]:
+                self._stop(n)
+            return
+        cv = self._cv(n)
+        if not self.running[n]:
+            self._start(n)
+        elif self.res[n] == 100:
+            cv = min(cv + self.d100, MAX_CV)
+        self._set(n, cv, cv >= pt)
+
+    def tof(self, n: int, en: int, pt: int) -> None:
+        """TOF: off-delay.  IN=1 sets the bit and clears the value; the
+        falling edge of IN starts timing; at PT the bit goes off."""
+        self.preset[n] = pt
+        self.kind[n] = "TOF"
+        prev = self.prev_in[n]
+        self.prev_in[n] = 1 if en else 0
+        if en:
+            if self.running[n]:
+                self._stop(n)
+            self._set(n, 0, 1)
+            return
+        if prev:
+            self._start(n)
+            self._set(n, 0, 1)
+            return
+        if self.running[n] and self.res[n] == 100:
+            cv = min(self._cv(n) + self.d100, MAX_CV)
+            if cv >= pt:
+                self._set(n, cv, 0)
+                self._stop(n)
+            else:
+                self._set(n, cv, 1)

@@ -1,0 +1,118 @@
+"""Source locations, diagnostics and the plcrt error hierarchy.
+
+Every stage reports problems as :class:`Diagnostic` values that carry a
+:class:`SourceLoc`; a stage that fails raises one :class:`PlcError` subclass
+holding *all* diagnostics it found.  Messages are GNU style so editors can jump
+to them::
+
+    prog.awl:12:5: error: unknown instruction 'LDX' [OB1 network 7]
+
+This module is not a logger and does no I/O.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Literal
+
+Severity = Literal["error", "warning", "note"]
+
+
+@dataclass(frozen=True, slots=True)
+class SourceLoc:
+    """A position in a source file, optionally inside a block and network."""
+
+    file: str
+    line: int
+    column: int
+    block: str | None = None  #: block id as the user sees it, e.g. "OB1", "SBR3"
+    network: int | None = None  #: network number as written in the file
+
+    def within(self, block: str | None, network: int | None) -> SourceLoc:
+        """Return a copy that also names the block and network."""
+        return replace(self, block=block, network=network)
+
+    def context(self) -> str:
+        """The ``[OB1 network 7]`` suffix, or an empty string."""
+        if self.block is None:
+            return ""
+        if self.network is None:
+            return f" [{self.block}]"
+        return f" [{self.block} network {self.network}]"
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.column}"
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """One finding of a compiler or runtime stage."""
+
+    severity: Severity
+    message: str
+    loc: SourceLoc | None = None
+    code: str = ""  #: short machine-readable tag, e.g. "unimplemented"
+
+    def __str__(self) -> str:
+        if self.loc is None:
+            return f"{self.severity}: {self.message}"
+        return f"{self.loc}: {self.severity}: {self.message}{self.loc.context()}"
+
+
+class PlcError(Exception):
+    """Root of all errors plcrt reports to users."""
+
+    def __init__(self, message: str, loc: SourceLoc | None = None,
+                 diagnostics: Iterable[Diagnostic] = ()) -> None:
+        super().__init__(message)
+        self.message = message
+        self.loc = loc
+        self.diagnostics: list[Diagnostic] = list(diagnostics)
+        if not self.diagnostics:
+            self.diagnostics = [Diagnostic("error", message, loc)]
+
+    def __str__(self) -> str:
+        return "\n".join(str(d) for d in self.diagnostics)
+
+
+class PlcSyntaxError(PlcError):
+    """The program, symbol or data file text cannot be parsed."""
+
+
+class PlcCompileError(PlcError):
+    """The program parsed but cannot be compiled (all problems listed)."""
+
+
+class PlcRuntimeError(PlcError):
+    """A fatal fault while the program runs; the CPU goes to STOP."""
+
+
+class PlcAddressError(PlcError, ValueError):
+    """An address given through the API or the command line is not valid."""
+
+
+class PlcConfigError(PlcError, ValueError):
+    """A bad option or configuration value."""
+
+
+@dataclass
+class DiagnosticSink:
+    """Collects diagnostics of one stage; ``raise_if_errors`` ends the stage."""
+
+    items: list[Diagnostic] = field(default_factory=list)
+
+    def error(self, message: str, loc: SourceLoc | None, code: str = "") -> None:
+        self.items.append(Diagnostic("error", message, loc, code))
+
+    def warning(self, message: str, loc: SourceLoc | None, code: str = "") -> None:
+        self.items.append(Diagnostic("warning", message, loc, code))
+
+    @property
+    def errors(self) -> list[Diagnostic]:
+        return [d for d in self.items if d.severity == "error"]
+
+    def raise_if_errors(self, kind: type[PlcError] = PlcCompileError) -> None:
+        errors = self.errors
+        if errors:
+            head = f"{len(errors)} error(s)"
+            raise kind(head, errors[0].loc, self.items)

@@ -1,0 +1,235 @@
+"""Instruction family: bit logic and the logic stack.
+
+S7-200 System Manual, "Bit logic instructions" and "Logic stack":
+contacts push (LD*) or combine into the top of the stack (A*, O*); ALD/OLD
+combine the two top levels; LPS/LRD/LPP/LDS copy levels; outputs read the
+top without changing the stack.  Immediate contacts read the physical input
+(PI) without touching the image; immediate outputs write image and terminal.
+"""
+
+from __future__ import annotations
+
+from ..compiler.emit import Gen
+from ..compiler.operands import Addr, Const
+from .registry import Role, insn
+
+F = "bitlogic"
+
+
+def _phys(g: Gen, op: Addr) -> str:
+    """Expression reading a physical input terminal (immediate contacts)."""
+    pi = g.use("PI")
+    return f"({pi}[{op.offset}] >> {op.bit} & 1)" if op.bit else f"({pi}[{op.offset}] & 1)"
+
+
+@insn("LD", Role.BIT_R, family=F, summary="push the bit")
+def _ld(g: Gen, op: Addr) -> None:
+    g.push(g.rbit(op))
+
+
+@insn("LDN", Role.BIT_R, family=F, summary="push the inverted bit")
+def _ldn(g: Gen, op: Addr) -> None:
+    g.push(f"{g.rbit(op)} ^ 1")
+
+
+@insn("A", Role.BIT_R, family=F, summary="top := top AND bit")
+def _a(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} &= {g.rbit(op)}")
+
+
+@insn("AN", Role.BIT_R, family=F, summary="top := top AND NOT bit")
+def _an(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} &= {g.rbit(op)} ^ 1")
+
+
+@insn("O", Role.BIT_R, family=F, summary="top := top OR bit")
+def _o(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} |= {g.rbit(op)}")
+
+
+@insn("ON", Role.BIT_R, family=F, summary="top := top OR NOT bit")
+def _on(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} |= {g.rbit(op)} ^ 1")
+
+
+@insn("LDI", Role.IBIT, family=F, summary="push the physical input")
+def _ldi(g: Gen, op: Addr) -> None:
+    g.push(_phys(g, op))
+
+
+@insn("LDNI", Role.IBIT, family=F, summary="push the inverted physical input")
+def _ldni(g: Gen, op: Addr) -> None:
+    g.push(f"{_phys(g, op)} ^ 1")
+
+
+@insn("AI", Role.IBIT, family=F, summary="top := top AND physical input")
+def _ai(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} &= {_phys(g, op)}")
+
+
+@insn("ANI", Role.IBIT, family=F, summary="top := top AND NOT physical input")
+def _ani(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} &= {_phys(g, op)} ^ 1")
+
+
+@insn("OI", Role.IBIT, family=F, summary="top := top OR physical input")
+def _oi(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} |= {_phys(g, op)}")
+
+
+@insn("ONI", Role.IBIT, family=F, summary="top := top OR NOT physical input")
+def _oni(g: Gen, op: Addr) -> None:
+    g.line(f"{g.top} |= {_phys(g, op)} ^ 1")
+
+
+@insn("NOT", family=F, summary="invert the top of the stack")
+def _not(g: Gen) -> None:
+    g.line(f"{g.top} ^= 1")
+
+
+def _edge(g: Gen, rising: bool) -> None:
+    # Each EU/ED has its own memory byte; 2 = "not executed yet", so the first
+    # execution after entering RUN never reports an edge (manual: the CPU
+    # saves the initial state in a memory bit).
+    edges = g.unit.hooks.setdefault("edges", bytearray())
+    idx = len(edges)
+    edges.append(2)
+    em = g.bind(edges, "EM")
+    top = g.top
+    prev = g.tmp("p")
+    g.line(f"{prev} = {em}[{idx}]")
+    g.line(f"{em}[{idx}] = {top}")
+    want = (1, 0) if rising else (0, 1)
+    g.line(f"{top} = 1 if ({top} == {want[0]} and {prev} == {want[1]}) else 0")
+
+
+@insn("EU", family=F, summary="1 for one execution on a rising edge of the top")
+def _eu(g: Gen) -> None:
+    _edge(g, True)
+
+
+@insn("ED", family=F, summary="1 for one execution on a falling edge of the top")
+def _ed(g: Gen) -> None:
+    _edge(g, False)
+
+
+@insn("ALD", family="stack", summary="AND the two top levels, pop one")
+def _ald(g: Gen) -> None:
+    below, top = g.level(1), g.top
+    g.line(f"{below} &= {top}")
+    g.pop()
+
+
+@insn("OLD", family="stack", summary="OR the two top levels, pop one")
+def _old(g: Gen) -> None:
+    below, top = g.level(1), g.top
+    g.line(f"{below} |= {top}")
+    g.pop()
+
+
+@insn("LPS", family="stack", summary="duplicate the top (push)")
+def _lps(g: Gen) -> None:
+    g.push(g.top)
+
+
+@insn("LRD", family="stack", summary="copy the second level to the top")
+def _lrd(g: Gen) -> None:
+    g.line(f"{g.top} = {g.level(1)}")
+
+
+@insn("LPP", family="stack", summary="pop the top")
+def _lpp(g: Gen) -> None:
+    g.level(1)
+    g.pop()
+
+
+@insn("LDS", Role.N, family="stack", summary="push a copy of stack level n")
+def _lds(g: Gen, n: Const) -> None:
+    level = int(n.value)
+    if level > 8:
+        g.fail("LDS takes a level 1..8")
+    g.push(g.level(level))
+
+
+@insn("AENO", family="stack", summary="AND the previous box's ENO into the top")
+def _aeno(g: Gen) -> None:
+    if g.eno_valid:
+        # eno is assigned only when the box ran, i.e. when the top was 1
+        with g.block(f"if {g.top}:"):
+            g.line(f"{g.top} = eno")
+
+
+@insn("=", Role.BIT_W, family=F, summary="write the top to the bit")
+def _assign(g: Gen, op: Addr) -> None:
+    g.wbit(op, g.top)
+
+
+@insn("=I", Role.QBIT, family=F, summary="write the top to the output and its terminal now")
+def _assign_i(g: Gen, op: Addr) -> None:
+    top = g.top
+    g.wbit(op, top)
+    g.wbit(Addr("PQ", op.offset, 0, op.bit), top)
+
+
+def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
+    """S/R over ``n`` consecutive bits starting at ``op`` (T/C: n timers)."""
+    count = int(n.value)
+    with g.box():
+        if op.area in ("T", "C"):
+            if value:
+                g.fail("S cannot set timers or counters; use R to reset them")
+            last = op.offset + count - 1
+            limit = 256
+            if last >= limit:
+                g.fail(f"the range runs past {op.area}{limit - 1}")
+            if op.area == "T":
+                bank = g.bind(g.unit.hooks["timers"].reset, "Treset")
+                g.line(f"for _n in range({op.offset}, {last + 1}): {bank}(_n)")
+            else:
+                bank = g.bind(g.unit.hooks["counters"].reset, "Creset")
+                g.line(f"for _n in range({op.offset}, {last + 1}): {bank}(_n)")
+            return
+        start = op.offset * 8 + op.bit
+        end = start + count
+        from ..compiler.operands import area_size
+        size = area_size(g.unit.model, op.area) if op.area != "PQ" else g.unit.model.q_bytes
+        if (end + 7) // 8 > size:
+            g.fail(f"{count} bits from {op.text} run past the end of the {op.area} area")
+        areas = [op.area] + (["PQ"] if phys else [])
+        for area in areas:
+            buf = g.use(area)
+            bit = start
+            while bit < end:
+                byte, b = divmod(bit, 8)
+                span = min(8 - b, end - bit)
+                mask = ((1 << span) - 1) << b
+                if value:
+                    g.line(f"{buf}[{byte}] |= {mask}")
+                else:
+                    g.line(f"{buf}[{byte}] &= {~mask & 0xFF}")
+                bit += span
+
+
+@insn("S", Role.BIT_TC, Role.N, family=F, summary="set n bits")
+def _s(g: Gen, op: Addr, n: Const) -> None:
+    _range(g, op, n, 1)
+
+
+@insn("R", Role.BIT_TC, Role.N, family=F, summary="reset n bits (timers/counters: reset them)")
+def _r(g: Gen, op: Addr, n: Const) -> None:
+    _range(g, op, n, 0)
+
+
+@insn("SI", Role.QBIT, Role.N, family=F, summary="set n outputs and their terminals now")
+def _si(g: Gen, op: Addr, n: Const) -> None:
+    _range(g, op, n, 1, phys=True)
+
+
+@insn("RI", Role.QBIT, Role.N, family=F, summary="reset n outputs and their terminals now")
+def _ri(g: Gen, op: Addr, n: Const) -> None:
+    _range(g, op, n, 0, phys=True)
+
+
+@insn("NOP", Role.N, family=F, summary="no operation")
+def _nop(g: Gen, n: Const) -> None:
+    pass

@@ -1,0 +1,156 @@
+"""Instruction family: moves (MOVB MOVW MOVD MOVR BMB BMW BMD SWAP FILL BIR BIW).
+
+S7-200 System Manual, "Move instructions".  Moves copy bit patterns, so
+no SM flags change.  ``MOVD &VB100, AC1`` loads a pointer.  Block moves copy
+N (1..255) elements; the manual leaves overlapping source and destination
+open, plcrt copies element by element in ascending order (docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+from ..compiler.emit import Gen
+from ..compiler.operands import Addr, Const, Indirect
+from .registry import Role, insn
+
+F = "move"
+
+
+@insn("MOVB", Role.B_R, Role.B_W, family=F, summary="OUT := IN (byte)")
+def _movb(g: Gen, src, dst) -> None:
+    with g.box():
+        g.wr(dst, "B", g.rd(src, "B"))
+
+
+@insn("MOVW", Role.W_R, Role.W_W, family=F, summary="OUT := IN (word)")
+def _movw(g: Gen, src, dst) -> None:
+    with g.box():
+        g.copy(src, dst, "WU")
+
+
+@insn("MOVD", Role.D_PTR, Role.D_W, family=F, summary="OUT := IN (double word or pointer)")
+def _movd(g: Gen, src, dst) -> None:
+    with g.box():
+        g.copy(src, dst, "DU")
+
+
+@insn("MOVR", Role.R_R, Role.D_W, family=F, summary="OUT := IN (real)")
+def _movr(g: Gen, src, dst) -> None:
+    with g.box():
+        if isinstance(src, Const):
+            g.wr(dst, "R", g.rd(src, "R"))
+        else:
+            g.copy(src, dst, "DU")
+
+
+def _block(g: Gen, src, dst, n, kind: str, width: int) -> None:
+    with g.box():
+        if isinstance(n, Const):
+            count = int(n.value)
+            if not 1 <= count <= 255:
+                g.fail("N must be 1..255")
+            if isinstance(src, Addr) and isinstance(dst, Addr) and src.area not in ("AC", "T", "C") \
+                    and dst.area not in ("AC", "T", "C"):
+                _check_span(g, src, count * width)
+                _check_span(g, dst, count * width)
+                sb, db = g.use(src.area), g.use(dst.area)
+                a, b = src.offset, dst.offset
+                if a == b and sb == db:
+                    return
+                if sb != db or b < a or b >= a + count * width:
+                    # perf: non-overlapping (or backward-safe) block as one slice copy
+                    g.line(f"{db}[{b}:{b + count * width}] = {sb}[{a}:{a + count * width}]")
+                    return
+        cnt = g.rd(n, "B")
+        i = g.tmp("i")
+        with g.block(f"for {i} in range({cnt}):"):
+            g.line(f"pass")
+            g.lines.pop()
+            _elem_copy(g, src, dst, i, kind, width)
+
+
+def _check_span(g: Gen, a: Addr, nbytes: int) -> None:
+    from ..compiler.operands import area_size
+    if a.offset + nbytes > area_size(g.unit.model, a.area):
+        g.fail(f"the block at {a.text} runs past the end of the {a.area} area")
+
+
+def _elem_copy(g: Gen, src, dst, i: str, kind: str, width: int) -> None:
+    """Copy element ``i`` (a loop variable) of a block; run-time bounds-checked."""
+    helper = g.bind(_block_elem, "blk")
+    sref = _ref(g, src)
+    dref = _ref(g, dst)
+    g.line(f"{helper}({sref}, {dref}, {i}, {width}, {g.insn_id}, _LOCS)")
+    g.use("_LOCS")
+
+
+def _ref(g: Gen, op) -> str:
+    if isinstance(op, Indirect):
+        pbuf, poff = g._place(op.ptr, 4)
+        return f"{g.use('_ptr')}({pbuf}, {poff}, 1, {g.insn_id})"
+    buf, off = g._place(op, 1)
+    return f"({buf}, {off})"
+
+
+def _block_elem(src, dst, i: int, width: int, insn: int, locs) -> None:
+    from ..errors import PlcRuntimeError
+    sb, so = src
+    db, do = dst
+    a, b = so + i * width, do + i * width
+    if a + width > len(sb) or b + width > len(db):
+        raise PlcRuntimeError("block move runs past the end of its memory area", locs[insn])
+    db[b:b + width] = sb[a:a + width]
+
+
+@insn("BMB", Role.B_R, Role.B_W, Role.B_R, family=F, summary="move N bytes")
+def _bmb(g: Gen, src, dst, n) -> None:
+    _block(g, src, dst, n, "B", 1)
+
+
+@insn("BMW", Role.W_R, Role.W_W, Role.B_R, family=F, summary="move N words")
+def _bmw(g: Gen, src, dst, n) -> None:
+    _block(g, src, dst, n, "WU", 2)
+
+
+@insn("BMD", Role.D_R, Role.D_W, Role.B_R, family=F, summary="move N double words")
+def _bmd(g: Gen, src, dst, n) -> None:
+    _block(g, src, dst, n, "DU", 4)
+
+
+@insn("SWAP", Role.W_W, family=F, summary="exchange the bytes of a word")
+def _swap(g: Gen, op) -> None:
+    with g.box():
+        v = g.tmp("v")
+        g.line(f"{v} = {g.rd(op, 'WU')}")
+        g.wr(op, "W", f"({v} >> 8) | (({v} & 255) << 8)")
+
+
+@insn("FILL", Role.W_R, Role.W_W, Role.B_R, family=F, summary="write IN to N words from OUT")
+def _fill(g: Gen, src, dst, n) -> None:
+    with g.box():
+        if isinstance(n, Const) and isinstance(dst, Addr) and dst.area not in ("AC", "T", "C"):
+            count = int(n.value)
+            if not 1 <= count <= 255:
+                g.fail("N must be 1..255")
+            _check_span(g, dst, count * 2)
+            v = g.tmp("v")
+            db = g.use(dst.area)
+            g.line(f"{v} = {g.rd(src, 'WU')}")
+            g.line(f"{db}[{dst.offset}:{dst.offset + 2 * count}] = "
+                   f"bytes(({v} >> 8, {v} & 255)) * {count}")
+            return
+        g.fail("FILL needs a constant count and a direct destination address")
+
+
+@insn("BIR", Role.B_IB, Role.B_W, family=F, summary="OUT := physical input byte (immediate)")
+def _bir(g: Gen, src: Addr, dst) -> None:
+    with g.box():
+        g.wr(dst, "B", f"{g.use('PI')}[{src.offset}]")
+
+
+@insn("BIW", Role.B_R, Role.B_QB, family=F, summary="physical output byte := IN (immediate)")
+def _biw(g: Gen, src, dst: Addr) -> None:
+    with g.box():
+        v = g.tmp("v")
+        g.line(f"{v} = {g.rd(src, 'B')}")
+        g.line(f"{g.use('PQ')}[{dst.offset}] = {v}")
+        g.line(f"{g.use('Q')}[{dst.offset}] = {v}")

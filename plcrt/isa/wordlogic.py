@@ -1,0 +1,3 @@
+"""Instruction family: word logic, shifts and rotates (filled in by its table)."""
+
+from __future__ import annotations

@@ -1,0 +1,60 @@
+"""CPU model table: the size of every memory area per S7-200 CPU.
+
+Data only.  Sizes follow the S7-200 System Manual, appendix A (CPU
+specifications): process image I/Q 128 points each, M 32 bytes, S 32 bytes,
+V memory by model, AIW/AQW 32 words each, 256 timers and counters, four
+accumulators, six high-speed counters, 64 bytes of L memory per program unit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class CpuModel:
+    """Area sizes in bytes (T/C in elements) of one CPU type."""
+
+    name: str
+    v_bytes: int
+    sm_bytes: int
+    i_bytes: int = 16
+    q_bytes: int = 16
+    m_bytes: int = 32
+    s_bytes: int = 32
+    ai_bytes: int = 64
+    aq_bytes: int = 64
+    l_bytes: int = 64
+    timers: int = 256
+    counters: int = 256
+    accumulators: int = 4
+    hsc: int = 6
+    sm_readonly: int = 30  #: SMB0..SMB29 are read-only to the program
+
+
+CPU_MODELS: dict[str, CpuModel] = {
+    m.name: m
+    for m in (
+        CpuModel("CPU221", v_bytes=2048, sm_bytes=180, ai_bytes=0, aq_bytes=0),
+        CpuModel("CPU222", v_bytes=2048, sm_bytes=300),
+        CpuModel("CPU224", v_bytes=8192, sm_bytes=550),
+        CpuModel("CPU224XP", v_bytes=10240, sm_bytes=550),
+        CpuModel("CPU226", v_bytes=10240, sm_bytes=550),
+    )
+}
+
+DEFAULT_CPU = "CPU226"
+
+
+def cpu_model(name: str | None) -> CpuModel:
+    """Look up a model by name (case and blanks ignored)."""
+    from ..errors import PlcConfigError
+
+    key = (name or DEFAULT_CPU).upper().replace(" ", "").replace("-", "")
+    if not key.startswith("CPU"):
+        key = "CPU" + key
+    try:
+        return CPU_MODELS[key]
+    except KeyError:
+        known = ", ".join(CPU_MODELS)
+        raise PlcConfigError(f"unknown CPU model {name!r} (known: {known})") from None

@@ -97,8 +97,6 @@ class Resolver:
             raise ResolveError(str(e)) from None
         if isinstance(op, Name):
             return self._symbol(op, t)
-        if isinstance(op, (Pointer, Indirect)) and False:
-            return op
         return op
 
     def _symbol(self, op: Name, text: str) -> Resolved:
@@ -148,7 +146,8 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
     if isinstance(op, Name):
         if role in (Role.LABEL,):
             raise _bad(text, role)
-        raise ResolveError(f"'{text}' is not an address, constant or known symbol")
+        raise ResolveError(f"unknown symbol '{text}': not an address or constant, and not "
+                           f"in the symbol table (give one with --symbols)")
     if role is Role.LABEL:
         if isinstance(op, Const) and isinstance(op.value, int) and 0 <= op.value <= 255:
             return op

@@ -21,7 +21,7 @@ from __future__ import annotations
 import sys
 import time as _time
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 from ..compiler import compile_program
 from ..compiler.operands import Addr, OperandError, parse_operand
@@ -161,7 +161,10 @@ class Plc:
         self.scans += 1
         self._t_us += self.scan_us
         if self.stop_requested:
+            # STOP instruction: the scan completes, then the CPU switches to
+            # STOP and the outputs take their STOP state (off).
             self.mode = "STOP"
+            m["PQ"][:] = bytes(len(m["PQ"]))
 
     def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
         self.mode = "STOP"
@@ -275,42 +278,58 @@ def _system_symbols() -> dict[str, str]:
     return dict(SYSTEM_SYMBOLS)
 
 
-def load(source: str | Path, *, symbols: Any = None, data: Any = None,
-         scan_ms: float = 10.0, cpu: str | None = None, **kw: Any) -> Plc:
+def _text_or_path(x: Any) -> tuple[str, str]:
+    """(text, file name) for a path or literal text argument."""
+    from ..lang import read_source
+    if isinstance(x, Path):
+        return read_source(x), str(x)
+    s = str(x)
+    if "\n" not in s and len(s) < 4096:
+        return read_source(s), s
+    return s, "<string>"
+
+
+def parse_sources(sources: str | Path | Sequence[str | Path]) -> ir.Program:
+    """Parse one program file or text, or several (their blocks are merged,
+    as Micro/WIN keeps OB1 and its subroutines in one project)."""
+    from ..lang import parse_program
+    items = [sources] if isinstance(sources, (str, Path)) else list(sources)
+    if not items:
+        raise PlcConfigError("no program given")
+    programs = [parse_program(*_text_or_path(x)) for x in items]
+    if len(programs) == 1:
+        return programs[0]
+    pous = tuple(p for prog in programs for p in prog.pous)
+    # OB1 first, as in a Micro/WIN project
+    pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
+    return ir.Program(pous, programs[0].file, programs[0].source)
+
+
+def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
+         data: Any = None, scan_ms: float = 10.0, cpu: str | None = None,
+         **kw: Any) -> Plc:
     """Parse, compile and bind a program.
 
     Args:
-        source: a path to a ``.awl`` file, or program text (anything with a
-            newline or starting with a block keyword is taken as text).
+        source: a path to a ``.awl`` file, program text (anything with a
+            newline), or a list of them whose blocks are merged.
         symbols: path or text of a symbol table, or a parsed table.
         data: path or text of a data block, or a parsed one.
+        scan_ms: simulated scan time in milliseconds.
+        cpu: CPU model name (default CPU 226).
+
+    Raises:
+        PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
     """
-    from ..lang import parse_datablock, parse_program, parse_symbols, read_source
+    from ..lang import parse_datablock, parse_symbols
 
-    def text_or_path(x: Any) -> tuple[str, str] | None:
-        if x is None or not isinstance(x, (str, Path)):
-            return None
-        s = str(x)
-        if isinstance(x, Path) or ("\n" not in s and len(s) < 4096 and Path(s).suffix
-                                   and not s.lstrip().upper().startswith(
-                                       ("ORGANIZATION_BLOCK", "SUBROUTINE_BLOCK"))):
-            return read_source(s), s
-        return s, "<string>"
-
-    t = text_or_path(source)
-    if t is None:
-        raise PlcConfigError("load() needs a path or program text")
-    program = parse_program(t[0], t[1])
+    program = parse_sources(source)
     if isinstance(symbols, (str, Path)):
-        st = text_or_path(symbols)
-        assert st is not None
-        symbols = parse_symbols(st[0], st[1])
+        symbols = parse_symbols(*_text_or_path(symbols))
     if isinstance(data, (str, Path)):
-        dt = text_or_path(data)
-        assert dt is not None
-        data = parse_datablock(dt[0], dt[1])
+        data = parse_datablock(*_text_or_path(data))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, **kw)
 
 
-__all__ = ["Plc", "load"]
+__all__ = ["Plc", "load", "parse_sources"]
 _ = (sys, Iterable)

@@ -40,7 +40,8 @@ import re
 import struct
 from dataclasses import dataclass, field
 
-from ..errors import Diagnostic, DiagnosticSink, PlcSyntaxError, SourceLoc
+from ..errors import Diagnostic, DiagnosticSink, SourceLoc
+from .stl import raise_collected
 
 __all__ = ["DataBlock", "DataEntry", "parse_datablock"]
 
@@ -92,7 +93,7 @@ class DataBlock:
                     f"{entry.end - entry.offset} byte(s) but V memory has only "
                     f"{len(buf)} bytes (VB0..VB{len(buf) - 1})",
                     entry.loc, code="datablock")
-        sink.raise_if_errors(PlcSyntaxError)
+        raise_collected(sink)
         for entry in self.entries:
             if entry.bit is None:
                 buf[entry.offset:entry.end] = entry.data
@@ -151,7 +152,7 @@ def parse_datablock(text: str, file: str = "<string>") -> DataBlock:
     for number, line in enumerate(text.splitlines(), start=1):
         cursor = _parse_line(line, number, file, cursor, block, sink)
     _note_overlaps(block)
-    sink.raise_if_errors(PlcSyntaxError)
+    raise_collected(sink)
     return block
 
 

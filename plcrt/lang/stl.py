@@ -19,10 +19,10 @@ lark exception ever leaves this module.
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from collections.abc import Iterable
+from functools import cache
 from importlib import resources
 from pathlib import Path
-from typing import Iterable
 
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
@@ -92,7 +92,7 @@ def _decode(data: bytes) -> str:
 # The parser
 # --------------------------------------------------------------------------
 
-@lru_cache(maxsize=None)
+@cache
 def _parser() -> Lark:
     """Build the lark parser once per process (lazily, on first use).
 
@@ -143,11 +143,29 @@ def parse_program(text: str, file: str = "<string>") -> Program:
     sink = DiagnosticSink()
     tree = _parse_collecting(prepared, file, sink)
     if tree is None:
-        sink.raise_if_errors(PlcSyntaxError)
+        raise_collected(sink)
         raise AssertionError("unreachable: failed parse without diagnostics")
     pous = _Builder(file, sink).program(tree)
-    sink.raise_if_errors(PlcSyntaxError)
+    raise_collected(sink)
     return Program(pous=tuple(pous), file=file, source=text)
+
+
+def raise_collected(sink: DiagnosticSink) -> None:
+    """Raise one :class:`PlcSyntaxError` for all errors in ``sink``, if any.
+
+    Unlike ``DiagnosticSink.raise_if_errors`` the exception's ``message`` and
+    ``loc`` are those of the first error, so a caller that shows only one line
+    still shows something useful; ``str()`` lists every diagnostic.  Shared
+    by the symbol-table and data-block readers.
+    """
+    errors = sink.errors
+    if not errors:
+        return
+    first = errors[0]
+    message = first.message
+    if len(errors) > 1:
+        message += f" (and {len(errors) - 1} more error(s))"
+    raise PlcSyntaxError(message, first.loc, sink.items)
 
 
 def _prepare(text: str) -> str:
@@ -265,12 +283,13 @@ def _describe(exc: UnexpectedInput, text: str, file: str,
     elif isinstance(exc, UnexpectedCharacters):
         line, column = exc.line, exc.column
         expected = set(exc.allowed or ())
-        char = text[exc.pos_in_stream] if exc.pos_in_stream < len(text) else ""
+        pos = exc.pos_in_stream or 0
+        char = text[pos] if pos < len(text) else ""
         if char in ("'", '"'):
             _, block, network = _open_block(lines, line)
             loc = SourceLoc(file, line, column, block, network if block else None)
             return loc, f"unterminated string literal (missing closing {char})"
-        found = repr(_word_at(text, exc.pos_in_stream))
+        found = repr(_word_at(text, pos))
     else:  # UnexpectedEOF and future kinds
         line, column = _end_position(lines)
         expected = set(getattr(exc, "expected", ()) or ())

@@ -20,6 +20,7 @@ import io
 from dataclasses import dataclass, field
 
 from ..errors import Diagnostic, DiagnosticSink, PlcSyntaxError, SourceLoc
+from .stl import raise_collected
 
 __all__ = ["SYSTEM_SYMBOLS", "Symbol", "SymbolTable", "parse_symbols",
            "resolve_symbol"]
@@ -202,7 +203,7 @@ def parse_symbols(text: str, file: str = "<string>") -> SymbolTable:
                 "note", f"first definition of {name!r}", previous.loc, "symbol"))
             continue
         table.entries[name] = Symbol(name, address, comment, loc)
-    sink.raise_if_errors(PlcSyntaxError)
+    raise_collected(sink)
     return table
 
 

@@ -259,7 +259,13 @@ def const_expr(c: Const, kind: str) -> str:
         n = int.from_bytes(v[:4].ljust(VALUE_WIDTH[kind[0]], b"\0")[:VALUE_WIDTH[kind[0]]], "big")
         v = n
     if kind == "R":
-        return repr(float(v))
+        # A REAL constant is stored as IEEE single on the CPU: round it here,
+        # or math would run on a more precise value than the program holds.
+        import struct
+        try:
+            return repr(struct.unpack(">f", struct.pack(">f", float(v)))[0])
+        except OverflowError:
+            raise CodegenError(f"real constant {c.text} is outside the REAL range") from None
     if isinstance(v, float):
         if kind[0] == "D" and not c.is_real:
             v = int(v)

@@ -9,7 +9,11 @@ small tables.
 
 from __future__ import annotations
 
+from typing import Any, Sequence
+
 from ..compiler.emit import Gen
+from ..compiler.operands import Const
+from ..errors import PlcRuntimeError, SourceLoc
 from .registry import Role, insn
 
 F = "compare"
@@ -26,7 +30,10 @@ def _make(prefix: str, width: str, rel: str) -> None:
     how = COMBINE[prefix]
 
     def emit(g: Gen, a, b) -> None:
-        expr = f"({g.rd(a, kind)} {pyop} {g.rd(b, kind)})"
+        if kind == "R":
+            expr = _real_operands(g, a, b, pyop)
+        else:
+            expr = f"({g.rd(a, kind)} {pyop} {g.rd(b, kind)})"
         if how == "push":
             g.push(f"1 if {expr} else 0")
         else:
@@ -35,6 +42,38 @@ def _make(prefix: str, width: str, rel: str) -> None:
     summary = {"push": "push", "&=": "AND", "|=": "OR"}[how]
     insn(f"{prefix}{width}{rel}", role, role, family=F,
          summary=f"{summary} IN1 {rel} IN2 ({width})")(emit)
+
+
+def _illegal_real(insn_id: int, locs: Sequence[SourceLoc]) -> None:
+    """Raise the fatal error of a REAL compare that reads a NaN."""
+    raise PlcRuntimeError("compare of an illegal REAL value (NaN); the CPU goes to STOP",
+                          locs[insn_id])
+
+
+def _real_operands(g: Gen, a: Any, b: Any, pyop: str) -> str:
+    """Read both REAL operands once and check them; returns the comparison.
+
+    An illegal real is a fatal error on the S7-200 (System Manual, "Compare
+    instructions"; only the S7-200 SMART makes it non-fatal with result 0).
+    Python's IEEE rules would instead make ``<>`` true and every other
+    relation false, matching neither CPU.  Constants are finite by
+    construction, so only memory operands are checked.
+    """
+    names = []
+    checks = []
+    for op in (a, b):
+        if isinstance(op, Const):
+            names.append(g.rd(op, "R"))
+            continue
+        v = g.tmp("r")
+        g.line(f"{v} = {g.rd(op, 'R')}")
+        names.append(v)
+        checks.append(f"{v} != {v}")
+    if checks:
+        bad = g.bind(_illegal_real, "badreal")
+        with g.block(f"if {' or '.join(checks)}:"):
+            g.line(f"{bad}({g.insn_id}, {g.use('_LOCS')})")
+    return f"({names[0]} {pyop} {names[1]})"
 
 
 for _p in COMBINE:

@@ -157,13 +157,24 @@ def _lscr(g: Gen, bit: Addr) -> None:
 
 
 def _tofs_in_segment(g: Gen, info, start: int) -> list[int]:
+    """Numbers of the TOF timers written inside the SCR segment at ``start``.
+
+    The timer operand is resolved like any operand, so a TOF named by a
+    symbol (``TOF Fan_Delay, +50``, common in SMART exports) is found too.
+    Operands that do not resolve are reported by the TOF itself.
+    """
+    from ..compiler.resolve import Resolver
+    res = Resolver(g.unit.model, g.unit.symbols, g.unit.system_symbols, info.local_vars)
     found: list[int] = []
     for idx in info.scr_pieces.get(start, [start]):
         for ins in info.pieces[idx].insns:
             if ins.mnemonic == "TOF" and ins.operands:
-                t = ins.operands[0].text.strip().upper()
-                if t[:1] == "T" and t[1:].isdigit() and int(t[1:]) < 256:
-                    found.append(int(t[1:]))
+                try:
+                    t = res.resolve(ins.operands[0], Role.TIMER)
+                except ResolveError:
+                    continue
+                if isinstance(t, Addr):
+                    found.append(t.offset)
     return sorted(set(found))
 
 

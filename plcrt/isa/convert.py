@@ -20,6 +20,8 @@ and ASCII conversions (ITA, DTA, RTA, ATH, HTA, ITS, ...) are not here.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ..compiler.emit import Gen
 from .registry import Role, insn
 
@@ -29,7 +31,8 @@ F = "convert"
 
 #: mnemonic -> (IN role, OUT role, IN kind, OUT kind, lo, hi, summary)
 NARROW: dict[str, tuple[Role, Role, str, str, int, int, str]] = {
-    # ITB: "values 0 to 255 are converted, all others overflow" (unsigned byte)
+    # ITB converts 0..255 only; anything else is an overflow (System Manual,
+    # "Byte to integer and integer to byte").
     "ITB": (Role.W_R, Role.B_W, "W", "B", 0, 255, "byte := INT (0..255)"),
     "DTI": (Role.D_R, Role.W_W, "D", "W", -32768, 32767, "INT := DINT"),
 }
@@ -41,7 +44,7 @@ WIDEN: dict[str, tuple[Role, Role, str, str, str]] = {
 }
 
 
-def _overflow(g: Gen, ok: str, write) -> None:
+def _overflow(g: Gen, ok: str, write: Callable[[], None]) -> None:
     """``if ok``: write, clear SM1.1, ENO 1; else set SM1.1, ENO 0."""
     sm = g.use("SM")
     with g.block(f"if {ok}:"):
@@ -84,16 +87,20 @@ for _mn in WIDEN:
 @insn("DTR", Role.D_R, Role.R_W, family=F, summary="REAL := DINT (nearest single)")
 def _dtr(g: Gen, a, out) -> None:
     with g.box():
-        # float() is exact for 32-bit integers; storing as single rounds to
-        # nearest, ties to even (IEEE-754, as the CPU's converter).
+        # float() is exact for 32-bit integers; storing it as a single rounds
+        # to nearest, ties to even (the IEEE-754 default rounding).
         g.wr(out, "R", f"float({g.rd(a, 'D')})")
 
 
 # -- REAL -> DINT -------------------------------------------------------------
 #
-# Bounds are open intervals on the double value of the single-precision
-# input, chosen so that the integer result lies in -2**31 .. 2**31 - 1.  A NaN
-# fails every comparison and so lands in the overflow branch.
+# System Manual, "Round" / "Truncate": a REAL that is not a number or does
+# not fit a DINT sets SM1.1 and leaves OUT alone.  The bounds are open
+# intervals on the (exact) double value of the single-precision input, chosen
+# so that the integer result lies in -2**31 .. 2**31 - 1; a NaN fails every
+# comparison and so lands in the overflow branch.  The manual says a fraction
+# of 0.5 or more rounds "up"; plcrt reads that as away from zero for negative
+# values too (-2.5 -> -3), matching the magnitude rule it states.
 
 #: mnemonic -> (exclusive bounds, integer expression template over {x}, summary)
 REAL_TO_DINT: dict[str, tuple[tuple[float, float], str, str]] = {
@@ -133,7 +140,7 @@ INT_TO_BCD: tuple[int, ...] = tuple(
 BCD_TO_INT: dict[int, int] = {b: i for i, b in enumerate(INT_TO_BCD)}
 
 
-def _bcd_error(g: Gen, ok: str, write) -> None:
+def _bcd_error(g: Gen, ok: str, write: Callable[[], None]) -> None:
     """``if ok``: write, clear SM1.6, ENO 1; else set SM1.6 (non-BCD), ENO 0."""
     sm = g.use("SM")
     with g.block(f"if {ok}:"):
@@ -145,7 +152,8 @@ def _bcd_error(g: Gen, ok: str, write) -> None:
         g.line("eno = 0")
 
 
-@insn("BCDI", Role.W_W, family=F, may_fail=True, summary="OUT := INT of the BCD word OUT")
+@insn("BCDI", Role.W_W, family=F, may_fail=True,
+      summary="OUT := INT of the BCD word OUT")
 def _bcdi(g: Gen, out) -> None:
     table = g.bind(BCD_TO_INT, "bcd2i")
     with g.box():
@@ -154,7 +162,8 @@ def _bcdi(g: Gen, out) -> None:
         _bcd_error(g, f"{r} is not None", lambda: g.wr(out, "W", r))
 
 
-@insn("IBCD", Role.W_W, family=F, may_fail=True, summary="OUT := BCD word of the INT OUT (0..9999)")
+@insn("IBCD", Role.W_W, family=F, may_fail=True,
+      summary="OUT := BCD word of the INT OUT (0..9999)")
 def _ibcd(g: Gen, out) -> None:
     table = g.bind(INT_TO_BCD, "i2bcd")
     with g.box():

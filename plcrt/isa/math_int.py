@@ -80,24 +80,23 @@ def _divd(g: Gen, a, out) -> None:
     _div(g, a, out, "D", D_RANGE)
 
 
-def _low_word(out):
-    """The low word (INT) of a double-word operand: the second input of MUL/DIV."""
+def _low_word(g: Gen, out) -> str:
+    """Expression reading the low word (INT) of a double-word operand: the
+    second input of MUL/DIV (big-endian, so bytes 2..3 of the double word)."""
     from ..compiler.operands import Addr
     if isinstance(out, Addr):
         if out.area == "AC":
-            return Addr("AC", out.offset, 2, 0, out.text)
-        return Addr(out.area, out.offset + 2, 2, 0, out.text)
-    return None
+            return g.rd(Addr("AC", out.offset, 2, 0, out.text), "W")
+        return g.rd(Addr(out.area, out.offset + 2, 2, 0, out.text), "W")
+    # *VDn / *ACn / *LDn: read the whole double word and take its low half.
+    return f"(({g.rd(out, 'DU')} & 65535 ^ 32768) - 32768)"
 
 
 @insn("MUL", Role.W_R, Role.D_W, family=F, summary="OUT := IN1 * low word of OUT (32-bit result)")
 def _mul(g: Gen, a, out) -> None:
-    lw = _low_word(out)
-    if lw is None:
-        g.fail("MUL needs a direct double-word output")
     with g.box():
         r = g.tmp("r")
-        g.line(f"{r} = {g.rd(a, 'W')} * {g.rd(lw, 'W')}")
+        g.line(f"{r} = {g.rd(a, 'W')} * {_low_word(g, out)}")
         g.wr(out, "D", r)
         g.flags_zn(r)
 
@@ -105,9 +104,6 @@ def _mul(g: Gen, a, out) -> None:
 @insn("DIV", Role.W_R, Role.D_W, family=F, may_fail=True,
       summary="low word of OUT / IN1: quotient low word, remainder high word")
 def _divw(g: Gen, a, out) -> None:
-    lw = _low_word(out)
-    if lw is None:
-        g.fail("DIV needs a direct double-word output")
     with g.box():
         d, n, q, m = g.tmp("d"), g.tmp("n"), g.tmp("q"), g.tmp("m")
         sm = g.use("SM")
@@ -116,7 +112,7 @@ def _divw(g: Gen, a, out) -> None:
             g.line(f"{sm}[1] |= 8")
             g.line("eno = 0")
         with g.block("else:"):
-            g.line(f"{n} = {g.rd(lw, 'W')}")
+            g.line(f"{n} = {_low_word(g, out)}")
             g.line(f"{q} = abs({n}) // abs({d}) * (-1 if ({n} < 0) != ({d} < 0) else 1)")
             g.line(f"{m} = {n} - {q} * {d}")
             g.line(f"{sm}[1] &= 247")

@@ -101,6 +101,15 @@ def _block_elem(src, dst, i: int, width: int, insn: int, locs) -> None:
     db[b:b + width] = sb[a:a + width]
 
 
+def _fill_words(value: int, dst, count: int, insn: int, locs) -> None:
+    """FILL at run time: ``count`` big-endian copies of ``value`` from ``dst``."""
+    from ..errors import PlcRuntimeError
+    db, do = dst
+    if do + 2 * count > len(db):
+        raise PlcRuntimeError("FILL runs past the end of its memory area", locs[insn])
+    db[do:do + 2 * count] = bytes((value >> 8 & 255, value & 255)) * count
+
+
 @insn("BMB", Role.B_R, Role.B_W, Role.B_R, family=F, summary="move N bytes")
 def _bmb(g: Gen, src, dst, n) -> None:
     _block(g, src, dst, n, "B", 1)
@@ -138,7 +147,16 @@ def _fill(g: Gen, src, dst, n) -> None:
             g.line(f"{db}[{dst.offset}:{dst.offset + 2 * count}] = "
                    f"bytes(({v} >> 8, {v} & 255)) * {count}")
             return
-        g.fail("FILL needs a constant count and a direct destination address")
+        if isinstance(dst, Addr) and dst.area == "AC":
+            # The manual's OUT operands for FILL are word areas and *pointers;
+            # an accumulator holds one word only.
+            g.fail("FILL cannot write to an accumulator")
+        # N from memory (VB, MB, ...) or OUT through a pointer (*VD, *LD,
+        # *AC): both are legal (System Manual, FILL), so fill at run time
+        # with a bounds check like the block moves.
+        helper = g.bind(_fill_words, "fill")
+        g.line(f"{helper}({g.rd(src, 'WU')}, {_ref(g, dst)}, {g.rd(n, 'B')}, "
+               f"{g.insn_id}, {g.use('_LOCS')})")
 
 
 @insn("BIR", Role.B_IB, Role.B_W, family=F, summary="OUT := physical input byte (immediate)")

@@ -89,13 +89,18 @@ def insn(mnemonic: str, *roles: Role, family: str, summary: str,
     return register
 
 
+_loaded = False
+
+
 def lookup(mnemonic: str) -> InsnSpec | None:
     """The spec of a mnemonic, loading all families on first use."""
-    if not REGISTRY:
+    if not _loaded:
         load_families()
     return REGISTRY.get(mnemonic)
 
 
 def load_families() -> None:
     """Import every family module (each registers its instructions)."""
+    global _loaded
     from . import families  # noqa: F401
+    _loaded = True

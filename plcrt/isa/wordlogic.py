@@ -125,18 +125,18 @@ def _make_shift(stem: str, width: str) -> None:
     def emit(g: Gen, out, count) -> None:
         with g.box():
             if isinstance(count, Const):
-                n = int(count.value) & 0xFF
+                k = int(count.value) & 0xFF
                 # Shifts: a count >= width shifts the maximum number of times;
                 # rotates: the count is taken modulo the width (System Manual,
                 # "Shift and rotate instructions").
-                n = n % bits if rotate else min(n, bits)
-                if n == 0:
-                    # No shift/rotate: OUT and SM1.1 unchanged (the manual
-                    # sets SM1.1 only "if the shift count is greater than 0"
-                    # / "if the rotate operation is performed").
+                k = k % bits if rotate else min(k, bits)
+                if k == 0:
+                    # No shift/rotate: OUT and SM1.1 unchanged.  The manual
+                    # updates SM1.1 only for a shift count above 0 and only
+                    # when a rotate is actually performed.
                     _zero_flag(g, g.rd(out, kind))
                     return
-                _shift_body(g, out, kind, bits, tpl, str(n), str(bits - n), str(n - 1))
+                _shift_body(g, out, kind, bits, tpl, str(k), str(bits - k), str(k - 1))
                 return
             n = g.tmp("n")
             g.line(f"{n} = {g.rd(count, 'B')}")
@@ -212,6 +212,24 @@ def _shrb_var(buf: bytearray, start: int, size: int, count: int, data: int) -> i
     return fn(buf, *_shrb_layout(start, n), data)
 
 
+def _shrb_inline(g: Gen, buf: str, byte: int, sh: int, mask: int, top: int,
+                 up: bool, data: str) -> None:
+    """SHRB of a register that lies inside one byte, as inline statements."""
+    field = mask << sh
+    x, d = g.tmp("x"), g.tmp("d")
+    sm = g.use("SM")
+    g.line(f"{d} = {data}")
+    g.line(f"{x} = {buf}[{byte}]")
+    if up:
+        new = f"((({x} & {field}) << 1 | {d} << {sh}) & {field})"
+        out = f"{x} >> {sh + top} & 1"
+    else:
+        new = f"(({x} & {field}) >> 1 & {field} | {d} << {sh + top})"
+        out = f"{x} >> {sh} & 1"
+    g.line(f"{buf}[{byte}] = {x} & {~field & 0xFF} | {new}")
+    g.line(f"{sm}[1] = {sm}[1] & 253 | ({out}) << 1")
+
+
 @insn("SHRB", Role.BIT_R, Role.BIT_W, Role.B_R, family=F, may_fail=True,
       summary="shift DATA into the bit register S_BIT..S_BIT+|N|-1; SM1.1 bit out")
 def _shrb(g: Gen, data: Addr, sbit: Addr, count) -> None:
@@ -228,6 +246,13 @@ def _shrb(g: Gen, data: Addr, sbit: Addr, count) -> None:
         if layout[1] > size:
             g.fail(f"the {abs(n)}-bit shift register from {sbit.text} runs past "
                    f"the end of the {sbit.area} area")
+        b0, b1, sh, mask, top = layout
+        if b1 - b0 == 1:
+            # perf: a register inside one byte is shifted inline.
+            with g.box():
+                _shrb_inline(g, buf, b0, sh, mask, top, n > 0, g.rbit(data))
+                g.eno("1")
+            return
         fn = g.bind(_shrb_up if n > 0 else _shrb_down, "shrb")
         args = ", ".join(str(x) for x in layout)
         with g.box():

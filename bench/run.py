@@ -1,0 +1,408 @@
+"""plcrt benchmark: execution speed of compiled programs and compile time.
+
+Run ``python bench/run.py`` (or ``make bench``).  It
+
+1. generates two STL programs in Micro/WIN export form (deterministic,
+   seeded): a boolean-heavy one (contacts, ALD/OLD, LPS/LRD/LPP, outputs)
+   and a mixed one (moves, INT/DINT math, compares, 100 ms timers), each of
+   at least 1000 instructions;
+2. loads each with :func:`plcrt.load`, warms it up, then times many scans
+   with ``time.perf_counter`` and keeps the best of several repeats;
+3. reports instructions per second = instructions in the program x scans /
+   seconds.  Every instruction of the program is counted once per scan, as a
+   PLC's instruction timing does, whether or not a box's enable was 1;
+4. times parse and compile of the corpus file ``roundtrip.awl`` (if the
+   shared corpus is present).  That file uses instructions plcrt does not
+   implement, so compiling it ends in ``PlcCompileError``: the time to that
+   error is reported, and also the load time of the same program with the
+   failing networks left out.
+
+This is a measuring tool, not a test: it asserts nothing and never fails on
+slow results (``--check`` makes it exit 1 below the targets).  ``--save DIR``
+writes the generated programs so they can be read or dumped with
+``plcrt dump``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import gc
+import json
+import os
+import platform
+import random
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # run from a checkout without installing
+
+import plcrt  # noqa: E402
+from plcrt import PlcCompileError, PlcError  # noqa: E402
+
+CORPUS = ROOT.parent / "shared" / "corpus"
+if not CORPUS.is_dir():
+    CORPUS = Path("/work/shared/corpus")
+CORPUS_FILE = "bulaofen0036-coder__Smart200-MicroWIN-MCP__roundtrip.awl"
+CORPUS_SYMBOLS = ROOT / "tests" / "data" / "roundtrip_symbols.sdf"
+
+#: Targets from the project brief, in instructions per second.
+TARGETS = {"bool": 10_000_000, "mixed": 3_000_000}
+
+MIN_INSNS = 1000
+
+
+# ---------------------------------------------------------------------------
+# Program generators
+# ---------------------------------------------------------------------------
+
+def _insn(mnemonic: str, operands: str = "") -> str:
+    # Micro/WIN pads the mnemonic to seven columns.
+    return f"{mnemonic:<7}{operands}".rstrip()
+
+
+def _export(title: str, networks: list[tuple[str, list[str]]]) -> str:
+    lines = ["ORGANIZATION_BLOCK MAIN:OB1", f"TITLE={title}", "BEGIN"]
+    for number, (net_title, body) in enumerate(networks, 1):
+        lines.append(f"Network {number} // {net_title}" if net_title else f"Network {number}")
+        lines.extend(body)
+    lines.append("END_ORGANIZATION_BLOCK")
+    return "\n".join(lines) + "\n"
+
+
+def _count(networks: list[tuple[str, list[str]]]) -> int:
+    return sum(len(body) for _, body in networks)
+
+
+def bool_program(min_insns: int = MIN_INSNS, seed: int = 1) -> str:
+    """Boolean-heavy OB1: rungs of contacts, blocks and branched outputs."""
+    rnd = random.Random(seed)
+
+    def contact() -> str:
+        area = rnd.choice(("I", "I", "M", "V", "Q"))
+        byte = rnd.randrange(4 if area != "V" else 16)
+        return f"{area}{byte}.{rnd.randrange(8)}"
+
+    def out_bit(k: int) -> str:
+        # Outputs go to M and V so that later rungs read earlier results.
+        return f"M{4 + k // 8 % 28}.{k % 8}" if k % 3 else f"V{100 + k // 8}.{k % 8}"
+
+    networks: list[tuple[str, list[str]]] = []
+    k = 0
+    while _count(networks) < min_insns:
+        shape = len(networks) % 4
+        body: list[str] = []
+        if shape == 0:  # series and parallel contacts
+            body += [_insn("LD", contact()), _insn("A", contact()), _insn("AN", contact()),
+                     _insn("O", contact()), _insn("ON", contact()), _insn("A", contact()),
+                     _insn("=", out_bit(k))]
+            k += 1
+        elif shape == 1:  # (a AND b OR c AND NOT d) AND (e OR f)
+            body += [_insn("LD", contact()), _insn("A", contact()),
+                     _insn("LD", contact()), _insn("AN", contact()), _insn("OLD"),
+                     _insn("LD", contact()), _insn("O", contact()), _insn("ALD"),
+                     _insn("AN", contact()), _insn("=", out_bit(k))]
+            k += 1
+        elif shape == 2:  # one condition, three branched outputs
+            body += [_insn("LD", contact()), _insn("O", contact()), _insn("LPS"),
+                     _insn("A", contact()), _insn("=", out_bit(k)), _insn("LRD"),
+                     _insn("AN", contact()), _insn("=", out_bit(k + 1)), _insn("LPP"),
+                     _insn("A", contact()), _insn("=", out_bit(k + 2))]
+            k += 3
+        else:  # seal-in with interlocks
+            out = out_bit(k)
+            body += [_insn("LD", contact()), _insn("O", out), _insn("AN", contact()),
+                     _insn("A", contact()), _insn("LDN", contact()), _insn("ON", contact()),
+                     _insn("ALD"), _insn("=", out)]
+            k += 1
+        networks.append(("", body))
+    return _export("plcrt benchmark: boolean logic", networks)
+
+
+def mixed_program(min_insns: int = MIN_INSNS, seed: int = 2) -> str:
+    """Mixed OB1: moves, INT/DINT math, compares and 100 ms timers."""
+    rnd = random.Random(seed)
+    networks: list[tuple[str, list[str]]] = []
+    # TON numbers with 100 ms resolution: T37-T63 and T101-T255.
+    timers = [*range(37, 64), *range(101, 256)]
+    k = 0
+    while _count(networks) < min_insns:
+        shape = len(networks) % 5
+        a, b = 2 * rnd.randrange(0, 40), 2 * rnd.randrange(0, 40)  # inputs VW0..VW78
+        w = 200 + 2 * (k % 200)                                  # results VW200..
+        d = 1000 + 4 * (k % 100)                                 # results VD1000..
+        if shape == 0:  # moves
+            body = [_insn("LD", "SM0.0"), _insn("MOVW", f"VW{a}, VW{w}"),
+                    _insn("MOVB", f"VB{a + 1}, VB{w + 1}"), _insn("MOVD", f"VD{a}, VD{d}"),
+                    _insn("MOVW", f"+{rnd.randrange(1, 500)}, VW{w + 400}")]
+        elif shape == 1:  # INT math on a scratch word (no accumulation: no overflow)
+            body = [_insn("LD", "SM0.0"), _insn("MOVW", f"VW{a}, VW{w}"),
+                    _insn("+I", f"VW{b}, VW{w}"), _insn("-I", f"+{rnd.randrange(1, 9)}, VW{w}"),
+                    _insn("*I", f"+3, VW{w}")]
+        elif shape == 2:  # DINT math and a compare-driven move
+            body = [_insn("LD", "SM0.0"), _insn("MOVD", f"VD{a}, VD{d}"),
+                    _insn("+D", f"VD{b}, VD{d}"),
+                    _insn("LDW>", f"VW{a}, VW{b}"), _insn("AW<", f"VW{a}, +500"),
+                    _insn("MOVW", f"VW{a}, VW{w}")]
+        elif shape == 3:  # compares into bits
+            body = [_insn("LDW>=", f"VW{a}, +{rnd.randrange(0, 300)}"),
+                    _insn("OW=", f"VW{b}, +7"), _insn("LDD<", f"VD{a}, VD{b}"),
+                    _insn("AB<>", f"VB{a}, VB{b}"), _insn("OLD"),
+                    _insn("=", f"M{k % 32}.{k % 8}"), _insn("INCW", f"VW{w}")]
+        else:  # a 100 ms timer and its bit
+            t = f"T{timers[k // 5 % len(timers)]}"
+            body = [_insn("LD", f"I{k % 2}.{k % 8}"), _insn("AN", f"M{k % 32}.{(k + 1) % 8}"),
+                    _insn("TON", f"{t}, +{rnd.randrange(5, 50)}"),
+                    _insn("LD", t), _insn("=", f"Q{k % 4}.{k % 8}")]
+        networks.append(("", body))
+        k += 1
+    return _export("plcrt benchmark: mixed word logic", networks)
+
+
+# ---------------------------------------------------------------------------
+# Measuring
+# ---------------------------------------------------------------------------
+
+@dataclasses.dataclass
+class ScanResult:
+    name: str
+    instructions: int
+    networks: int
+    scans_per_repeat: int
+    repeats: int
+    best_s: float
+    load_s: float
+
+    @property
+    def scans_per_s(self) -> float:
+        return self.scans_per_repeat / self.best_s
+
+    @property
+    def insns_per_s(self) -> float:
+        return self.instructions * self.scans_per_s
+
+    def as_dict(self) -> dict[str, Any]:
+        d = dataclasses.asdict(self)
+        d.update(scans_per_s=round(self.scans_per_s, 1),
+                 insns_per_s=round(self.insns_per_s),
+                 us_per_scan=round(1e6 / self.scans_per_s, 2),
+                 target_insns_per_s=TARGETS.get(self.name),
+                 meets_target=self.insns_per_s >= TARGETS.get(self.name, 0))
+        return d
+
+
+def _prepare_inputs(plc: plcrt.Plc) -> None:
+    """Non-trivial data so both branches of the logic run."""
+    rnd = random.Random(7)
+    for byte in range(4):
+        plc[f"IB{byte}"] = rnd.randrange(256)
+    for word in range(0, 80, 2):
+        plc[f"VW{word}"] = rnd.randrange(0, 1000)
+
+
+def measure_scans(name: str, text: str, *, repeats: int, target_s: float) -> ScanResult:
+    t0 = time.perf_counter()
+    plc = plcrt.load(text)
+    load_s = time.perf_counter() - t0
+    _prepare_inputs(plc)
+    plc.scan(200)  # warm-up: timers started, caches filled
+    # calibrate: scans per repeat so one repeat takes about target_s
+    t0 = time.perf_counter()
+    plc.scan(100)
+    per_scan = (time.perf_counter() - t0) / 100
+    n = max(100, int(target_s / max(per_scan, 1e-9)))
+    best = float("inf")
+    gc_was = gc.isenabled()
+    gc.disable()  # generated code allocates little; keep collector pauses out
+    try:
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            plc.scan(n)
+            best = min(best, time.perf_counter() - t0)
+    finally:
+        if gc_was:
+            gc.enable()
+    if plc.mode != "RUN":
+        raise RuntimeError(f"benchmark program {name} left RUN mode: {plc.fault}")
+    return ScanResult(name, plc.program.instruction_count(), plc.program.network_count(),
+                      n, repeats, best, load_s)
+
+
+def _best_of(repeats: int, fn: Callable[[], Any]) -> tuple[float, Any]:
+    best, result = float("inf"), None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, result
+
+
+def measure_corpus(repeats: int) -> dict[str, Any] | None:
+    """Parse + compile time of the roundtrip corpus file, honestly labelled."""
+    from plcrt.lang import parse_program, parse_symbols, read_source
+
+    path = CORPUS / CORPUS_FILE
+    if not path.is_file():
+        return None
+    symbols = None
+    if CORPUS_SYMBOLS.is_file():
+        symbols = parse_symbols(read_source(CORPUS_SYMBOLS), str(CORPUS_SYMBOLS))
+
+    t0 = time.perf_counter()
+    text = read_source(path)
+    read_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    program = parse_program(text, str(path))  # first parse: builds or loads the grammar
+    first_parse_s = time.perf_counter() - t0
+    parse_s, program = _best_of(repeats, lambda: parse_program(text, str(path)))
+
+    def compile_full() -> PlcCompileError:
+        try:
+            plcrt.Plc(program, symbols=symbols)
+        except PlcCompileError as e:
+            return e
+        raise RuntimeError("expected the corpus file to have unimplemented instructions")
+
+    compile_s, err = _best_of(repeats, compile_full)
+    errors = [d for d in err.diagnostics if d.severity == "error"]
+    unimplemented = sorted({d.message.split()[1] for d in errors if d.code == "unimplemented"})
+
+    # The same program without the networks that failed: a full load
+    # (compile + bind) that succeeds, and a short run of it.
+    reduced, dropped = _drop_failing_networks(program, symbols)
+    result: dict[str, Any] = {
+        "file": CORPUS_FILE,
+        "symbols": CORPUS_SYMBOLS.name if symbols is not None else None,
+        "instructions": program.instruction_count(),
+        "networks": program.network_count(),
+        "blocks": len(program.pous),
+        "read_s": read_s,
+        "first_parse_s": first_parse_s,
+        "parse_s": parse_s,
+        "compile_to_error_s": compile_s,
+        "parse_plus_compile_s": parse_s + compile_s,
+        "errors": len(errors),
+        "unimplemented": unimplemented,
+    }
+    if reduced is not None:
+        load_s, plc = _best_of(repeats, lambda: plcrt.Plc(reduced, symbols=symbols))
+        plc.scan(100)
+        t0 = time.perf_counter()
+        plc.scan(1000)
+        scan_s = (time.perf_counter() - t0) / 1000
+        result.update(reduced_networks_dropped=dropped,
+                      reduced_instructions=reduced.instruction_count(),
+                      reduced_load_s=load_s,
+                      reduced_us_per_scan=scan_s * 1e6,
+                      reduced_mode_after_run=plc.mode)
+    return result
+
+
+def _drop_failing_networks(program: Any, symbols: Any) -> tuple[Any, int]:
+    """Remove networks with compile errors until the program loads (or give up)."""
+    dropped = 0
+    for _ in range(5):
+        try:
+            plcrt.Plc(program, symbols=symbols)
+            return program, dropped
+        except PlcCompileError as e:
+            bad = {(d.loc.block, d.loc.network) for d in e.diagnostics
+                   if d.severity == "error" and d.loc is not None}
+        except PlcError:
+            return None, dropped
+        pous = []
+        for pou in program.pous:
+            keep = tuple(n for n in pou.networks if (pou.ident, n.number) not in bad)
+            dropped += len(pou.networks) - len(keep)
+            pous.append(dataclasses.replace(pou, networks=keep))
+        program = dataclasses.replace(program, pous=tuple(pous))
+    return None, dropped
+
+
+# ---------------------------------------------------------------------------
+# Main
+# ---------------------------------------------------------------------------
+
+def machine() -> dict[str, Any]:
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return {"cores": os.cpu_count(), "cpu": cpu,
+            "python": platform.python_version(),
+            "implementation": platform.python_implementation(),
+            "plcrt": plcrt.__version__}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--json", action="store_true", help="print one JSON object")
+    ap.add_argument("--repeats", type=int, default=7, help="timed repeats (best is kept)")
+    ap.add_argument("--repeat-seconds", type=float, default=0.5,
+                    help="approximate duration of one repeat")
+    ap.add_argument("--insns", type=int, default=MIN_INSNS,
+                    help="minimum instructions per generated program")
+    ap.add_argument("--save", metavar="DIR", help="write the generated programs to DIR")
+    ap.add_argument("--check", action="store_true", help="exit 1 when below a target")
+    args = ap.parse_args(argv)
+
+    programs = {"bool": bool_program(args.insns), "mixed": mixed_program(args.insns)}
+    if args.save:
+        out = Path(args.save)
+        out.mkdir(parents=True, exist_ok=True)
+        for name, text in programs.items():
+            (out / f"{name}.awl").write_text(text, encoding="utf-8")
+
+    scans = {name: measure_scans(name, text, repeats=args.repeats,
+                                 target_s=args.repeat_seconds)
+             for name, text in programs.items()}
+    corpus = measure_corpus(max(3, args.repeats // 2))
+
+    if args.json:
+        print(json.dumps({"machine": machine(),
+                          "programs": {k: v.as_dict() for k, v in scans.items()},
+                          "corpus": corpus}, indent=2))
+    else:
+        m = machine()
+        print(f"machine: {m['cores']} cores, {m['cpu']}, "
+              f"{m['implementation']} {m['python']}, plcrt {m['plcrt']}")
+        for r in scans.values():
+            target = TARGETS[r.name]
+            verdict = "meets" if r.insns_per_s >= target else "BELOW"
+            print(f"{r.name:<6} {r.instructions:>5} instructions, {r.networks:>4} networks: "
+                  f"{r.insns_per_s / 1e6:6.2f} M instructions/s "
+                  f"({1e6 / r.scans_per_s:7.1f} us/scan, best of {r.repeats} x "
+                  f"{r.scans_per_repeat} scans; load {r.load_s * 1e3:.0f} ms) "
+                  f"- {verdict} target {target / 1e6:g} M/s")
+        if corpus is None:
+            print(f"corpus: {CORPUS_FILE} not found, skipped")
+        else:
+            c = corpus
+            print(f"corpus {c['file']}: {c['instructions']} instructions, "
+                  f"{c['networks']} networks, {c['blocks']} blocks"
+                  + (f" (symbols {c['symbols']})" if c["symbols"] else ""))
+            print(f"  parse {c['parse_s'] * 1e3:.1f} ms (first parse in process "
+                  f"{c['first_parse_s'] * 1e3:.1f} ms), compile until PlcCompileError "
+                  f"{c['compile_to_error_s'] * 1e3:.1f} ms -> parse+compile "
+                  f"{c['parse_plus_compile_s'] * 1e3:.1f} ms; {c['errors']} errors, "
+                  f"unimplemented: {' '.join(c['unimplemented'])}")
+            if "reduced_load_s" in c:
+                print(f"  without the {c['reduced_networks_dropped']} failing networks: "
+                      f"load (compile+bind) {c['reduced_load_s'] * 1e3:.1f} ms for "
+                      f"{c['reduced_instructions']} instructions, "
+                      f"{c['reduced_us_per_scan']:.1f} us/scan")
+    if args.check and any(r.insns_per_s < TARGETS[r.name] for r in scans.values()):
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,479 @@
+"""The ``plcrt`` command line: ``check``, ``run`` and ``dump``.
+
+This module is the presentation layer only.  It turns command-line
+arguments into calls of the public API (:func:`plcrt.load`, :class:`plcrt.Plc`)
+and turns results and :class:`~plcrt.errors.PlcError` diagnostics into text,
+a table or JSON.  It holds no PLC semantics: what an instruction does, how an
+address is spelled and what a diagnostic says are decided by the core.
+
+Exit status: 0 success, 1 a problem with the input (missing file, syntax or
+compile error, bad option or address, internal error), 2 a run-time fault of
+the PLC program (the CPU went to STOP).  No path prints a Python traceback;
+an unexpected exception is reported as an internal error, and the traceback
+is shown only when the environment variable ``PLCRT_TRACEBACK`` is set.
+
+``rich`` is imported lazily and only for the watch table on a terminal.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import sys
+from pathlib import Path
+from typing import Any, NoReturn, Sequence, TextIO
+
+from . import __version__
+from .engine.runtime import Plc, load
+from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+
+EXIT_OK = 0
+EXIT_ERROR = 1
+EXIT_FAULT = 2
+
+PROG = "plcrt"
+
+# Value syntax for --set, after the STL constant forms (16#FF, 2#1010) so a
+# value can be copied from a program.  Reals need a dot or an exponent.
+_DEC_RE = re.compile(r"[+-]?\d+")
+_HEX_RE = re.compile(r"16#([0-9A-Fa-f][0-9A-Fa-f_]*)")
+_BIN_RE = re.compile(r"2#([01][01_]*)")
+_REAL_RE = re.compile(r"[+-]?(\d+\.\d*|\.\d+|\d+(?=[eE]))([eE][+-]?\d+)?")
+
+# The comment codegen puts before each instruction's code.
+_INSN_COMMENT_RE = re.compile(r"^(\s*)# \[(\d+)\] line (\d+)\s*$")
+_PIECE_DEF_RE = re.compile(r"^def n_([A-Z]+\d+)_(\d+)")
+_RUNNER_RE = re.compile(r"^(?:def |_pieces_|_costs_)pou_([A-Z]+\d+)")
+
+
+class _UsageError(Exception):
+    """A bad command line, reported like argparse does but with exit status 1."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, except that a usage error returns instead of exiting with 2
+    (status 2 is reserved for PLC run-time faults)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.print_usage(sys.stderr)
+        raise _UsageError(message)
+
+
+# ---------------------------------------------------------------------------
+# Entry point
+# ---------------------------------------------------------------------------
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (never raises)."""
+    try:
+        return _main(sys.argv[1:] if argv is None else argv)
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # The reader of our output went away (`plcrt dump x | head`): stop
+        # quietly, and keep Python from complaining again at shutdown.
+        _silence_stdout()
+        return EXIT_ERROR
+    except Exception as exc:  # noqa: BLE001 - the one place that must not leak a traceback
+        _internal_error(exc)
+        return EXIT_ERROR
+
+
+def _main(argv: list[str]) -> int:
+    parser = _build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return EXIT_ERROR
+    except SystemExit as e:  # --help, --version
+        return e.code if isinstance(e.code, int) else EXIT_OK
+    try:
+        return int(args.func(args))
+    except PlcError as e:
+        # Errors a command does not handle itself: report them all.
+        _print_diagnostics(e.diagnostics)
+        return EXIT_FAULT if isinstance(e, PlcRuntimeError) else EXIT_ERROR
+
+
+def _build_parser() -> _Parser:
+    parser = _Parser(
+        prog=PROG,
+        description="Run Siemens S7-200 (STEP 7-Micro/WIN) STL programs in Python.",
+        epilog="Exit status: 0 ok, 1 error in the input or options, "
+               "2 run-time fault of the PLC program.")
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    def common(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True) -> None:
+        p.add_argument("programs", nargs="+", metavar="PROGRAM",
+                       help="STL export (.awl); several files are merged into one program")
+        p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
+        if data:
+            p.add_argument("--data", metavar="F", help="data block (V memory initial values)")
+        if cpu:
+            p.add_argument("--cpu", metavar="NAME", help="CPU model, e.g. CPU224 (default CPU226)")
+
+    p = sub.add_parser("check", help="parse and compile; list every error and warning",
+                       description="Parse and compile a program and list every error and "
+                                   "warning GNU-style (file:line:col: ...) on stderr.")
+    common(p)
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser("run", help="run a program for a simulated time or number of scans",
+                       description="Run a program in simulated time and print watched values.")
+    common(p)
+    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
+                   help="simulated scan time in ms (default 10)")
+    length = p.add_mutually_exclusive_group(required=True)
+    length.add_argument("--seconds", type=float, metavar="S", help="simulated seconds to run")
+    length.add_argument("--scans", type=int, metavar="N", help="number of scans to run")
+    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
+                   help="write before the first scan (inputs keep their value); "
+                        "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+    p.add_argument("--watch", action="append", default=[], metavar="ADDR",
+                   help="print this address at the end; ADDR:REAL reads a float")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("dump", help="print the generated Python with the STL lines",
+                       description="Print the Python the program compiles to, network by "
+                                   "network, each instruction's code under its STL line.")
+    common(p, data=False)
+    p.set_defaults(func=cmd_dump)
+    return parser
+
+
+# ---------------------------------------------------------------------------
+# Commands
+# ---------------------------------------------------------------------------
+
+def _load(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
+    """Load the program named on the command line (raises PlcError)."""
+    data = getattr(args, "data", None)
+    # Path objects make load() read files, never take the argument as text.
+    return load([Path(p) for p in args.programs],
+                symbols=Path(args.symbols) if args.symbols else None,
+                data=Path(data) if data else None,
+                scan_ms=scan_ms, cpu=getattr(args, "cpu", None))
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors."""
+    name = ", ".join(args.programs)
+    try:
+        plc = _load(args)
+    except PlcError as e:
+        diags = e.diagnostics
+        _print_diagnostics(diags)
+        print(f"{name}: {_count(diags)}", file=sys.stderr)
+        return EXIT_ERROR
+    diags = plc.diagnostics
+    _print_diagnostics(diags)
+    prog = plc.program
+    print(f"{name}: {_count(diags)} ({len(prog.pous)} block(s), "
+          f"{prog.network_count()} network(s), {prog.instruction_count()} instruction(s))",
+          file=sys.stderr)
+    return EXIT_OK
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """``plcrt run``: load, apply --set, run, print --watch values."""
+    program = args.programs[0]
+    try:
+        if args.scans is not None and args.scans < 0:
+            raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
+        if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
+            raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+        writes = [_parse_set(item) for item in args.set]
+        watches = [_parse_watch(item) for item in args.watch]
+        plc = _load(args, args.scan_ms)
+        _print_diagnostics(plc.diagnostics)  # warnings
+        for addr, value, text in writes:
+            _write(plc, addr, value, text)
+        for spec, addr, kind in watches:
+            plc.read(addr, kind)  # reject a bad address before running
+    except PlcError as e:
+        _print_diagnostics(e.diagnostics)
+        if args.json:
+            _emit_json(args, None, {}, str(e))
+        return EXIT_ERROR
+
+    fault: PlcError | None = None
+    try:
+        plc.run(seconds=args.seconds, scans=args.scans)
+    except PlcRuntimeError as e:
+        fault = e
+    values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
+    if args.json:
+        _emit_json(args, plc, values, str(fault) if fault else None)
+    else:
+        _print_values(program, plc, values)
+    if fault is not None:
+        _print_diagnostics(fault.diagnostics)
+        return EXIT_FAULT
+    return EXIT_OK
+
+
+def cmd_dump(args: argparse.Namespace) -> int:
+    """``plcrt dump``: the generated module with STL lines as comments."""
+    try:
+        plc = _load(args)
+    except PlcError as e:
+        _print_diagnostics(e.diagnostics)
+        return EXIT_ERROR
+    _print_diagnostics(plc.diagnostics)
+    sys.stdout.write(render_dump(plc))
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------
+# dump
+# ---------------------------------------------------------------------------
+
+def render_dump(plc: Plc) -> str:
+    """The generated source, annotated for reading.
+
+    Before each network's function a banner names the block, network and
+    title; each ``# [id] line n`` marker gains the STL text of line ``n``.
+    The result is meant for people: the STL text is inserted into comments
+    only, and nothing of it is executed.
+    """
+    texts = _source_lines(plc)
+    titles = {(p.ident, n.number): n.title for p in plc.program.pous for n in p.networks}
+    names = {p.ident: p.name for p in plc.program.pous}
+    locs = plc.unit.locs
+    lines = plc.source.splitlines()
+    files = sorted({str(f) for f in texts})
+    out = [f"# plcrt dump of {', '.join(files) or plc.program.file}",
+           "# Generated Python, for reading only: each '# [id] line n:' comment",
+           "# shows the STL instruction whose code follows it.", ""]
+    last_runner = None
+    for i, line in enumerate(lines):
+        piece = _PIECE_DEF_RE.match(line)
+        if piece:
+            block, net = _piece_origin(lines, i, locs) or (piece.group(1), int(piece.group(2)))
+            title = titles.get((block, net), "")
+            out.append(f"# ==== {block} network {net}" + (f": {title}" if title else "") + " ====")
+            last_runner = None
+        runner = _RUNNER_RE.match(line)
+        if runner and runner.group(1) != last_runner:
+            last_runner = runner.group(1)
+            name = names.get(last_runner, "")
+            label = f" ({name})" if name and name != last_runner else ""
+            out.append(f"# ==== {last_runner}{label}: runs its networks in order ====")
+        m = _INSN_COMMENT_RE.match(line)
+        if m:
+            insn_id = int(m.group(2))
+            loc = locs[insn_id] if insn_id < len(locs) else None
+            lineno = loc.line if loc else int(m.group(3))
+            stl = _stl_line(texts, loc.file if loc else None, lineno)
+            line = f"{m.group(1)}# [{insn_id}] line {lineno}: {stl}"
+        out.append(line)
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def _piece_origin(lines: list[str], start: int, locs: Sequence[Any]) -> tuple[str, int] | None:
+    """Block and network of the function starting at ``lines[start]``, from
+    its first instruction marker (exact even when names change)."""
+    for line in lines[start + 1:]:
+        if line and not line.startswith((" ", "\t")):
+            return None  # next top-level statement: a function without instructions
+        m = _INSN_COMMENT_RE.match(line)
+        if m:
+            insn_id = int(m.group(2))
+            if insn_id < len(locs) and locs[insn_id].block and locs[insn_id].network is not None:
+                return locs[insn_id].block, locs[insn_id].network
+            return None
+    return None
+
+
+def _source_lines(plc: Plc) -> dict[str, list[str]]:
+    """Program text per file, split into lines the way the parser counts them
+    (CRLF and a lone CR each end one line)."""
+    from .lang import read_source
+
+    files = {p.loc.file for p in plc.program.pous}
+    texts: dict[str, list[str]] = {}
+    for f in files:
+        try:
+            text = read_source(f)
+        except PlcError:
+            # A file that vanished since loading: fall back to the text kept
+            # in the program, which is right for the first file at least.
+            text = plc.program.source if f == plc.program.file else ""
+        texts[f] = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    return texts
+
+
+def _stl_line(texts: dict[str, list[str]], file: str | None, lineno: int) -> str:
+    lines = texts.get(file or "") or next(iter(texts.values()), [])
+    if 1 <= lineno <= len(lines):
+        return lines[lineno - 1].strip()
+    return "?"
+
+
+# ---------------------------------------------------------------------------
+# run: --set / --watch
+# ---------------------------------------------------------------------------
+
+def parse_value(text: str) -> int | float:
+    """Parse a --set value: decimal, ``16#hex``, ``2#binary`` or a real.
+
+    Raises:
+        PlcConfigError: for anything else (``nan`` and ``inf`` included).
+    """
+    t = text.strip()
+    if _DEC_RE.fullmatch(t):
+        return int(t)
+    m = _HEX_RE.fullmatch(t)
+    if m:
+        return int(m.group(1).replace("_", ""), 16)
+    m = _BIN_RE.fullmatch(t)
+    if m:
+        return int(m.group(1).replace("_", ""), 2)
+    if _REAL_RE.fullmatch(t):
+        return float(t)
+    raise PlcConfigError(f"bad value '{text}': use a decimal (12, -3), 16#hex, "
+                         f"2#binary or a real (1.5, 2e3)")
+
+
+def _parse_set(item: str) -> tuple[str, int | float, str]:
+    addr, sep, value = item.partition("=")
+    if not sep or not addr.strip() or not value.strip():
+        raise PlcConfigError(f"--set needs ADDR=VALUE, got '{item}'")
+    return addr.strip(), parse_value(value), item
+
+
+def _parse_watch(item: str) -> tuple[str, str, str | None]:
+    """(key for the output, address, read kind) of one --watch argument."""
+    spec = item.strip()
+    addr, sep, kind = spec.rpartition(":")
+    if sep and kind.strip().upper() in ("REAL", "R"):
+        if not addr.strip():
+            raise PlcConfigError(f"--watch needs an address before ':REAL', got '{item}'")
+        return spec, addr.strip(), "REAL"
+    if sep and addr.strip():
+        raise PlcConfigError(f"--watch {item}: unknown format ':{kind}' (only ':REAL' is known)")
+    if not spec:
+        raise PlcConfigError("--watch needs an address")
+    return spec, spec, None
+
+
+def _write(plc: Plc, addr: str, value: int | float, item: str) -> None:
+    """Write one --set value, refusing silent truncation of a real."""
+    if isinstance(value, float):
+        plc.read(addr)  # a bad address is reported as such first
+        try:
+            is_dword = isinstance(plc.read(addr, "REAL"), float)
+        except PlcError:
+            is_dword = False
+        if not is_dword:
+            raise PlcConfigError(f"--set {item}: a real value needs a double word "
+                                 f"address (VD, MD, ...)")
+    try:
+        plc.write(addr, value)
+    except PlcError as e:
+        raise PlcConfigError(f"--set {item}: {e.message}") from None
+
+
+def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int | float],
+               error: str | None) -> None:
+    obj: dict[str, Any] = {
+        "program": args.programs[0],
+        "scans": plc.scans if plc else 0,
+        "time_s": plc.time if plc else 0.0,
+        "mode": plc.mode if plc else None,
+        "values": values,
+    }
+    if len(args.programs) > 1:
+        obj["files"] = list(args.programs)
+    if error is not None:
+        obj["error"] = error
+    sys.stdout.write(json.dumps(obj, ensure_ascii=False) + "\n")
+
+
+def _fmt(value: int | float) -> str:
+    # REALs are single precision: seven significant digits say all there is.
+    return f"{value:.7g}" if isinstance(value, float) else str(value)
+
+
+def _print_values(program: str, plc: Plc, values: dict[str, int | float]) -> None:
+    summary = f"{program}: {plc.scans} scan(s), {plc.time:g} s simulated, mode {plc.mode}"
+    if values and sys.stdout.isatty() and _print_rich_table(summary, values):
+        return
+    print(summary)
+    if values:
+        width = max(len("address"), *(len(k) for k in values))
+        print(f"{'address':<{width}}  value")
+        for key, value in values.items():
+            print(f"{key:<{width}}  {_fmt(value)}")
+
+
+def _print_rich_table(summary: str, values: dict[str, int | float]) -> bool:
+    try:
+        from rich.console import Console
+        from rich.table import Table
+    except ImportError:  # rich is a dependency, but the plain form is fine too
+        return False
+    console = Console()
+    # The summary stays one line above the table: as a table title it would
+    # wrap to the (narrow) table width.
+    console.print(summary, highlight=False, markup=False)
+    table = Table()
+    table.add_column("address")
+    table.add_column("value", justify="right")
+    for key, value in values.items():
+        table.add_row(key, _fmt(value))
+    console.print(table)
+    return True
+
+
+# ---------------------------------------------------------------------------
+# Reporting
+# ---------------------------------------------------------------------------
+
+def _print_diagnostics(diags: Sequence[Diagnostic], stream: TextIO | None = None) -> None:
+    """GNU-style lines, in source order (stable for equal positions)."""
+    stream = stream or sys.stderr
+
+    def key(d: Diagnostic) -> tuple[int, str, int, int]:
+        if d.loc is None:
+            return (0, "", 0, 0)
+        return (1, d.loc.file, d.loc.line, d.loc.column)
+
+    for d in sorted(diags, key=key):
+        print(str(d) if d.loc is not None else f"{PROG}: {d}", file=stream)
+
+
+def _count(diags: Sequence[Diagnostic]) -> str:
+    errors = sum(d.severity == "error" for d in diags)
+    warnings = sum(d.severity == "warning" for d in diags)
+    return (f"{errors} error{'s' if errors != 1 else ''}, "
+            f"{warnings} warning{'s' if warnings != 1 else ''}")
+
+
+def _internal_error(exc: BaseException) -> None:
+    print(f"{PROG}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+    if os.environ.get("PLCRT_TRACEBACK"):
+        import traceback
+        traceback.print_exception(exc, file=sys.stderr)
+    else:
+        print(f"{PROG}: this is a bug in plcrt; please report it together with the "
+              f"program and the command (set PLCRT_TRACEBACK=1 to see the traceback)",
+              file=sys.stderr)
+
+
+def _silence_stdout() -> None:
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+__all__ = ["main", "parse_value", "render_dump"]

@@ -1,0 +1,404 @@
+"""Tests of the ``plcrt`` command line (:mod:`plcrt.cli`).
+
+``main([...])`` is called in-process with pytest's ``capsys``; one test runs
+``python -m plcrt --help`` in a subprocess to cover the module entry point.
+Every error path must end in a message and exit status 1 (2 for a PLC
+run-time fault), never in a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from plcrt import PlcConfigError
+from plcrt.cli import main, parse_value
+
+PROGRAMS = Path(__file__).resolve().parents[2] / "programs"
+SEAL_IN = str(PROGRAMS / "seal_in.awl")
+TIMERS = str(PROGRAMS / "timers.awl")
+
+
+def write(tmp_path: Path, name: str, text: str) -> str:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def ob1(*networks: str) -> str:
+    """A program text with one OB1 whose networks are the given bodies."""
+    body = "".join(f"Network {i}\n{n.strip()}\n" for i, n in enumerate(networks, 1))
+    return f"ORGANIZATION_BLOCK MAIN:OB1\nTITLE=test\nBEGIN\n{body}END_ORGANIZATION_BLOCK\n"
+
+
+def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    return code, out, err
+
+
+# ---------------------------------------------------------------------------
+# check
+# ---------------------------------------------------------------------------
+
+def test_check_clean_program(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run_cli(capsys, "check", SEAL_IN)
+    assert code == 0
+    assert out == ""
+    assert err.strip() == (f"{SEAL_IN}: 0 errors, 0 warnings "
+                           f"(1 block(s), 2 network(s), 6 instruction(s))")
+
+
+def test_check_lists_unknown_and_unimplemented_with_locations(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "p.awl", ob1(
+        "LD     I0.0\nLDX    I0.1\n=      Q0.0",
+        "LD     SM0.1\nATCH   INT_0, 10\nENI",
+    ))
+    code, out, err = run_cli(capsys, "check", prog)
+    assert code == 1
+    lines = err.splitlines()
+    assert f"{prog}:6:1: error: unknown instruction 'LDX' [OB1 network 1]" in lines
+    assert f"{prog}:10:1: error: instruction ATCH is not implemented yet [OB1 network 2]" in lines
+    assert f"{prog}:11:1: error: instruction ENI is not implemented yet [OB1 network 2]" in lines
+    assert lines[-1] == f"{prog}: 3 errors, 0 warnings"
+
+
+def test_check_reports_warnings_but_succeeds(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    # A 100 ms timer box executed from two places gains time: a warning.
+    prog = write(tmp_path, "w.awl", ob1(
+        "LD     I0.0\nTON    T37, +10",
+        "LD     I0.1\nTON    T37, +10",
+    ))
+    code, _, err = run_cli(capsys, "check", prog)
+    assert code == 0
+    assert f"{prog}:9:1: warning:" in err
+    assert "0 errors, 1 warning " in err
+
+
+def test_check_syntax_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "s.awl", "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\n"
+                                    "LD     I0.0\n")
+    code, out, err = run_cli(capsys, "check", prog)
+    assert code == 1
+    assert out == ""
+    assert err.startswith(f"{prog}:")
+    assert ": error: " in err
+    assert err.splitlines()[-1] == f"{prog}: 1 error, 0 warnings"
+
+
+def test_check_missing_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    missing = str(tmp_path / "nope.awl")
+    code, _, err = run_cli(capsys, "check", missing)
+    assert code == 1
+    assert f"{missing}:1:1: error: cannot read file: no such file" in err
+
+
+def test_check_binary_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "bin.awl"
+    path.write_bytes(bytes(range(256)) * 4)
+    code, _, err = run_cli(capsys, "check", str(path))
+    assert code == 1
+    assert ": error: " in err
+
+
+def test_check_directory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(capsys, "check", str(tmp_path))
+    assert code == 1
+    assert "directory" in err
+
+
+def test_check_with_symbols_and_several_files(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    main_awl = write(tmp_path, "main.awl", ob1("LD     Start\nCALL   SBR_0"))
+    sbr_awl = write(tmp_path, "sbr.awl",
+                    "SUBROUTINE_BLOCK SBR_0:SBR0\nTITLE=sub\nBEGIN\nNetwork 1\n"
+                    "LD     Start\n=      Motor\nEND_SUBROUTINE_BLOCK\n")
+    sdf = write(tmp_path, "sym.sdf", '"Symbol","Address","Comment"\n'
+                                     '"Start","I0.0","start button"\n"Motor","Q0.0",""\n')
+    code, _, err = run_cli(capsys, "check", main_awl, sbr_awl, "--symbols", sdf)
+    assert code == 0, err
+    assert "2 block(s)" in err
+    code, _, err = run_cli(capsys, "check", main_awl, sbr_awl)  # without the table
+    assert code == 1
+    assert "unknown symbol 'Start'" in err
+
+
+def test_check_bad_cpu(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(capsys, "check", SEAL_IN, "--cpu", "CPU999")
+    assert code == 1
+    assert "unknown CPU model" in err
+
+
+# ---------------------------------------------------------------------------
+# run
+# ---------------------------------------------------------------------------
+
+def test_run_plain_output(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "3", "--set", "I0.0=1",
+                             "--watch", "I0.0", "--watch", "Q0.0")
+    assert code == 0
+    assert err == ""
+    assert out.splitlines() == [
+        f"{SEAL_IN}: 3 scan(s), 0.03 s simulated, mode RUN",
+        "address  value",
+        "I0.0     1",  # a --set input keeps its value over the scans
+        "Q0.0     1",
+    ]
+
+
+def test_run_json(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run_cli(capsys, "run", TIMERS, "--seconds", "2.5", "--set", "I0.0=1",
+                           "--watch", "T37", "--watch", "Q0.0", "--json")
+    assert code == 0
+    obj = json.loads(out)
+    assert obj == {"program": TIMERS, "scans": 250, "time_s": 2.5, "mode": "RUN",
+                   "values": {"T37": 24, "Q0.0": 1}}
+
+
+def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "k.awl", ob1(
+        "LD     SM0.0\nMOVW   -2, VW0\nMOVB   200, VB10\nMOVR   1.5, VD20\nMOVD   -70000, VD30"))
+    code, out, _ = run_cli(capsys, "run", prog, "--scans", "1", "--json",
+                           "--watch", "VW0", "--watch", "VB10", "--watch", "VD20:REAL",
+                           "--watch", "VD30", "--watch", "V0.0", "--watch", "SM0.0")
+    assert code == 0
+    values = json.loads(out)["values"]
+    assert values == {"VW0": -2, "VB10": 200, "VD20:REAL": 1.5, "VD30": -70000,
+                      "V0.0": 1, "SM0.0": 1}
+    assert isinstance(values["VD20:REAL"], float)
+
+
+@pytest.mark.parametrize(("setting", "watch", "expected"), [
+    ("VW0=16#FF", "VW0", 255),
+    ("VW0=2#1010_0101", "VW0", 0xA5),
+    ("VW0=-12", "VW0", -12),
+    ("VB0=255", "VB0", 255),
+    ("VD0=2.5", "VD0:REAL", 2.5),
+    ("VD0=-1e3", "VD0:REAL", -1000.0),
+    ("M0.3=1", "M0.3", 1),
+])
+def test_run_set_values(setting: str, watch: str, expected: float,
+                        capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", "--json",
+                             "--set", setting, "--watch", watch)
+    assert code == 0, err
+    assert json.loads(out)["values"][watch] == expected
+
+
+def test_run_with_data_block(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "d.awl", ob1("LD     SM0.0\nMOVW   VW0, VW2\n+I     +1, VW2"))
+    data = write(tmp_path, "d.txt", "VW0     41\n")
+    code, out, err = run_cli(capsys, "run", prog, "--data", data, "--scans", "1",
+                             "--json", "--watch", "VW2")
+    assert code == 0, err
+    assert json.loads(out)["values"] == {"VW2": 42}
+
+
+def test_run_scan_ms(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run_cli(capsys, "run", TIMERS, "--seconds", "3", "--scan-ms", "100",
+                           "--set", "I0.0=1", "--watch", "Q0.0", "--json")
+    assert code == 0
+    obj = json.loads(out)
+    assert obj["scans"] == 30 and obj["time_s"] == pytest.approx(3.0)
+    assert obj["values"]["Q0.0"] == 1
+
+
+def test_run_stop_instruction(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "stop.awl", ob1("LD     SM0.0\nINCW   VW0", "LD     I0.0\nSTOP"))
+    code, out, _ = run_cli(capsys, "run", prog, "--scans", "10", "--set", "I0.0=1",
+                           "--watch", "VW0", "--json")
+    assert code == 0  # STOP is the program's choice, not a fault
+    obj = json.loads(out)
+    assert obj["mode"] == "STOP"
+    assert obj["values"]["VW0"] == 1
+
+
+FAULT = ob1("LD     SM0.0\n=      Q0.0", "LD     I0.0\nMOVD   +0, AC1\nMOVW   *AC1, VW0")
+
+
+def test_run_runtime_fault_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "f.awl", FAULT)
+    code, out, err = run_cli(capsys, "run", prog, "--scans", "5", "--set", "I0.0=1",
+                             "--watch", "Q0.0")
+    assert code == 2
+    assert "mode STOP" in out
+    assert f"{prog}:10:1: error: " in err
+    assert "[OB1 network 2]" in err
+
+
+def test_run_runtime_fault_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "f.awl", FAULT)
+    code, out, err = run_cli(capsys, "run", prog, "--scans", "5", "--json")
+    assert code == 0  # I0.0 off: the faulting network never runs
+    code, out, err = run_cli(capsys, "run", prog, "--scans", "5", "--set", "I0.0=1",
+                             "--json", "--watch", "VW0")
+    assert code == 2
+    obj = json.loads(out)
+    assert obj["mode"] == "STOP"
+    assert obj["error"].startswith(f"{prog}:10:1: error: ")
+    assert obj["values"] == {"VW0": 0}
+    assert err  # the message goes to stderr as well
+
+
+def test_run_compile_error_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "e.awl", ob1("LD     I0.0\nFOO    Q0.0"))
+    code, out, err = run_cli(capsys, "run", prog, "--scans", "1", "--json")
+    assert code == 1
+    obj = json.loads(out)
+    assert "unknown instruction 'FOO'" in obj["error"]
+    assert obj["mode"] is None
+    assert "unknown instruction 'FOO'" in err
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--set", "I0.0=abc"], "bad value 'abc'"),
+    (["--set", "I0.0"], "--set needs ADDR=VALUE"),
+    (["--set", "VW0=1.5"], "a real value needs a double word"),
+    (["--set", "VW0=70000"], "does not fit"),
+    (["--set", "XQ9=1"], "not an address"),
+    (["--set", "VB99999=1"], "VB99999"),
+    (["--watch", "XQ9"], "not an address"),
+    (["--watch", "VW0:REAL"], "double word"),
+    (["--watch", "VW0:BCD"], "unknown format ':BCD'"),
+    (["--scan-ms", "0"], "scan time"),
+    (["--scans", "-1"], "must not be negative"),
+])
+def test_run_bad_options(args: list[str], message: str,
+                         capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["run", SEAL_IN, *args]
+    if "--scans" not in args:
+        argv += ["--scans", "1"]
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 1
+    assert message in err
+    assert out == ""
+
+
+def test_run_needs_exactly_one_duration(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(capsys, "run", SEAL_IN)
+    assert code == 1
+    assert "--seconds" in err
+    code, _, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", "--seconds", "1")
+    assert code == 1
+    assert "not allowed with" in err
+
+
+def test_run_missing_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run_cli(capsys, "run", str(tmp_path / "x.awl"), "--scans", "1")
+    assert code == 1
+    assert "no such file" in err
+
+
+@pytest.mark.parametrize(("text", "value"), [
+    ("0", 0), ("+50", 50), ("-13", -13), ("16#4E4F", 0x4E4F), ("16#ffff_0000", 0xFFFF0000),
+    ("2#1010", 10), ("3.25", 3.25), (".5", 0.5), ("-1.0", -1.0), ("1E3", 1000.0),
+])
+def test_parse_value(text: str, value: float) -> None:
+    result = parse_value(text)
+    assert result == value
+    assert type(result) is type(value)
+
+
+@pytest.mark.parametrize("text", ["", "abc", "16#", "16#XYZ", "2#102", "nan", "inf", "1.2.3",
+                                  "0x10", "1e"])
+def test_parse_value_rejects(text: str) -> None:
+    with pytest.raises(PlcConfigError):
+        parse_value(text)
+
+
+# ---------------------------------------------------------------------------
+# dump
+# ---------------------------------------------------------------------------
+
+def test_dump_shows_networks_and_stl_lines(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run_cli(capsys, "dump", SEAL_IN)
+    assert code == 0
+    assert err == ""
+    lines = out.splitlines()
+    assert lines[0] == f"# plcrt dump of {SEAL_IN}"
+    assert "# ==== OB1 network 1: Motor seal-in ====" in lines
+    assert "# ==== OB1 network 2: Running lamp ====" in lines
+    assert "    # [0] line 10: LD     I0.0" in lines
+    assert "    # [3] line 13: =      Q0.0" in lines
+    assert any(line.startswith("def pou_OB1(") for line in lines)
+    # each marker is followed by that instruction's code
+    i = lines.index("    # [0] line 10: LD     I0.0")
+    assert "I[0]" in lines[i + 1]
+
+
+def test_dump_subroutine_block_names(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run_cli(capsys, "dump", str(PROGRAMS / "subroutine.awl"))
+    assert code == 0
+    assert "# ==== SBR0 network 3: High limit ====" in out
+    assert "# ==== SBR0 (SCALE): runs its networks in order ====" in out
+    assert "line 34: =      #High" in out
+
+
+def test_dump_stl_text_stays_in_comments(tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    # A code comment that looks like Python must not become code in the dump.
+    prog = write(tmp_path, "c.awl", ob1("LD     I0.0  // __import__('os')\n=      Q0.0"))
+    code, out, _ = run_cli(capsys, "dump", prog)
+    assert code == 0
+    hits = [line for line in out.splitlines() if "__import__" in line]
+    assert hits and all(line.lstrip().startswith("#") for line in hits)
+
+
+def test_dump_compile_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "e.awl", ob1("LD     I0.0\nFOO    Q0.0"))
+    code, out, err = run_cli(capsys, "dump", prog)
+    assert code == 1
+    assert out == ""
+    assert f"{prog}:6:1: error: unknown instruction 'FOO'" in err
+
+
+# ---------------------------------------------------------------------------
+# top level
+# ---------------------------------------------------------------------------
+
+def test_no_command_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(capsys)
+    assert code == 1
+    assert "usage:" in err
+
+
+def test_unknown_command(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(capsys, "frobnicate")
+    assert code == 1
+    assert "invalid choice" in err
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run_cli(capsys, "--version")
+    assert code == 0
+    assert out.startswith("plcrt ")
+
+
+def test_internal_error_is_reported_without_traceback(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    def boom(*args: object, **kw: object) -> None:
+        raise RuntimeError("something broke")
+
+    monkeypatch.setattr("plcrt.cli.load", boom)
+    monkeypatch.delenv("PLCRT_TRACEBACK", raising=False)
+    code, _, err = run_cli(capsys, "check", SEAL_IN)
+    assert code == 1
+    assert "plcrt: internal error: RuntimeError: something broke" in err
+    assert "report" in err
+
+
+def test_python_m_plcrt_help() -> None:
+    result = subprocess.run([sys.executable, "-m", "plcrt", "--help"],
+                            capture_output=True, text=True, timeout=60,
+                            cwd=Path(__file__).resolve().parents[2])
+    assert result.returncode == 0
+    for word in ("check", "run", "dump"):
+        assert word in result.stdout
+    assert result.stderr == ""

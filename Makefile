@@ -16,8 +16,10 @@ $(BIN)/.installed: pyproject.toml
 setup: $(BIN)/.installed
 
 demo: setup
+	$(BIN)/plcrt check programs/subroutine.awl
 	$(BIN)/plcrt run programs/seal_in.awl --scans 3 --set I0.0=1 --watch I0.0 --watch Q0.0
 	$(BIN)/plcrt run programs/timers.awl --seconds 2.5 --set I0.0=1 --watch T37 --watch Q0.0
+	$(BIN)/plcrt run programs/subroutine.awl --scans 1 --set AIW0=25600 --watch VW10 --watch Q0.0 --json
 
 test: setup
 	$(BIN)/python -m pytest -q

@@ -20,7 +20,7 @@ Run ``python bench/run.py`` (or ``make bench``).  It
 This is a measuring tool, not a test: it asserts nothing and never fails on
 slow results (``--check`` makes it exit 1 below the targets).  ``--save DIR``
 writes the generated programs so they can be read or dumped with
-``plcrt dump``.
+``plcrt dump``; ``bench/programs/`` holds such a copy (``--save bench/programs``).
 """
 
 from __future__ import annotations
@@ -34,14 +34,15 @@ import platform
 import random
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
-import plcrt  # noqa: E402
-from plcrt import PlcCompileError, PlcError  # noqa: E402
+import plcrt
+from plcrt import PlcCompileError, PlcError
 
 CORPUS = ROOT.parent / "shared" / "corpus"
 if not CORPUS.is_dir():
@@ -345,8 +346,8 @@ def machine() -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
-    ap.add_argument("--repeats", type=int, default=7, help="timed repeats (best is kept)")
-    ap.add_argument("--repeat-seconds", type=float, default=0.5,
+    ap.add_argument("--repeats", type=int, default=15, help="timed repeats (best is kept)")
+    ap.add_argument("--repeat-seconds", type=float, default=0.2,
                     help="approximate duration of one repeat")
     ap.add_argument("--insns", type=int, default=MIN_INSNS,
                     help="minimum instructions per generated program")

@@ -33,8 +33,13 @@ from ..memory import MemoryImage, cpu_model
 from .counters import CounterBank
 from .timers import TimerBank
 
-#: Estimated execution time per instruction for the watchdog (µs).
-WATCHDOG_US_PER_INSN = 0.5
+#: Estimated execution time per instruction for the watchdog (µs).  Only
+#: loops (FOR/NEXT, backward jumps) are checked, and their instructions are
+#: mostly word operations: even the faster S7-200 SMART needs 1.2 µs for a
+#: word move (0.15 µs only for booleans), so 1.2 µs is a lower bound for the
+#: classic CPU.  It also keeps an endless loop's fault well under a second
+#: of wall time.
+WATCHDOG_US_PER_INSN = 1.2
 WATCHDOG_MS = 500  #: S7-200 watchdog time (System Manual, WDR)
 
 

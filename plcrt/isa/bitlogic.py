@@ -230,6 +230,8 @@ def _ri(g: Gen, op: Addr, n: Const) -> None:
     _range(g, op, n, 0, phys=True)
 
 
-@insn("NOP", Role.N, family=F, summary="no operation")
+# NOP N takes N = 0..255 (System Manual, "No Operation"); Role.N starts at
+# 1, the label role is the registry's 0..255 constant.
+@insn("NOP", Role.LABEL, family=F, summary="no operation")
 def _nop(g: Gen, n: Const) -> None:
     pass

@@ -9,7 +9,8 @@ small tables.
 
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from ..compiler.emit import Gen
 from ..compiler.operands import Const

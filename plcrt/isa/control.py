@@ -19,6 +19,9 @@ from ..isa.registry import Role, insn
 
 F = "control"
 
+# Areas whose words live at a plain byte offset of one buffer.
+_BYTE_AREAS = ("I", "Q", "M", "V", "SM", "S", "L")
+
 
 def _info(g: Gen):
     return g.unit.current
@@ -32,6 +35,7 @@ def _piece(g: Gen):
 def _end(g: Gen) -> None:
     if _info(g).pou.kind != "OB":
         g.fail("END is only allowed in the main program (OB1)")
+    _reject_in_scr(g, "END")
     with g.box():
         g.line("return -1")
 
@@ -100,6 +104,7 @@ def _jmp(g: Gen, n: Const) -> None:
 @insn("FOR", Role.W_W, Role.W_R, Role.W_R, family=F,
       summary="loop: INDX := INIT; repeat until INDX > FINAL", flow="for")
 def _for(g: Gen, indx, init, final) -> None:
+    _reject_in_scr(g, "FOR")
     info = _info(g)
     here = _piece(g).index
     body, exit_, _ = info.loops.get(here, (None, None, None))
@@ -115,6 +120,7 @@ def _for(g: Gen, indx, init, final) -> None:
 
 @insn("NEXT", family=F, summary="end of a FOR loop", flow="next")
 def _next(g: Gen) -> None:
+    _reject_in_scr(g, "NEXT")
     info = _info(g)
     fp = info.next_of.get(_piece(g).index)
     if fp is None:
@@ -126,18 +132,45 @@ def _next(g: Gen) -> None:
     final = res.resolve(for_insn.operands[2], Role.W_R)
     v = g.tmp("x")
     # INDX counts as an INT: past 32767 it wraps, as on the CPU (the
-    # watchdog then ends the endless loop).
-    g.line(f"{v} = ({g.rd(indx, 'W')} + 1 + 32768) % 65536 - 32768")
-    g.wr(indx, "W", v)
-    with g.block(f"if {v} <= {g.rd(final, 'W')}:"):
+    # watchdog then ends the endless loop).  The increment works on the
+    # unsigned pattern; direct byte-area words are read and written as two
+    # bytes (big-endian), which is the fast path for the usual VW/MW index.
+    if isinstance(indx, Addr) and indx.area in _BYTE_AREAS:
+        buf, o = g.use(indx.area), indx.offset
+        g.line(f"{v} = ({buf}[{o}] << 8 | {buf}[{o + 1}]) + 1 & 65535")
+        g.line(f"{buf}[{o}] = {v} >> 8")
+        g.line(f"{buf}[{o + 1}] = {v} & 255")
+    else:
+        g.line(f"{v} = {g.rd(indx, 'WU')} + 1 & 65535")
+        g.wr(indx, "W", v)
+    with g.block(f"if ({v} ^ 32768) - 32768 <= {g.rd(final, 'W')}:"):
         g.line(f"return {int(body)}")
 
 
 # -- SCR -----------------------------------------------------------------
+def _reject_in_scr(g: Gen, mnemonic: str) -> None:
+    """FOR, NEXT and END cannot stand inside an SCR segment (System Manual,
+    "Sequence control relay instructions", restrictions)."""
+    info, piece = _info(g), _piece(g)
+    if piece.index not in info.scr_exit:
+        return
+    # The piece that holds the LSCR may start with instructions of the
+    # network before the LSCR: those are outside the segment.
+    lscr = next((i for i in piece.insns if i.mnemonic == "LSCR"), None)
+    if lscr is not None and g.loc is not None and \
+            (g.loc.line, g.loc.column) < (lscr.loc.line, lscr.loc.column):
+        return
+    g.fail(f"{mnemonic} is not allowed inside an SCR segment")
+
+
 @insn("LSCR", Role.SBIT, family=F, summary="start an SCR segment controlled by the S bit",
       flow="lscr")
 def _lscr(g: Gen, bit: Addr) -> None:
     info = _info(g)
+    if info.pou.kind == "INT":
+        # System Manual, SCR: segments are usable in the main program and
+        # in subroutines, not in interrupt routines.
+        g.fail("SCR segments cannot be used in an interrupt routine")
     here = _piece(g).index
     exit_ = info.scr_exit.get(here)
     if exit_ is None:

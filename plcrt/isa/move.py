@@ -48,8 +48,8 @@ def _block(g: Gen, src, dst, n, kind: str, width: int) -> None:
             count = int(n.value)
             if not 1 <= count <= 255:
                 g.fail("N must be 1..255")
-            if isinstance(src, Addr) and isinstance(dst, Addr) and src.area not in ("AC", "T", "C") \
-                    and dst.area not in ("AC", "T", "C"):
+            if (isinstance(src, Addr) and isinstance(dst, Addr)
+                    and src.area not in ("AC", "T", "C") and dst.area not in ("AC", "T", "C")):
                 _check_span(g, src, count * width)
                 _check_span(g, dst, count * width)
                 sb, db = g.use(src.area), g.use(dst.area)
@@ -63,8 +63,6 @@ def _block(g: Gen, src, dst, n, kind: str, width: int) -> None:
         cnt = g.rd(n, "B")
         i = g.tmp("i")
         with g.block(f"for {i} in range({cnt}):"):
-            g.line(f"pass")
-            g.lines.pop()
             _elem_copy(g, src, dst, i, kind, width)
 
 

@@ -60,7 +60,7 @@ def test_check_lists_unknown_and_unimplemented_with_locations(
         "LD     I0.0\nLDX    I0.1\n=      Q0.0",
         "LD     SM0.1\nATCH   INT_0, 10\nENI",
     ))
-    code, out, err = run_cli(capsys, "check", prog)
+    code, _, err = run_cli(capsys, "check", prog)
     assert code == 1
     lines = err.splitlines()
     assert f"{prog}:6:1: error: unknown instruction 'LDX' [OB1 network 1]" in lines
@@ -235,7 +235,7 @@ def test_run_runtime_fault_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture
 
 def test_run_runtime_fault_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     prog = write(tmp_path, "f.awl", FAULT)
-    code, out, err = run_cli(capsys, "run", prog, "--scans", "5", "--json")
+    code, _, _ = run_cli(capsys, "run", prog, "--scans", "5", "--json")
     assert code == 0  # I0.0 off: the faulting network never runs
     code, out, err = run_cli(capsys, "run", prog, "--scans", "5", "--set", "I0.0=1",
                              "--json", "--watch", "VW0")
@@ -293,6 +293,7 @@ def test_run_needs_exactly_one_duration(capsys: pytest.CaptureFixture[str]) -> N
 def test_run_missing_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run_cli(capsys, "run", str(tmp_path / "x.awl"), "--scans", "1")
     assert code == 1
+    assert out == ""
     assert "no such file" in err
 
 
@@ -396,7 +397,7 @@ def test_internal_error_is_reported_without_traceback(
 
 def test_python_m_plcrt_help() -> None:
     result = subprocess.run([sys.executable, "-m", "plcrt", "--help"],
-                            capture_output=True, text=True, timeout=60,
+                            capture_output=True, text=True, timeout=60, check=False,
                             cwd=Path(__file__).resolve().parents[2])
     assert result.returncode == 0
     for word in ("check", "run", "dump"):

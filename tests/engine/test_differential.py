@@ -18,6 +18,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
@@ -25,7 +26,7 @@ import plcrt
 from plcrt.isa.registry import lookup
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from reference_interp import ReferencePlc  # noqa: E402
+from reference_interp import ReferencePlc, Unsupported  # noqa: E402
 
 #: Areas both sides model (and that OB1 can change or read).
 COMPARED_AREAS = ("PI", "I", "Q", "PQ", "M", "V", "SM", "S", "TV", "TB", "CV", "CB")
@@ -156,7 +157,10 @@ DEEP_PUSH = st.one_of(_choice(BIT_LOADS), st.just("LPS"))
 DEEP_COUNT = _choice((0, 0, 0, 4, 6, 8, 9, 10))
 NETWORK_LENGTH = st.integers(1, 12)
 NETWORK_COUNT = st.integers(1, 5)
-RANGE_COUNT = {"T": st.integers(1, 3), "C": st.integers(1, 3), "bits": st.integers(1, 12)}
+#: S/R counts: timers / counters from the pool on, bits up to 100 (every pool
+#: start bit leaves room for 100 bits in its area).
+RANGE_COUNT = {"T": st.integers(1, 3), "C": st.integers(1, 3),
+               "bits": st.one_of(st.integers(1, 12), st.sampled_from((16, 33, 100)))}
 
 #: Instruction kinds and how they change the static stack depth.
 PUSHES = {"load": 1, "load_cmp": 1, "lps": 1, "ald/old": -1, "lpp": -1, "ctu": -1}
@@ -412,6 +416,17 @@ def test_reference_stack_overflow_loses_bottom() -> None:
     ref = ReferencePlc(STACK_OVERFLOW)
     ref.scan()
     assert ref.mem["Q"][0] & 1 == 1
+
+
+def test_lost_level_is_never_read() -> None:
+    """After ten pushes nine levels remain: a ninth ALD would read the lost
+    level (the manual: its value is unknown).  Both sides refuse it, which
+    is why random programs never pop below the static depth."""
+    text = _prog("LD I0.0\n" * 10 + "ALD\n" * 9 + "= Q0.0")
+    with pytest.raises(plcrt.PlcCompileError, match="needs 2 values"):
+        plcrt.load(text)
+    with pytest.raises(Unsupported):
+        ReferencePlc(text).scan()
 
 
 def test_reference_math_edges() -> None:

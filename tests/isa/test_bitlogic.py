@@ -370,3 +370,11 @@ def test_r_resets_a_range_of_timers_and_counters() -> None:
     assert (tb[4] >> 5 & 1, tb[4] >> 6 & 1, tb[4] >> 7 & 1) == (0, 0, 1)
     assert [p["C1"], p["C2"], p["C3"]] == [0, 0, 1]
     assert p.mem.areas["CB"][0] & 0b1110 == 0b1000
+
+
+@pytest.mark.parametrize("n", [0, 1, 255])
+def test_nop_accepts_0_to_255(n: int) -> None:
+    """NOP N (N = 0..255) does nothing and leaves the stack alone."""
+    p = _load(f"LD I0.0\nNOP {n}\n= Q0.0")
+    _scan_with(p, {"I0.0": 1})
+    assert p["Q0.0"] == 1

@@ -52,7 +52,7 @@ def _cases() -> list:
     return out
 
 
-def _write(p: plcrt.Plc, addr: str, value: int | float, width: str) -> None:
+def _write(p: plcrt.Plc, addr: str, value: float, width: str) -> None:
     if width == "R":
         p.write(addr, float(value))
     else:

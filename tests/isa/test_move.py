@@ -75,8 +75,8 @@ ACCUMULATOR = [
     ("MOVB into AC0", "MOVD 16#11223344, AC0\nMOVB 16#AA, AC0", 0x112233AA),
     ("MOVW into AC2", "MOVD 16#11223344, AC2\nMOVW 16#BBCC, AC2", 0x1122BBCC),
     ("MOVD into AC1", "MOVD 16#11223344, AC1\nMOVD 16#01020304, AC1", 0x01020304),
-    ("INCB-free byte read", "MOVD 16#112233F0, AC3\nMOVB AC3, VB0\nMOVD 0, AC3\n"
-     "MOVB VB0, AC3", 0x000000F0),
+    ("byte read and write", ("MOVD 16#112233F0, AC3\nMOVB AC3, VB0\nMOVD 0, AC3\n"
+                             "MOVB VB0, AC3"), 0x000000F0),
 ]
 
 

@@ -33,6 +33,12 @@ def test_all_five_samples_exist() -> None:
                        "subroutine.awl", "timers.awl"]
 
 
+def test_programs_readme_lists_every_sample() -> None:
+    readme = (PROGRAMS / "README.md").read_text(encoding="utf-8")
+    for name in SAMPLES:
+        assert f"`{name}`" in readme
+
+
 @pytest.mark.parametrize("name", SAMPLES)
 def test_sample_compiles_without_diagnostics(name: str) -> None:
     plc = load(name)
@@ -60,10 +66,9 @@ def test_sample_is_in_microwin_export_format(name: str) -> None:
             in_body = True
         elif line.startswith("END_"):
             in_body = False
-        elif in_body and line and not line.startswith(("Network ", "//")):
-            # an instruction: the mnemonic padded to seven columns
-            if " " in line:
-                assert line[6] == " " and line[7] != " ", line
+        elif in_body and " " in line and not line.startswith(("Network ", "//")):
+            # an instruction with operands: the mnemonic padded to seven columns
+            assert line[6] == " " and line[7] != " ", line
 
 
 # ---------------------------------------------------------------------------

@@ -257,8 +257,8 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
     """Emit the module source for all POUs (diagnostics go to ``unit.diag``)."""
     out: list[str] = []
     line_locs: dict[int, SourceLoc] = {}
-    for p in unit.program.pous:
-        info = unit.pous[p.ident]
+    for info in unit.pous.values():
+        p = info.pou
         unit.current = info
         resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars)
         fnames: list[str] = []
@@ -277,6 +277,7 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
                 for _ in range(d):
                     gen.push("1")
             emit_piece(unit, gen, piece, resolver)
+            gen.pending = None  # a value left on the stack at the end is dead
             unit.hooks[("depth_after", p.ident, piece.index)] = gen.depth
             args = ["L"] + [f"{n}={n}" for n in sorted(gen.used - {"L"})]
             header = f"def {fname}({', '.join(args)}):"
@@ -356,15 +357,15 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         gen.insn_id = insn_id
         gen.line_map.append((len(gen.lines), insn_id))
         # The comment carries only the instruction id and line number.
-        gen.line(f"# [{insn_id}] line {int(loc.line)}")
-        saved = (list(gen.lines), gen.depth, gen.indent)
+        gen.comment(f"[{insn_id}] line {int(loc.line)}")
+        saved = (list(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
             if spec.variadic:
                 spec.emit(gen, insn, resolver, *ops)
             else:
                 spec.emit(gen, *ops)
         except (CodegenError, ResolveError) as e:
-            gen.lines, gen.depth, gen.indent = saved
+            gen.lines, gen.depth, gen.indent, gen.pending = saved
             if not (broken and "logic stack" in str(e)):
                 unit.diag.error(f"{insn.mnemonic}: {e}", loc)
             broken = True

@@ -54,11 +54,28 @@ class Gen:
         self.insn_id = -1         #: index of that instruction in unit.locs
         self.eno_valid = False    #: the previous box set ``eno``
         self.line_map: list[tuple[int, int]] = []  #: (first line index, insn id)
+        #: perf: expression of the top stack level not stored yet, so that a
+        #: run like ``LD a / A b / AN c`` becomes one assignment.  Any emitted
+        #: statement stores it first, so memory is always read in program order.
+        self.pending: str | None = None
+        self._terms = 0
 
     # -- source ---------------------------------------------------------
     def line(self, text: str) -> None:
         """Append one statement at the current indentation."""
+        if self.pending is not None:
+            self.flush()
         self.lines.append("    " * self.indent + text)
+
+    def comment(self, text: str) -> None:
+        """Append a comment line (does not store a pending stack value)."""
+        self.lines.append("    " * self.indent + "# " + text)
+
+    def flush(self) -> None:
+        """Store the pending top-of-stack expression in its local."""
+        expr, self.pending = self.pending, None
+        if expr is not None:
+            self.lines.append("    " * self.indent + f"s{self.depth} = {expr}")
 
     @contextmanager
     def block(self, header: str) -> Iterator[None]:
@@ -100,6 +117,8 @@ class Gen:
     # -- logic stack ----------------------------------------------------
     @property
     def top(self) -> str:
+        if self.pending is not None:
+            self.flush()
         if self.depth < 1:
             self.fail("the logic stack is empty here: start the network with a "
                       "load (LD, LDN, LDx=, ...)")
@@ -107,12 +126,16 @@ class Gen:
 
     def level(self, n: int) -> str:
         """Stack level ``n`` counted from the top (0 = top)."""
+        if self.pending is not None:
+            self.flush()
         if self.depth - n < 1:
             self.fail(f"needs {n + 1} values on the logic stack, it holds {self.depth}")
         return f"s{self.depth - n}"
 
     def push(self, expr: str) -> None:
         """Push ``expr`` (0/1).  Beyond nine levels the bottom level is lost."""
+        if self.pending is not None:
+            self.flush()
         if self.depth == MAX_STACK:
             self.warn("logic stack overflow: a tenth level is pushed and the bottom "
                       "level is lost, as on the S7-200", "stack-overflow")
@@ -121,9 +144,21 @@ class Gen:
             self.line(f"{lhs} = {rhs}, {expr}")
             return
         self.depth += 1
-        self.line(f"s{self.depth} = {expr}")
+        self.pending = expr
+        self._terms = 1
+
+    def combine(self, op: str, expr: str) -> None:
+        """``top := top <op> expr`` for ``op`` in ``&``, ``|`` (A, O, ...)."""
+        if self.pending is not None and self._terms < 24:
+            self.pending = f"({self.pending}) {op} ({expr})"
+            self._terms += 1
+        else:
+            self.line(f"{self.top} {op}= {expr}")
 
     def pop(self, n: int = 1) -> None:
+        # A pending value of a popped level is simply dropped: reading
+        # memory has no side effects.
+        self.pending = None
         if self.depth < n:
             self.fail(f"needs {n + 1 if n == 1 else n} values on the logic stack, "
                       f"it holds {self.depth}")
@@ -197,15 +232,19 @@ class Gen:
         buf, off = self._place(op, width)
         if width == 1:
             return f"{buf}[{off}]"
+        if kind == "WU":
+            # perf: two byte reads beat struct.unpack_from + tuple indexing
+            return f"({buf}[{off}] << 8 | {buf}[{off + 1}])"
         codec = {"W": "_rh", "WU": "_rH", "D": "_ri", "DU": "_rI", "R": "_rf"}[kind]
         return f"{self.use(codec)}({buf}, {off})[0]"
 
-    def wr(self, op: Any, kind: str, expr: str) -> None:
+    def wr(self, op: Any, kind: str, expr: str, exact: bool = False) -> None:
         """Statements writing ``expr`` to a value operand.
 
         Integer values are masked to the width, so callers may pass signed or
         oversized results.  REAL values must already be finite single
-        precision numbers.
+        precision numbers.  ``exact=True`` promises a byte value already in
+        0..255 (no mask needed).
         """
         width = VALUE_WIDTH[kind[0]]
         if isinstance(op, Indirect):
@@ -214,10 +253,17 @@ class Gen:
                       f"{self.insn_id})")
             return
         buf, off = self._place(op, width)
+        if kind != "R" and _is_int_literal(expr):
+            # perf: a constant becomes byte stores computed at compile time
+            v = int(expr) & ((1 << 8 * width) - 1)
+            data = v.to_bytes(width, "big")
+            for i, b in enumerate(data):
+                self.line(f"{buf}[{off + i}] = {b}")
+            return
         if kind == "R":
             self.line(f"{self.use('_wf')}({buf}, {off}, {expr})")
         elif width == 1:
-            self.line(f"{buf}[{off}] = ({expr}) & 255")
+            self.line(f"{buf}[{off}] = {expr}" if exact else f"{buf}[{off}] = ({expr}) & 255")
         elif width == 2:
             self.line(f"{self.use('_wH')}({buf}, {off}, ({expr}) & 65535)")
         else:
@@ -230,6 +276,12 @@ class Gen:
                 and src.area not in ("AC",) and dst.area not in ("AC",)):
             sbuf, soff = self._place(src, width)
             dbuf, doff = self._place(dst, width)
+            if width == 2:
+                # perf: two byte stores beat a slice copy for words (the right
+                # side is evaluated first, so overlap is safe)
+                self.line(f"{dbuf}[{doff}], {dbuf}[{doff + 1}] = "
+                          f"{sbuf}[{soff}], {sbuf}[{soff + 1}]")
+                return
             # perf: slice copy avoids decode/encode (big-endian bytes move as is)
             self.line(f"{dbuf}[{doff}:{doff + width}] = {sbuf}[{soff}:{soff + width}]")
             return
@@ -250,6 +302,11 @@ class Gen:
         """Record the box's ENO (for a following AENO)."""
         self.line(f"eno = {expr}")
         self.eno_valid = True
+
+
+def _is_int_literal(expr: str) -> bool:
+    t = expr[1:] if expr.startswith("-") else expr
+    return t.isdigit()
 
 
 def const_expr(c: Const, kind: str) -> str:

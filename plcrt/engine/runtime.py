@@ -89,12 +89,21 @@ class Plc:
         ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
                   _watchdog=self._watchdog)
         ns.update(self.unit.bindings)
-        code = compile(self.source, self._filename, "exec")
+        try:
+            code = compile(self.source, self._filename, "exec")
+        except SyntaxError as e:  # a plcrt bug, never the user's: say so clearly
+            raise PlcConfigError(f"internal error: generated code does not compile "
+                                 f"({e.msg}, generated line {e.lineno}); please report it "
+                                 f"with the program") from None
         exec(code, ns)  # noqa: S102 - source built only from validated numbers
         self._ns = ns
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
         if data is not None:
             data.apply(self.mem.areas["V"])
+        # SMW22/24/26: last, minimum and maximum scan time in ms.  SMB0..29
+        # are read-only to the program, so they are written once.
+        ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
+        self.mem.areas["SM"][22:28] = ms * 3
 
     # -- time -----------------------------------------------------------
     @property
@@ -144,10 +153,6 @@ class Plc:
         if self.scans % 2 == 0:
             b0 |= 0x40
         sm[0] = b0
-        ms = min(self.scan_us // 1000, 0xFFFF)
-        sm[22:24] = ms.to_bytes(2, "big")
-        sm[24:26] = ms.to_bytes(2, "big")
-        sm[26:28] = ms.to_bytes(2, "big")
         self.timers.start_scan(self._prev_start, now)
         self._prev_start = now
         self.wd[0] = 0
@@ -233,7 +238,7 @@ class Plc:
         if width == 0:
             return buf[off] >> bit & 1
         if kind and kind.upper() in ("REAL", "R"):
-            if width != 4:
+            if width != 4 or a.area in ("T", "C"):
                 raise PlcAddressError(f"{address}: a REAL needs a double word")
             return CODECS["_rf"](buf, off)[0]
         if width == 1:
@@ -257,6 +262,8 @@ class Plc:
                     b[off] &= ~(1 << bit) & 0xFF
             elif isinstance(value, float) and width == 4:
                 CODECS["_wf"](b, off, value)
+            elif isinstance(value, float) and not value.is_integer():
+                raise PlcAddressError(f"{address}: a real value needs a double word")
             else:
                 v = int(value)
                 lo, hi = -(1 << (8 * width - 1)), (1 << (8 * width)) - 1

@@ -131,6 +131,13 @@ class TimerBank:
     # -- instruction side -----------------------------------------------
     def ton(self, n: int, en: int, pt: int) -> None:
         """TON: on-delay.  IN=0 clears the current value and the bit."""
+        # perf: a running timer with no new tick and the same preset changes
+        # nothing -- unless the program wrote its current value (MOVW ..., Tn),
+        # so the bit must still agree with CV >= PT.
+        if en and self.running[n] and pt == self.preset[n] and (
+                self.d100 == 0 or self.res[n] != 100) and self.kind[n] == "TON" \
+                and (self.tb[n >> 3] >> (n & 7) & 1) == (self._cv(n) >= pt):
+            return
         self.preset[n] = pt
         self.kind[n] = "TON"
         if not en:

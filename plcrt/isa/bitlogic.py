@@ -34,22 +34,22 @@ def _ldn(g: Gen, op: Addr) -> None:
 
 @insn("A", Role.BIT_R, family=F, summary="top := top AND bit")
 def _a(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} &= {g.rbit(op)}")
+    g.combine("&", g.rbit(op))
 
 
 @insn("AN", Role.BIT_R, family=F, summary="top := top AND NOT bit")
 def _an(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} &= {g.rbit(op)} ^ 1")
+    g.combine("&", f"({g.rbit(op)} ^ 1)")
 
 
 @insn("O", Role.BIT_R, family=F, summary="top := top OR bit")
 def _o(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} |= {g.rbit(op)}")
+    g.combine("|", g.rbit(op))
 
 
 @insn("ON", Role.BIT_R, family=F, summary="top := top OR NOT bit")
 def _on(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} |= {g.rbit(op)} ^ 1")
+    g.combine("|", f"({g.rbit(op)} ^ 1)")
 
 
 @insn("LDI", Role.IBIT, family=F, summary="push the physical input")
@@ -115,16 +115,22 @@ def _ed(g: Gen) -> None:
 
 @insn("ALD", family="stack", summary="AND the two top levels, pop one")
 def _ald(g: Gen) -> None:
-    below, top = g.level(1), g.top
-    g.line(f"{below} &= {top}")
+    _fold(g, "&")
+
+
+def _fold(g: Gen, op: str) -> None:
+    """ALD/OLD: combine the top into the level below and pop it."""
+    if g.depth < 2:
+        g.level(1)  # raises the stack error
+    expr, g.pending = g.pending, None
+    below = f"s{g.depth - 1}"
+    g.line(f"{below} {op}= {expr if expr is not None else f's{g.depth}'}")
     g.pop()
 
 
 @insn("OLD", family="stack", summary="OR the two top levels, pop one")
 def _old(g: Gen) -> None:
-    below, top = g.level(1), g.top
-    g.line(f"{below} |= {top}")
-    g.pop()
+    _fold(g, "|")
 
 
 @insn("LPS", family="stack", summary="duplicate the top (push)")

@@ -18,7 +18,7 @@ F = "move"
 @insn("MOVB", Role.B_R, Role.B_W, family=F, summary="OUT := IN (byte)")
 def _movb(g: Gen, src, dst) -> None:
     with g.box():
-        g.wr(dst, "B", g.rd(src, "B"))
+        g.wr(dst, "B", g.rd(src, "B"), exact=not isinstance(src, Const))
 
 
 @insn("MOVW", Role.W_R, Role.W_W, family=F, summary="OUT := IN (word)")

@@ -25,7 +25,9 @@ from hypothesis import strategies as st
 import plcrt
 from plcrt.isa.registry import lookup
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+_TESTS = str(Path(__file__).resolve().parents[1])
+if _TESTS not in sys.path:
+    sys.path.insert(0, _TESTS)
 from reference_interp import ReferencePlc, Unsupported  # noqa: E402
 
 #: Areas both sides model (and that OB1 can change or read).
@@ -184,7 +186,7 @@ def draw_network(draw: st.DrawFn, counters: list[str]) -> list[str]:
         lines.append(draw(DEEP_PUSH))
         depth = min(depth + 1, 9)
     for _ in range(draw(NETWORK_LENGTH)):
-        kinds = ALWAYS
+        kinds: tuple[str, ...] = ALWAYS
         if depth >= 2:
             kinds += WITH_TWO + (("ctu",) if counters else ())
         kinds += ("ton",)
@@ -407,6 +409,21 @@ S V0.0, 12
               scan_ms=60000))
 def test_compiled_engine_matches_reference(case: Case) -> None:
     run_side_by_side(case)
+
+
+# Regression: a work-in-progress code generator briefly fused ``LDN x`` /
+# ``LDx=`` with a following ``A``/``AN`` into ``x ^ 1 & y`` and
+# ``1 if c else 0 & y``, which Python groups as ``x ^ (1 & y)`` and
+# ``1 if c else (0 & y)``.
+@pytest.mark.parametrize("body, inputs", [
+    # I0.0 = 1: LDN gives 0, so Q0.0 = 0 AND I0.1 = 0 (the engine gave 1)
+    ("LDN I0.0\nA I0.1\n= Q0.0", ((1, 0, 1),)),
+    # VW0 = 0: the compare gives 1, I0.1 = 0, so Q0.0 = 0 (the engine gave 1)
+    ("LDW= VW0, 0\nA I0.1\n= Q0.0", ((0, 0, 1),)),
+    ("LDB<> VB1, 1\nAN I0.1\n= Q0.0", ((2, 0, 1),)),
+])
+def test_and_after_ldn_or_compare_push(body: str, inputs: tuple) -> None:
+    run_side_by_side(Case(_prog(body), inputs))
 
 
 # -- the oracle against hand-derived expectations ------------------------------

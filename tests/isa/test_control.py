@@ -485,3 +485,36 @@ def test_scr_segments_work_in_a_subroutine() -> None:
     p["I0.0"] = 1
     p.scan(2)
     assert (p["S1.0"], p["S1.1"], p["VW0"]) == (0, 1, 2)
+
+
+PACKED = """
+VAR_INPUT
+a:BOOL;
+b:BOOL;
+c:BYTE;
+END_VAR
+VAR_IN_OUT
+d:BYTE;
+e:DWORD;
+END_VAR
+VAR_OUTPUT
+f:BOOL;
+g:BOOL;
+END_VAR
+"""
+
+
+def test_parameter_layout_in_l_memory_follows_micro_win() -> None:
+    """Parameters sit in L from L0.0 in the order IN, IN_OUT, OUT; BOOLs pack, bytes align."""
+    # a=L0.0 b=L0.1 c=LB1 d=LB2 e=LD3 f=L7.0 g=L7.1: read them by address.
+    sbr = _sbr(0, "LD L0.1\n= #f\nLD L0.0\n= #g",
+               "LD SM0.0\nMOVB LB1, VB20\nINCB #d\nMOVD LD3, VD24\n+D +10, #e",
+               interface=PACKED)
+    p = _load("LD SM0.0\nCALL SBR_0, I0.0, I0.1, VB0, VB1, VD4, Q0.0, Q0.1", extra=sbr)
+    p["I0.1"] = 1
+    p["VB0"] = 0x5A
+    p["VB1"] = 255
+    p["VD4"] = -20
+    p.scan()
+    assert (p["Q0.0"], p["Q0.1"], p["VB20"], p["VD24"]) == (1, 0, 0x5A, -20)
+    assert (p["VB1"], p["VD4"]) == (0, -10)      # IN_OUT BYTE wraps, DWORD adds

@@ -361,3 +361,18 @@ def test_resolution_follows_the_timer_number(n: int, res: int) -> None:
     """The resolution table of the manual (T0/T64 1 ms, T1-T4 10 ms, ...)."""
     from plcrt.engine.timers import resolution_ms
     assert resolution_ms(n) == res
+
+
+@pytest.mark.parametrize("n,scan_ms", [(37, 10), (33, 10), (32, 0.5)])
+def test_ton_bit_follows_a_current_value_written_by_the_program(n: int, scan_ms: float) -> None:
+    """A running TON compares CV with PT at every execution, also after MOVW wrote its CV."""
+    p = _load(f"LD I0.0\nTON T{n}, +50", f"LD I0.1\nMOVW +60, T{n}", f"LD T{n}\n= Q0.0",
+              scan_ms=scan_ms)
+    p["I0.0"] = 1
+    p.scan(2)
+    assert p["Q0.0"] == 0
+    p["I0.1"] = 1
+    p.scan()                        # CV written after the box ran
+    p["I0.1"] = 0
+    p.scan()                        # next execution: no new 100 ms tick, CV 60 >= 50
+    assert p["Q0.0"] == 1 and p[f"T{n}"] >= 60

@@ -232,8 +232,13 @@ class Plc:
 
     def read(self, address: str, kind: str | None = None) -> int | float:
         """Read an address: bits 0/1, bytes unsigned, words/dwords signed,
-        ``T37``/``C5`` their current value; ``kind="REAL"`` reads a float."""
+        ``T37``/``C5`` their current value; ``kind="REAL"`` reads a float,
+        ``kind="BIT"`` the timer or counter bit of ``T37``/``C5``."""
         a = self._addr(address)
+        if kind and kind.upper() == "BIT":
+            if a.area not in ("T", "C"):
+                raise PlcAddressError(f"{address}: kind BIT is for timers and counters")
+            a = Addr(a.area, a.offset, 0, 0, a.text)
         buf, off, width, bit = self._locate(a)
         if width == 0:
             return buf[off] >> bit & 1

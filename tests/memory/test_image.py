@@ -103,3 +103,13 @@ def test_api_write_range_checked() -> None:
     assert plc["VW0"] == -32768
     plc["VD0"] = 1.5
     assert plc.read("VD0", "REAL") == 1.5
+
+
+def test_timer_bit_and_value_by_name() -> None:
+    """plc['T37'] is the current value; read('T37', 'BIT') the timer bit."""
+    plc = plcrt.load("ORGANIZATION_BLOCK OB1\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+                     "TON    T37, +2\nEND_ORGANIZATION_BLOCK\n", scan_ms=100)
+    plc.scan(3)
+    assert plc["T37"] == 2 and plc.read("T37", "BIT") == 1
+    with pytest.raises(plcrt.PlcAddressError):
+        plc.read("VW0", "BIT")

@@ -140,6 +140,9 @@ class ReferencePlc:
         self.time_us = 0
         self.previous_scan_start: int | None = None
         self.ticks_100ms = 0
+        # One logic stack for the whole run, as on the CPU (top = last item).
+        # A valid network never reads below the levels it pushed itself, so
+        # what earlier networks left behind is never observed.
         self.stack: list[int] = []
         # hidden state
         self.edge_memory: dict[tuple[int, int, int], int] = {}  # per EU/ED instruction

@@ -411,8 +411,8 @@ def test_compiled_engine_matches_reference(case: Case) -> None:
     run_side_by_side(case)
 
 
-# Regression: a work-in-progress code generator briefly fused ``LDN x`` /
-# ``LDx=`` with a following ``A``/``AN`` into ``x ^ 1 & y`` and
+# Regression: an early version of the contact-run folding (Gen.combine) turned
+# ``LDN x`` / ``LDx=`` followed by ``A``/``AN`` into ``x ^ 1 & y`` and
 # ``1 if c else 0 & y``, which Python groups as ``x ^ (1 & y)`` and
 # ``1 if c else (0 & y)``.
 @pytest.mark.parametrize("body, inputs", [
@@ -421,8 +421,12 @@ def test_compiled_engine_matches_reference(case: Case) -> None:
     # VW0 = 0: the compare gives 1, I0.1 = 0, so Q0.0 = 0 (the engine gave 1)
     ("LDW= VW0, 0\nA I0.1\n= Q0.0", ((0, 0, 1),)),
     ("LDB<> VB1, 1\nAN I0.1\n= Q0.0", ((2, 0, 1),)),
+    # fused runs: (I0.0 OR NOT I0.1) AND I0.2, and a pending run folded by ALD / OLD
+    ("LD I0.0\nON I0.1\nA I0.2\n= Q0.0", ((3, 0, 1), (4, 0, 1), (6, 0, 1))),
+    ("LD I0.0\nLDN I0.1\nA I0.2\nO I0.3\nALD\nLDW= VW0, 0\nOLD\n= Q0.0",
+     ((1, 0, 1), (5, 0, 1), (9, 0, 1), (0, 0, 1))),
 ])
-def test_and_after_ldn_or_compare_push(body: str, inputs: tuple) -> None:
+def test_fused_contact_runs(body: str, inputs: tuple) -> None:
     run_side_by_side(Case(_prog(body), inputs))
 
 

@@ -298,6 +298,31 @@ class Gen:
         sm = self.use("SM")
         self.line(f"{sm}[1] = {sm}[1] & 248 | 2")
 
+    def store_checked(self, out: Any, kind: str, r: str, lo: int | None, hi: int) -> None:
+        """Write result ``r`` with SM1.0/SM1.2 when ``lo <= r <= hi``; else set
+        SM1.1 and leave ``out`` unchanged (System Manual, math: "the output
+        is not altered").  ``lo=None`` checks only the upper bound."""
+        cond = f"{r} <= {hi}" if lo is None else f"{lo} <= {r} <= {hi}"
+        with self.block(f"if {cond}:"):
+            self.wr(out, kind, r)
+            self.flags_zn(r)
+            self.eno("1")
+        with self.block("else:"):
+            self.flag_overflow()
+            self.line("eno = 0")
+
+    @contextmanager
+    def divisor_guard(self, d: str) -> Iterator[None]:
+        """Divide by zero sets SM1.3 (other flags and the output unchanged,
+        ENO 0); the body runs for a non-zero divisor with SM1.3 cleared."""
+        sm = self.use("SM")
+        with self.block(f"if {d} == 0:"):
+            self.line(f"{sm}[1] |= 8")
+            self.line("eno = 0")
+        with self.block("else:"):
+            self.line(f"{sm}[1] &= 247")
+            yield
+
     def eno(self, expr: str) -> None:
         """Record the box's ENO (for a following AENO)."""
         self.line(f"eno = {expr}")

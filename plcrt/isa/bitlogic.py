@@ -22,64 +22,35 @@ def _phys(g: Gen, op: Addr) -> str:
     return f"({pi}[{op.offset}] >> {op.bit} & 1)" if op.bit else f"({pi}[{op.offset}] & 1)"
 
 
-@insn("LD", Role.BIT_R, family=F, summary="push the bit")
-def _ld(g: Gen, op: Addr) -> None:
-    g.push(g.rbit(op))
+# Contacts, from one table: (mnemonic, role, combine, inverted).  combine
+# is "push" for loads, "&" for A..., "|" for O...; the immediate forms (I
+# suffix) read the physical input terminal instead of the image.
+CONTACTS = [
+    ("LD", "push", False), ("LDN", "push", True), ("A", "&", False), ("AN", "&", True),
+    ("O", "|", False), ("ON", "|", True),
+]
+_HOW = {"push": "push", "&": "top := top AND", "|": "top := top OR"}
 
 
-@insn("LDN", Role.BIT_R, family=F, summary="push the inverted bit")
-def _ldn(g: Gen, op: Addr) -> None:
-    g.push(f"{g.rbit(op)} ^ 1")
+def _make_contact(mnemonic: str, how: str, inverted: bool, immediate: bool) -> None:
+    def emit(g: Gen, op: Addr) -> None:
+        expr = _phys(g, op) if immediate else g.rbit(op)
+        if inverted:
+            expr = f"({expr} ^ 1)"
+        if how == "push":
+            g.push(expr)
+        else:
+            g.combine(how, expr)
+
+    what = ("NOT " if inverted else "") + ("the physical input" if immediate else "the bit")
+    insn(mnemonic, Role.IBIT if immediate else Role.BIT_R, family=F,
+         summary=f"{_HOW[how]} {what}")(emit)
 
 
-@insn("A", Role.BIT_R, family=F, summary="top := top AND bit")
-def _a(g: Gen, op: Addr) -> None:
-    g.combine("&", g.rbit(op))
-
-
-@insn("AN", Role.BIT_R, family=F, summary="top := top AND NOT bit")
-def _an(g: Gen, op: Addr) -> None:
-    g.combine("&", f"({g.rbit(op)} ^ 1)")
-
-
-@insn("O", Role.BIT_R, family=F, summary="top := top OR bit")
-def _o(g: Gen, op: Addr) -> None:
-    g.combine("|", g.rbit(op))
-
-
-@insn("ON", Role.BIT_R, family=F, summary="top := top OR NOT bit")
-def _on(g: Gen, op: Addr) -> None:
-    g.combine("|", f"({g.rbit(op)} ^ 1)")
-
-
-@insn("LDI", Role.IBIT, family=F, summary="push the physical input")
-def _ldi(g: Gen, op: Addr) -> None:
-    g.push(_phys(g, op))
-
-
-@insn("LDNI", Role.IBIT, family=F, summary="push the inverted physical input")
-def _ldni(g: Gen, op: Addr) -> None:
-    g.push(f"{_phys(g, op)} ^ 1")
-
-
-@insn("AI", Role.IBIT, family=F, summary="top := top AND physical input")
-def _ai(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} &= {_phys(g, op)}")
-
-
-@insn("ANI", Role.IBIT, family=F, summary="top := top AND NOT physical input")
-def _ani(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} &= {_phys(g, op)} ^ 1")
-
-
-@insn("OI", Role.IBIT, family=F, summary="top := top OR physical input")
-def _oi(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} |= {_phys(g, op)}")
-
-
-@insn("ONI", Role.IBIT, family=F, summary="top := top OR NOT physical input")
-def _oni(g: Gen, op: Addr) -> None:
-    g.line(f"{g.top} |= {_phys(g, op)} ^ 1")
+for _mn, _how, _inv in CONTACTS:
+    _make_contact(_mn, _how, _inv, False)
+    # LDI LDNI AI ANI OI ONI: the N comes before the I
+    _make_contact(_mn + "I", _how, _inv, True)
 
 
 @insn("NOT", family=F, summary="invert the top of the stack")

@@ -25,34 +25,22 @@ def _binop(g: Gen, a, out, kind: str, expr_fmt: str, rng: tuple[int, int]) -> No
     with g.box():
         r = g.tmp("r")
         g.line(f"{r} = " + expr_fmt.format(a=g.rd(a, kind), o=g.rd(out, kind)))
-        with g.block(f"if {rng[0]} <= {r} <= {rng[1]}:"):
-            g.wr(out, kind, r)
-            g.flags_zn(r)
-            g.eno("1")
-        with g.block("else:"):
-            g.flag_overflow()
-            g.line("eno = 0")
+        g.store_checked(out, kind, r, *rng)
+
+
+def _quotient(g: Gen, n: str, d: str) -> str:
+    """Source of the quotient truncated toward zero (as the CPU divides)."""
+    return f"abs({n}) // abs({d}) * (-1 if ({n} < 0) != ({d} < 0) else 1)"
 
 
 def _div(g: Gen, a, out, kind: str, rng: tuple[int, int]) -> None:
     with g.box():
         d, n, r = g.tmp("d"), g.tmp("n"), g.tmp("r")
         g.line(f"{d} = {g.rd(a, kind)}")
-        sm = g.use("SM")
-        with g.block(f"if {d} == 0:"):
-            g.line(f"{sm}[1] |= 8")
-            g.line("eno = 0")
-        with g.block("else:"):
+        with g.divisor_guard(d):
             g.line(f"{n} = {g.rd(out, kind)}")
-            g.line(f"{r} = abs({n}) // abs({d}) * (-1 if ({n} < 0) != ({d} < 0) else 1)")
-            g.line(f"{sm}[1] &= 247")
-            with g.block(f"if {r} <= {rng[1]}:"):
-                g.wr(out, kind, r)
-                g.flags_zn(r)
-                g.eno("1")
-            with g.block("else:"):
-                g.flag_overflow()
-                g.line("eno = 0")
+            g.line(f"{r} = {_quotient(g, n, d)}")
+            g.store_checked(out, kind, r, None, rng[1])
 
 
 def _reg(mn: str, role_in: Role, role_out: Role, kind: str, fmt: str,
@@ -106,16 +94,11 @@ def _mul(g: Gen, a, out) -> None:
 def _divw(g: Gen, a, out) -> None:
     with g.box():
         d, n, q, m = g.tmp("d"), g.tmp("n"), g.tmp("q"), g.tmp("m")
-        sm = g.use("SM")
         g.line(f"{d} = {g.rd(a, 'W')}")
-        with g.block(f"if {d} == 0:"):
-            g.line(f"{sm}[1] |= 8")
-            g.line("eno = 0")
-        with g.block("else:"):
+        with g.divisor_guard(d):
             g.line(f"{n} = {_low_word(g, out)}")
-            g.line(f"{q} = abs({n}) // abs({d}) * (-1 if ({n} < 0) != ({d} < 0) else 1)")
+            g.line(f"{q} = {_quotient(g, n, d)}")
             g.line(f"{m} = {n} - {q} * {d}")
-            g.line(f"{sm}[1] &= 247")
             with g.block(f"if {q} <= 32767:"):
                 g.wr(out, "DU", f"(({m} & 65535) << 16) | ({q} & 65535)")
                 g.flags_zn(q)

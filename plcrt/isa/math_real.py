@@ -79,12 +79,7 @@ def _make_binary(mn: str, fn, summary: str) -> None:
             if mn == "/R":
                 d = g.tmp("d")
                 g.line(f"{d} = {g.rd(a, 'R')}")
-                sm = g.use("SM")
-                with g.block(f"if {d} == 0.0:"):
-                    g.line(f"{sm}[1] |= 8")
-                    g.line("eno = 0")
-                with g.block("else:"):
-                    g.line(f"{sm}[1] &= 247")
+                with g.divisor_guard(d):
                     g.line(f"{r} = {f}({d}, {g.rd(out, 'R')})")
                     _finish(g, out, r)
                 return

@@ -139,6 +139,8 @@ def _build_parser() -> _Parser:
     p.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="print this address at the end; ADDR:REAL reads a float")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--realtime", action="store_true",
+                   help="keep wall-clock pace (sleep between scans); results are unchanged")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",
@@ -156,11 +158,12 @@ def _build_parser() -> _Parser:
 def _load(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
     """Load the program named on the command line (raises PlcError)."""
     data = getattr(args, "data", None)
+    pace = "realtime" if getattr(args, "realtime", False) else "simulated"
     # Path objects make load() read files, never take the argument as text.
     return load([Path(p) for p in args.programs],
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
-                scan_ms=scan_ms, cpu=getattr(args, "cpu", None))
+                scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -194,6 +197,9 @@ def cmd_run(args: argparse.Namespace) -> int:
         watches = [_parse_watch(item) for item in args.watch]
         plc = _load(args, args.scan_ms)
         _print_diagnostics(plc.diagnostics)  # warnings
+        if "OB1" not in plc.unit.pous:
+            raise PlcConfigError("the program has no main program block (OB1), so there "
+                                 "is nothing to run; give the file with OB1 as well")
         for addr, value, text in writes:
             _write(plc, addr, value, text)
         for spec, addr, kind in watches:

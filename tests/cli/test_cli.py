@@ -405,3 +405,42 @@ def test_python_m_plcrt_help() -> None:
     for word in ("check", "run", "dump"):
         assert word in result.stdout
     assert result.stderr == ""
+
+
+CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
+ROUNDTRIP = CORPUS / "bulaofen0036-coder__Smart200-MicroWIN-MCP__roundtrip.awl"
+
+
+@pytest.mark.skipif(not ROUNDTRIP.is_file(), reason="shared/corpus not available")
+def test_check_lists_only_unimplemented_instructions_of_a_real_export(capsys) -> None:
+    """check on the Micro/WIN SMART roundtrip export lists each unimplemented
+    instruction use with file:line:col and block/network, and nothing else."""
+    symbols = str(Path(__file__).resolve().parents[1] / "data" / "roundtrip_symbols.sdf")
+    code, out, err = run_cli(capsys, "check", str(ROUNDTRIP), "--symbols", symbols)
+    assert code == 1
+    errors = [line for line in err.splitlines() if ": error: " in line]
+    assert len(errors) == 38
+    for line in errors:
+        assert "is not implemented yet [" in line and " network " in line, line
+        assert line.startswith(str(ROUNDTRIP) + ":")
+    mnemonics = {line.split("instruction ")[1].split()[0] for line in errors}
+    assert {"ATCH", "PID", "XMT", "HSC", "PLS", "TODR", "SCPY"} <= mnemonics
+    assert "MOVW" not in mnemonics
+
+
+def test_run_without_ob1_is_refused(tmp_path, capsys) -> None:
+    """run on a file holding only a subroutine says there is nothing to run."""
+    f = tmp_path / "sbr.awl"
+    f.write_text("SUBROUTINE_BLOCK S:SBR0\nTITLE=t\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+                 "=      Q0.0\nEND_SUBROUTINE_BLOCK\n", encoding="utf-8")
+    code, out, err = run_cli(capsys, "run", str(f), "--scans", "1")
+    assert code == 1
+    assert "no main program block (OB1)" in err
+
+
+def test_run_realtime_keeps_results(capsys) -> None:
+    """--realtime paces the scans on the wall clock without changing results."""
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "3", "--scan-ms", "1",
+                             "--realtime", "--set", "I0.0=1", "--watch", "Q0.0", "--json")
+    assert code == 0
+    assert json.loads(out)["values"] == {"Q0.0": 1}

@@ -49,7 +49,8 @@ class Plc:
     def __init__(self, program: ir.Program, *, symbols: Any = None, data: Any = None,
                  scan_ms: float = 10.0, cpu: str | None = None,
                  system_symbols: dict[str, str] | None = None,
-                 watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated") -> None:
+                 watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
+                 plant: Any = None) -> None:
         if not (isinstance(scan_ms, (int, float)) and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
         if pace not in ("simulated", "realtime"):
@@ -74,14 +75,24 @@ class Plc:
             from ..lang.symbols import SYSTEM_SYMBOLS
             system_symbols = dict(SYSTEM_SYMBOLS)
 
+        self._warned: set[str] = set()
+        self.diagnostics: list[Any] = []
+        self.modules: dict[int, Any] = {}
+        if plant is not None:
+            from ..devices import build_devices
+            self.devices = build_devices(self, plant)
+            self.modules = {d.slot: d for d in self.devices}
+        from ..blocks.call import library_call
+
         def setup(unit: Any) -> None:
             unit.hooks["plc"] = self
+            unit.hooks["library_call"] = library_call
             unit.hooks["timers"] = self.timers
             unit.hooks["counters"] = self.counters
 
         self.unit, self.source, self.line_locs = compile_program(
             program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup)
-        self.diagnostics = list(self.unit.diag.items)
+        self.diagnostics = list(self.unit.diag.items) + self.diagnostics
         self._filename = f"<plcrt {program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)
@@ -161,7 +172,7 @@ class Plc:
             if self._ob1 is not None:
                 self._ob1(m["L"])
             for dev in self.devices:
-                dev.step(self, self.scan_us)
+                dev.step(self, now, now + self.scan_us)
         except PlcError as e:
             self._fail(e)
         except Exception as e:  # an internal fault: map it to the program location
@@ -202,6 +213,38 @@ class Plc:
             f"watchdog: the scan ran longer than {WATCHDOG_MS} ms "
             f"(about {self.wd[0]} instructions in loops of {kind}{number}); "
             f"the CPU goes to STOP", None)
+
+    @property
+    def now_us(self) -> int:
+        """Simulated time of the current scan in µs (library blocks, devices)."""
+        return self._t_us
+
+    def warn(self, message: str, loc: SourceLoc | None, key: str) -> None:
+        """A run-time diagnostic (reported once per ``key``)."""
+        if key in self._warned:
+            return
+        self._warned.add(key)
+        from ..errors import Diagnostic
+        self.diagnostics.append(Diagnostic("warning", message, loc, "runtime"))
+
+    def module(self, slot: int) -> Any:
+        """The simulated module in expansion slot ``slot`` (EmNo), or None."""
+        return self.modules.get(slot)
+
+    def axis(self, slot: int, axis: int) -> dict[str, Any]:
+        """State of one configured axis: slot, axis, position (the module's
+        counter), mechanical (plant position), speed (Hz, signed), status."""
+        mod = self.modules.get(slot)
+        if mod is None:
+            raise PlcAddressError(f"no module in slot {slot}")
+        for entry in mod.snapshot(self._t_us):
+            if entry["axis"] == axis:
+                return entry
+        raise PlcAddressError(f"axis {axis} of slot {slot} is not configured in the plant")
+
+    def axes(self) -> list[dict[str, Any]]:
+        """State of every configured axis (see :meth:`axis`)."""
+        return [e for _, m in sorted(self.modules.items()) for e in m.snapshot(self._t_us)]
 
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""
@@ -340,12 +383,16 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     """
     from ..lang import parse_datablock, parse_symbols
 
+    plant = kw.pop("plant", None)
+    if isinstance(plant, (str, Path, dict)):
+        from ..devices.plant import load_plant
+        plant = load_plant(plant)
     program = parse_sources(source)
     if isinstance(symbols, (str, Path)):
         symbols = parse_symbols(*_text_or_path(symbols))
     if isinstance(data, (str, Path)):
         data = parse_datablock(*_text_or_path(data))
-    return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, **kw)
+    return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 
 __all__ = ["Plc", "load", "parse_sources"]

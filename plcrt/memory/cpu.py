@@ -30,15 +30,20 @@ class CpuModel:
     accumulators: int = 4
     hsc: int = 6
     sm_readonly: int = 30  #: SMB0..SMB29 are read-only to the program
+    onboard_di_bytes: int = 3  #: bytes of I used by the CPU's own inputs
+    onboard_do_bytes: int = 2  #: bytes of Q used by the CPU's own outputs
 
 
 CPU_MODELS: dict[str, CpuModel] = {
     m.name: m
     for m in (
-        CpuModel("CPU221", v_bytes=2048, sm_bytes=180, ai_bytes=0, aq_bytes=0),
-        CpuModel("CPU222", v_bytes=2048, sm_bytes=300),
-        CpuModel("CPU224", v_bytes=8192, sm_bytes=550),
-        CpuModel("CPU224XP", v_bytes=10240, sm_bytes=550),
+        # onboard I/O: 221 6 DI/4 DO, 222 8/6, 224 and 224XP 14/10, 226 24/16
+        CpuModel("CPU221", v_bytes=2048, sm_bytes=180, ai_bytes=0, aq_bytes=0,
+                 onboard_di_bytes=1, onboard_do_bytes=1),
+        CpuModel("CPU222", v_bytes=2048, sm_bytes=300, onboard_di_bytes=1, onboard_do_bytes=1),
+        CpuModel("CPU224", v_bytes=8192, sm_bytes=550, onboard_di_bytes=2, onboard_do_bytes=2),
+        CpuModel("CPU224XP", v_bytes=10240, sm_bytes=550, onboard_di_bytes=2,
+                 onboard_do_bytes=2),
         CpuModel("CPU226", v_bytes=10240, sm_bytes=550),
     )
 }

@@ -1,0 +1,84 @@
+"""Compiler hook: ``CALL NAME, args...`` of a built-in library block.
+
+Checks the call against the block's interface (argument count, operand
+kind and width, addresses where the block writes), then emits::
+
+    if s1:
+        r = _blk3(<IN values...>)
+        <write r[0], r[1], ... to the OUT / written-back arguments>
+
+``_blk3`` is the per-call-site callable built by the block's factory, so
+each call site has its own state (like the memory a Micro/WIN library
+subroutine gets per instance).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..compiler.operands import Addr, Const, Indirect
+from ..compiler.resolve import ResolveError, check_role
+from ..isa.registry import Role
+from . import BLOCK_FACTORIES
+from .interface import interfaces
+
+_READ = {"BOOL": Role.BIT_R, "BYTE": Role.B_R, "WORD": Role.W_R, "INT": Role.W_R,
+         "DINT": Role.D_R, "DWORD": Role.D_R}
+_WRITE = {"BOOL": Role.BIT_W, "BYTE": Role.B_W, "WORD": Role.W_W, "INT": Role.W_W,
+          "DINT": Role.D_W, "DWORD": Role.D_W}
+_KIND = {"BYTE": "B", "WORD": "WU", "INT": "W", "DINT": "D", "DWORD": "DU"}
+
+
+def library_call(g: Any, insn: Any, resolver: Any) -> bool:
+    """Emit a built-in block call; False if ``insn`` does not name one."""
+    name = insn.operands[0].text.split(":")[0].strip().upper()
+    itf = interfaces().get(name)
+    if itf is None:
+        return False
+    factory = BLOCK_FACTORIES.get(name)
+    if factory is None:
+        _load_implementations()
+        factory = BLOCK_FACTORIES.get(name)
+    if factory is None:
+        g.fail(f"library instruction {itf.name} has no implementation")
+    args = insn.operands[1:]
+    if len(args) != len(itf.params):
+        order = ", ".join(p.name for p in itf.params)
+        g.fail(f"{itf.name} takes {len(itf.params)} arguments ({order}); "
+               f"the call passes {len(args)}")
+    reads: list[str] = []
+    writes: list[tuple[Any, str]] = []   # (operand or None, type)
+    for p, op_ir in zip(itf.params, args):
+        try:
+            op = resolver.parse(op_ir.text)
+            if p.dir == "OUT" or p.address:
+                if isinstance(op, Const):
+                    raise ResolveError(f"must be an address, not the constant '{op_ir.text}'")
+                op = check_role(op, _WRITE[p.type], op_ir.text, g.unit.model)
+            else:
+                role = Role.D_PTR if p.pointer else _READ[p.type]
+                op = check_role(op, role, op_ir.text, g.unit.model)
+        except ResolveError as e:
+            g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}")
+        if p.dir == "IN":
+            reads.append(g.rbit(op) if p.type == "BOOL" else g.rd(op, _KIND[p.type]))
+        if p.dir == "OUT" or p.written:
+            target = op if isinstance(op, (Addr, Indirect)) else None
+            writes.append((target, p.type))
+    plc = g.unit.hooks["plc"]
+    fn = g.bind(factory(plc, g.loc, itf), "blk")
+    with g.box():
+        r = g.tmp("r")
+        g.line(f"{r} = {fn}({', '.join(reads)})")
+        for i, (target, typ) in enumerate(writes):
+            if target is None:
+                continue
+            if typ == "BOOL":
+                g.wbit(target, f"{r}[{i}]")
+            else:
+                g.wr(target, _KIND[typ], f"{r}[{i}]")
+    return True
+
+
+def _load_implementations() -> None:
+    from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)

@@ -1,0 +1,558 @@
+"""The seven instructions of the EM253 library ``EM253_Ext_v1.0``
+(EM253 user manual, chapter 3.2) as built-in blocks.
+
+Each CALL site gets its own block object (the instance memory a library
+subroutine has on the CPU).  The generated code calls it with the IN values
+and writes back what it returns (see ``library/EM253_Ext_v1.0.toml``).
+
+Common rules (manual 3.2, notes 1-5; decisions in docs/em253.md):
+
+* MOTION_EN3 must have run for the module earlier in the same scan;
+  otherwise a motion instruction does nothing and a diagnostic says why.
+* InnerState must be 0 before first use; the block sets it to 257.  If the
+  program changes it later the block stops its axis at once (the manual
+  only says the output "will be wrong") and reports it.
+* Update != 0 applies changed parameters to a running operation; the block
+  clears it.  E_Stop stops the pulses at once; a new start needs a new
+  rising edge of Run.  C_Status: 0 before the first run, 1 while running,
+  8 once stopped.
+* SpdSs must be below SpdSet (note 4), speeds are limited by the output
+  type (200 kHz single-ended, 500 kHz differential): otherwise the module's
+  behaviour is kept (no start / clamped) and a diagnostic is emitted.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any, Optional
+
+from ...blocks import register_block
+from ...compiler.operands import POINTER_AREA_NAMES
+from ..motion import plan_hold
+from .axis import Axis, distance_plan, stop_plan, velocity_plan
+from .module import EM253Module
+
+INNER_OK = 257
+ST_IDLE, ST_RUN, ST_STOPPED = 0, 1, 8
+STEP_BYTES = 12   #: POS_RUN table: AccTime W, DecTime W, SpdSet D, PosSet D
+MAX_STEPS = 32
+
+
+def _rate(v_set: int, v_ss: int, ms: int) -> Fraction:
+    """Ramp rate (Hz per µs) from note 3: (SpdSet - SpdSs) / time; a time
+    below 1 ms counts as 1 ms."""
+    return Fraction(max(v_set - v_ss, 1), max(ms, 1) * 1000)
+
+
+class _Base:
+    """Shared per-call-site logic: module lookup, InnerState, diagnostics."""
+
+    name = ""
+
+    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
+        self.plc = plc
+        self.loc = loc
+        self.itf = itf
+        self.status = ST_IDLE
+        self.initialised = False
+        self.prev_run = 0
+        self.axis: Optional[Axis] = None
+        self.module: Optional[EM253Module] = None
+        self._axis_no: Optional[int] = None
+        self.stopping = False
+        self.last_pos = 0
+
+    # -- helpers -----------------------------------------------------------
+    def warn(self, msg: str, code: str) -> None:
+        self.plc.warn(f"{self.name}: {msg}", self.loc, f"{self.name}:{code}:{id(self)}")
+
+    def now(self) -> int:
+        return self.plc.now_us
+
+    def find(self, em_no: int, axis_no: int | None) -> bool:
+        """Locate the module/axis; check that MOTION_EN3 ran this scan."""
+        mod = self.module
+        # perf: the same module and axis as last time, enabled in this scan
+        if mod is not None and mod.slot == em_no and mod.enabled_scan == self.plc.scans \
+                and self._axis_no == axis_no:
+            return True
+        mod = self.plc.modules.get(em_no)
+        if mod is None:
+            self.warn(f"no EM253 module in slot {em_no} (EmNo); configure one in the plant "
+                      f"file", "nomodule")
+            return False
+        if axis_no is not None and axis_no not in (0, 1):
+            self.warn(f"AxisNo must be 0 or 1, got {axis_no}", "axisno")
+            return False
+        if mod.enabled_scan != self.plc.scans:
+            self.warn(f"MOTION_EN3 for slot {em_no} has not run before this instruction in "
+                      f"this scan; the module ignores the instruction (call MOTION_EN3 with "
+                      f"SM0.0 first)", "noen")
+            return False
+        self.module = mod
+        self.axis = mod.axes[axis_no] if axis_no is not None else None
+        self._axis_no = axis_no
+        return True
+
+    def inner(self, value: int) -> bool:
+        """Check InnerState; False when the block must not run."""
+        if value == INNER_OK and self.initialised:
+            return True
+        if not self.initialised:
+            if value != 0:
+                self.warn(f"InnerState must be 0 before the first call (it is {value}); "
+                          f"the instruction does not run until it is cleared", "inner0")
+                return False
+            self.initialised = True
+            return True
+        if value != INNER_OK:
+            self.warn(f"InnerState was changed by the program (reads {value}, the block "
+                      f"keeps it at 257); the axis is stopped", "innerw")
+            if self.axis is not None and self.axis.moving and self.owns():
+                self.axis.stop_now(self.now())
+                self.status = ST_STOPPED
+        return True
+
+    def owns(self) -> bool:
+        return self.axis is not None and getattr(self.axis, "owner", None) is self
+
+    def speeds_ok(self, v_ss: int, v_set: int) -> Optional[int]:
+        """Validate speeds; returns the (possibly clamped) SpdSet or None."""
+        assert self.module is not None
+        if v_ss < 0 or v_set <= 0:
+            self.warn(f"speeds must be positive (SpdSs {v_ss}, SpdSet {v_set})", "spdneg")
+            return None
+        if v_ss >= v_set:
+            self.warn(f"SpdSs ({v_ss} Hz) is not below SpdSet ({v_set} Hz): the motor does "
+                      f"not start (manual note 4)", "ssset")
+            return None
+        lim = self.module.max_hz
+        if v_set > lim:
+            kind = "differential" if self.module.differential else "single-ended"
+            self.warn(f"SpdSet {v_set} Hz is above the {kind} output limit of {lim} Hz; "
+                      f"the module runs at {lim} Hz", "maxhz")
+            return lim
+        return v_set
+
+    def limit_watch(self, direction: int) -> list:
+        """Thresholds that stop the axis at a hard limit in ``direction``."""
+        assert self.axis is not None
+        p = self.axis.plant
+        lim = p.limit_pos if direction > 0 else p.limit_neg
+        if lim is None:
+            return []
+        return [(lim, self._hit_limit)]
+
+    def limit_active(self, direction: int) -> bool:
+        assert self.axis is not None
+        p, m = self.axis.plant, self.axis.mechanical(self.now())
+        if direction > 0:
+            return p.limit_pos is not None and m >= p.limit_pos
+        return p.limit_neg is not None and m <= p.limit_neg
+
+    def _hit_limit(self, t: int, pos: int) -> None:
+        assert self.axis is not None
+        self.axis.stop_now(t)
+        self.status = ST_STOPPED
+        self.warn(f"hard limit reached at position {pos} ({t / 1e6:.6f} s): the axis "
+                  f"stopped at once", f"limit{t}")
+
+    def begin(self, direction: int, segs: list, keep: bool = False) -> None:
+        assert self.axis is not None
+        ax = self.axis
+        t = self.now()
+        ax.owner = self
+        ax.start(t, direction, segs, self._done, keep_travel=keep)
+        ax.watch_positions(t, self.limit_watch(direction))
+        self.status = ST_RUN
+        self.stopping = False
+
+    def _done(self, t: int) -> None:
+        self.status = ST_STOPPED
+
+    def ramp_down(self, t: int, v_ss: int, rate: Fraction) -> None:
+        """Run went to 0: decelerate to SpdSs and stop (planned once)."""
+        if self.stopping:
+            return
+        ax = self.axis
+        assert ax is not None
+        x, v = ax.exact_state(t)
+        self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss), rate), keep=True)
+        self.stopping = True
+
+    def estop(self) -> None:
+        if self.axis is not None and self.axis.moving and self.owns():
+            self.axis.stop_now(self.now())
+        if self.status == ST_RUN:
+            self.status = ST_STOPPED
+
+    def running(self) -> bool:
+        ax = self.axis
+        return ax is not None and ax.owner is self and bool(ax.segs)
+
+
+@register_block("MOTION_EN3")
+class MotionEn3(_Base):
+    name = "MOTION_EN3"
+
+    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
+        super().__init__(plc, loc, itf)
+        self._last_key: tuple = ()
+        self._last_out: tuple = ()
+
+    def __call__(self, em_no: int, p_dor_ccw: int, sev0: int, sev1: int,
+                 clr0: int, clr1: int) -> tuple:
+        mod = self.plc.modules.get(em_no)
+        if mod is None:
+            self.warn(f"no EM253 module in slot {em_no} (EmNo): Status 4", "nomodule")
+            return clr0, clr1, 4
+        mod.enabled_scan = self.plc.scans
+        key = (em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
+        # perf: nothing to do when the inputs are as last scan and no CLR
+        # pulse or emergency stop is pending
+        if key == self._last_key and not mod.clr_pending and not mod.stf_any:
+            return self._last_out
+        t = self.now()
+        mod.differential = bool(p_dor_ccw)
+        out = []
+        for i, (sev, clr) in enumerate(((sev0, clr0), (sev1, clr1))):
+            ax = mod.axes[i]
+            if sev and ax.moving and not ax.masked:
+                self.warn(f"SevOn{i} masks pulse and direction while axis {i} moves: the "
+                          f"counter keeps counting but the motor does not follow", f"sev{i}")
+            ax.set_masked(t, bool(sev))
+            until = mod.clr_until[i]
+            if clr and until is None:
+                mod.clr_until[i] = t + 200_000
+            elif until is not None and t >= until:
+                mod.clr_until[i] = None
+                clr = 0  # the bit clears itself after the pulse (manual 3.2.1)
+            out.append(clr)
+        status = 4 if any(a.stf for a in mod.axes) else 1
+        mod.clr_pending = any(u is not None for u in mod.clr_until)
+        mod.stf_any = status == 4
+        result = (out[0], out[1], status)
+        self._last_key, self._last_out = (em_no, p_dor_ccw, sev0, sev1, out[0], out[1]), result
+        return result
+
+
+@register_block("GET_AbsPos")
+class GetAbsPos(_Base):
+    name = "GET_AbsPos"
+
+    def __call__(self, em_no: int, axis_no: int) -> tuple:
+        if not self.find(em_no, axis_no):
+            return 0, 0
+        assert self.axis is not None
+        return self.axis.position(self.now()), 1
+
+
+@register_block("SET_AbsPos")
+class SetAbsPos(_Base):
+    name = "SET_AbsPos"
+
+    def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
+        if not self.find(em_no, axis_no):
+            return start, self.status
+        assert self.axis is not None
+        if start:
+            self.axis.set_position(self.now(), pos)
+            self.status = 1
+            return 0, self.status
+        return 0, self.status
+
+
+@register_block("SPD_CTRL")
+class SpdCtrl(_Base):
+    name = "SPD_CTRL"
+
+    def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
+                 e_stop, run) -> tuple:
+        rising = run and not self.prev_run
+        self.prev_run = run
+        if not self.find(em_no, axis_no) or not self.inner(inner):
+            return inner, update, self.status, 0
+        ax = self.axis
+        assert ax is not None
+        t = self.now()
+        d = 1 if direction else -1
+        if e_stop:
+            self.estop()
+        elif self.running():
+            if not run:
+                self.ramp_down(t, v_ss, _rate(v_set, v_ss, dec))
+            elif update:
+                self._update(t, acc, dec, v_ss, v_set, d)
+        elif rising:
+            top = self.speeds_ok(v_ss, v_set)
+            if top is not None and not ax.moving:
+                if self.limit_active(d):
+                    self.warn("the hard limit in the running direction is active: the "
+                              "axis does not start", "limstart")
+                else:
+                    self.params = (acc, dec, v_ss, top, d)
+                    self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                                Fraction(top), _rate(top, v_ss, acc),
+                                                _rate(top, v_ss, dec)))
+            elif ax.moving:
+                self.warn("the axis is already moved by another instruction", "busy")
+        spd = ax.speed(t) if self.owns() else 0
+        if self.status == ST_RUN and not self.running():
+            self.status = ST_STOPPED
+        return INNER_OK, 0, self.status, spd
+
+    def _update(self, t, acc, dec, v_ss, v_set, d) -> None:
+        ax = self.axis
+        assert ax is not None
+        top = self.speeds_ok(v_ss, v_set)
+        if top is None:
+            return
+        x, v = ax.exact_state(t)
+        if d != ax.direction:
+            # manual note 5 advises against it; plcrt slows to a stop first
+            self.warn("direction changed while running (not recommended, manual note 5): "
+                      "the axis decelerates to a stop; start it again to reverse", "dirchg")
+            self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss),
+                                               _rate(top, v_ss, dec)), keep=True)
+            return
+        self.begin(ax.direction, velocity_plan(t, x, v, Fraction(v_ss), Fraction(top),
+                                               _rate(top, v_ss, acc), _rate(top, v_ss, dec)),
+                   keep=True)
+
+
+@register_block("POS_GOTO_R")
+class PosGotoR(_Base):
+    name = "POS_GOTO_R"
+
+    def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
+                 run) -> tuple:
+        rising = run and not self.prev_run
+        self.prev_run = run
+        if not self.find(em_no, axis_no) or not self.inner(inner):
+            return inner, update, self.status, 0, 0
+        ax = self.axis
+        assert ax is not None
+        t = self.now()
+        if e_stop:
+            self.estop()
+        elif self.running():
+            if not run:
+                self.ramp_down(t, v_ss, _rate(v_set, v_ss, dec))
+            elif update:
+                self._update(t, acc, dec, v_ss, v_set, pos)
+        elif rising:
+            top = self.speeds_ok(v_ss, v_set)
+            d = 1 if pos > 0 else -1
+            if pos == 0:
+                self.status = ST_STOPPED
+            elif top is not None and not ax.moving:
+                if self.limit_active(d):
+                    self.warn("the hard limit in the moving direction is active: the axis "
+                              "does not start", "limstart")
+                else:
+                    segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                            Fraction(top), Fraction(abs(pos)),
+                                            _rate(top, v_ss, acc), _rate(top, v_ss, dec))
+                    self.begin(d, segs)
+                    self.origin = ax.counter
+        if ax.owner is not self:
+            return INNER_OK, 0, self.status, 0, 0
+        if ax.segs:
+            return INNER_OK, 0, self.status, ax.travel(t), ax.speed(t)
+        if self.status == ST_RUN:
+            self.status = ST_STOPPED
+        return INNER_OK, 0, self.status, self.last_pos, 0
+
+    def _done(self, t: int) -> None:
+        assert self.axis is not None
+        self.last_pos = self.axis.last_travel
+        self.status = ST_STOPPED
+
+    def _update(self, t, acc, dec, v_ss, v_set, pos) -> None:
+        ax = self.axis
+        assert ax is not None
+        top = self.speeds_ok(v_ss, v_set)
+        if top is None:
+            return
+        d = 1 if pos > 0 else -1
+        x, v = ax.exact_state(t)
+        if d != ax.direction:
+            self.warn("PosSet changed sign while moving: a direction change is not "
+                      "allowed during a move; the new PosSet is ignored", "dirchg")
+            return
+        remaining = Fraction(abs(pos)) - x
+        ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
+        segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)
+        if remaining <= 0 or not ok:
+            self.warn("the updated PosSet cannot be reached with a ramp from the current "
+                      "speed: the axis decelerates and stops beyond it", "overshoot")
+            segs = stop_plan(t, x, v, Fraction(v_ss), rd)
+        self.begin(ax.direction, segs, keep=True)
+
+
+@register_block("POS_RUN")
+class PosRun(_Base):
+    name = "POS_RUN"
+
+    def __call__(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
+                 run) -> tuple:
+        rising = run and not self.prev_run
+        self.prev_run = run
+        if not self.find(em_no, axis_no) or not self.inner(inner):
+            return inner, update, self.status, 0, 0, 0
+        ax = self.axis
+        assert ax is not None
+        t = self.now()
+        if e_stop:
+            self.estop()
+        elif self.running():
+            if not run:
+                self.ramp_down(t, v_ss, self.stop_rate)
+        elif rising and not ax.moving:
+            if mode != 0:
+                self.warn(f"Mode {mode} is not defined (manual: 0); running as mode 0", "mode")
+            table = self._table(ptr, steps)
+            if table is not None:
+                self._start(t, v_ss, table)
+        step, c_pos = self._progress(t)
+        if self.status == ST_RUN and not self.running():
+            self.status = ST_STOPPED
+        spd = ax.speed(t) if self.owns() else 0
+        return INNER_OK, 0, self.status, c_pos, spd, step
+
+    def _table(self, ptr: int, steps: int) -> Optional[list[tuple[int, int, int, int]]]:
+        if not 1 <= steps <= MAX_STEPS:
+            self.warn(f"Step is {steps}; the module runs 1..{MAX_STEPS} steps and does not "
+                      f"start otherwise", "steps")
+            return None
+        area = POINTER_AREA_NAMES.get(ptr >> 24)
+        off = ptr & 0xFFFFFF
+        buf = self.plc.mem.areas.get({"T": "TV", "C": "CV"}.get(area, area)) if area else None
+        if buf is None or off + steps * STEP_BYTES > len(buf):
+            self.warn(f"ProfilePtr 16#{ptr:08X} does not point to {steps} x {STEP_BYTES} "
+                      f"bytes of memory", "ptr")
+            return None
+        rows = []
+        for i in range(steps):
+            b = off + i * STEP_BYTES
+            acc = int.from_bytes(buf[b:b + 2], "big")
+            dec = int.from_bytes(buf[b + 2:b + 4], "big")
+            spd = int.from_bytes(buf[b + 4:b + 8], "big", signed=True)
+            pos = int.from_bytes(buf[b + 8:b + 12], "big", signed=True)
+            rows.append((acc, dec, spd, pos))
+        signs = {1 if r[3] > 0 else -1 for r in rows if r[3] != 0}
+        if len(signs) > 1:
+            k = next(i for i, r in enumerate(rows) if r[3] != 0 and
+                     (1 if r[3] > 0 else -1) != (1 if rows[0][3] >= 0 else -1))
+            self.warn(f"step {k + 1} changes direction inside the envelope, which the module "
+                      f"does not allow (manual 3.2.6): the envelope does not start", "dir")
+            return None
+        return rows
+
+    def _start(self, t: int, v_ss: int, rows: list) -> None:
+        assert self.axis is not None and self.module is not None
+        d = -1 if any(r[3] < 0 for r in rows) else 1
+        segs = []
+        x = Fraction(0)
+        v = Fraction(v_ss)
+        tt = Fraction(t)
+        bounds = []
+        n = len(rows)
+        for i, (acc, dec, spd, pos) in enumerate(rows):
+            top = self.speeds_ok(v_ss, spd)
+            if top is None:
+                return
+            length = Fraction(abs(pos))
+            ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
+            if i == n - 1:
+                part, ok = _last(tt, x, v, v_ss, top, length, ra, rd)
+                if not ok:
+                    self.warn(f"the last step is too short to decelerate to SpdSs; the "
+                              f"pulses stop at a higher speed", "short")
+                self.stop_rate = rd
+            else:
+                part = plan_hold(tt, x, v, Fraction(top), length, ra, rd)
+            if part:
+                segs.extend(part)
+                tt, x, v = part[-1].t1, part[-1].x1, part[-1].v1
+            bounds.append(x)
+        if self.limit_active(d):
+            self.warn("the hard limit in the moving direction is active: the envelope does "
+                      "not start", "limstart")
+            return
+        self.bounds = bounds
+        self.begin(d, segs)
+
+    def _progress(self, t: int) -> tuple[int, int]:
+        if not self.owns() or not hasattr(self, "bounds"):
+            return getattr(self, "last", (0, 0))
+        assert self.axis is not None
+        x = self.axis.travel(t) if self.axis.moving else None
+        if x is None:
+            return getattr(self, "last", (0, 0))
+        start = 0
+        for i, b in enumerate(self.bounds):
+            if x < b or i == len(self.bounds) - 1:
+                res = (i + 1, x - start)
+                self.last = res
+                return res
+            start = int(b)
+        return 0, 0
+
+    def _done(self, t: int) -> None:
+        assert self.axis is not None
+        n = len(self.bounds)
+        prev = int(self.bounds[-2]) if n > 1 else 0
+        total = self.axis.last_travel
+        self.last = (n, total - prev)
+        self.status = ST_STOPPED
+
+
+def _last(t0, x, v, v_ss, top, length, ra, rd):
+    from ..motion import plan_distance
+    return plan_distance(t0, x, v if v > 0 else Fraction(v_ss), Fraction(top),
+                         Fraction(v_ss), length, ra, rd)
+
+
+@register_block("HOMING")
+class Homing(_Base):
+    name = "HOMING"
+
+    def __call__(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
+                 run) -> tuple:
+        rising = run and not self.prev_run
+        self.prev_run = run
+        if not self.find(em_no, axis_no) or not self.inner(inner):
+            return inner, self.status, 0
+        ax = self.axis
+        assert ax is not None
+        t = self.now()
+        if e_stop:
+            if getattr(self, "seq", None) is not None:
+                self.seq.abort()
+            self.estop()
+        elif getattr(self, "seq", None) is not None and self.seq.active:
+            if not run:
+                self.seq.abort()
+                x, v = ax.exact_state(t)
+                self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_low),
+                                                   self.seq.rate), keep=True)
+        elif rising and not ax.moving:
+            from .homing import HomingSequence, MODES
+            if mode not in MODES:
+                self.warn(f"HomingMode {mode} is not one of 0..14: nothing happens", "mode")
+            elif v_low <= 0 or v_high < v_low:
+                self.warn(f"homing needs 0 < SpdLow <= SpdHigh (got {v_low}, {v_high})",
+                          "speeds")
+            else:
+                top = min(v_high, self.module.max_hz) if self.module else v_high
+                if top < v_high:
+                    self.warn(f"SpdHigh {v_high} Hz is above the output limit; using {top} Hz",
+                              "maxhz")
+                self.seq = HomingSequence(self, ax, mode, v_low, top, offset)
+                self.status = ST_RUN
+                self.seq.start(t)
+        spd = ax.speed(t) if self.owns() else 0
+        if self.status == ST_RUN and not (getattr(self, "seq", None) and self.seq.active):
+            self.status = ST_STOPPED
+        return INNER_OK, self.status, spd

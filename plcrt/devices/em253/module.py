@@ -1,0 +1,127 @@
+"""One EM253 module in an expansion slot: two axes and their terminals.
+
+Process image map (EM253 manual, chapter 1: "one module occupies 16 DI and
+16 DO"; plcrt places them after the CPU's own I/O and the modules before
+it, slot by slot):
+
+* inputs: ``IB(n)`` axis 0, ``IB(n+1)`` axis 1, with n = CPU input bytes +
+  2 x slot (CPU 226: module 0 at IB3/IB4).  Bits: .0 STF, .1 RPS, .2 L+,
+  .3 L-, .4 Z.
+* outputs: ``QB(m)`` axis 0, ``QB(m+1)`` axis 1, m = CPU output bytes + 2 x
+  slot (CPU 226: QB2/QB3).  Bits: .0 En (SevOn), .1 CLR, .2 P (pulsing),
+  .3 D (direction positive).
+
+The module writes its inputs to the physical image PI (the next scan reads
+them) and its output terminal states into Q.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from ...errors import PlcConfigError
+from .axis import Axis, AxisPlant
+
+CLR_PULSE_US = 200_000  #: CLR output pulse length (manual 2.1: "about 200 ms")
+SINGLE_ENDED_MAX_HZ = 200_000
+DIFFERENTIAL_MAX_HZ = 500_000
+
+
+class EM253Module:
+    """Device: an EM253 in slot ``cfg.slot``."""
+
+    def __init__(self, plc: Any, cfg: Any) -> None:
+        self.plc = plc
+        self.slot = cfg.slot
+        self.configured = set(cfg.axes)
+        self.axes = [Axis(cfg.axes.get(i, AxisPlant())) for i in (0, 1)]
+        model = plc.model
+        self.di = model.onboard_di_bytes + 2 * self.slot
+        self.do = model.onboard_do_bytes + 2 * self.slot
+        if self.di + 2 > model.i_bytes or self.do + 2 > model.q_bytes:
+            raise PlcConfigError(
+                f"an EM253 in slot {self.slot} needs IB{self.di}-IB{self.di + 1} and "
+                f"QB{self.do}-QB{self.do + 1}, beyond the {model.name} process image")
+        self.enabled_scan = -1       #: scan number in which MOTION_EN3 last ran
+        self.differential = False
+        self.clr_until: list[Optional[int]] = [None, None]
+        self.clr_pending = False
+        self.stf_any = False
+        self._idle_written = [False, False]
+        self._events = [list(a.plant.events) for a in self.axes]
+        self._write_terminals(0)
+
+    @property
+    def max_hz(self) -> int:
+        return DIFFERENTIAL_MAX_HZ if self.differential else SINGLE_ENDED_MAX_HZ
+
+    def step(self, plc: Any, t_from: int, t_to: int) -> None:
+        for i, ax in enumerate(self.axes):
+            evs = self._events[i]
+            while evs and evs[0][0] <= t_to:
+                te, name, value = evs.pop(0)
+                te = max(te, t_from)
+                ax.advance(te)
+                if name == "STF":
+                    self.set_stf(i, te, value)
+            ax.advance(t_to)
+        self._write_terminals(t_to)
+
+    def set_stf(self, i: int, t: int, value: bool) -> None:
+        """Hardware emergency stop: pulses stop at once, no ramp (manual 2.1)."""
+        ax = self.axes[i]
+        ax.stf = value
+        ax.dirty = True
+        self.stf_any = any(a.stf for a in self.axes)
+        if value and ax.moving:
+            ax.stop_now(t)
+            self.plc.warn(f"EM253 slot {self.slot} axis {i}: STF emergency stop at "
+                          f"{t / 1e6:.6f} s, pulses stopped without deceleration",
+                          None, f"stf-{self.slot}-{i}-{t}")
+
+    def _write_terminals(self, t: int) -> None:
+        pi = self.plc.mem.areas["PI"]
+        q = self.plc.mem.areas["Q"]
+        for i, ax in enumerate(self.axes):
+            # perf: a stopped axis whose terminals were written since it
+            # stopped has nothing new to show (no CLR pulse running)
+            if not ax.moving and self._idle_written[i] and self.clr_until[i] is None \
+                    and not ax.dirty:
+                continue
+            self._idle_written[i] = not ax.moving
+            ax.dirty = False
+            p = ax.plant
+            m = ax.mechanical(t)
+            b = 1 if ax.stf else 0
+            if p.rps is not None and p.rps[0] <= m <= p.rps[1]:
+                b |= 2
+            if p.limit_pos is not None and m >= p.limit_pos:
+                b |= 4
+            if p.limit_neg is not None and m <= p.limit_neg:
+                b |= 8
+            if p.z_period and (m - p.z_offset) % p.z_period == 0:
+                b |= 16
+            pi[self.di + i] = b
+            o = 1 if ax.masked else 0
+            until = self.clr_until[i]
+            if until is not None and t < until:
+                o |= 2
+            if ax.moving and not ax.masked:
+                o |= 4
+            if ax.direction > 0 and not ax.masked:
+                o |= 8
+            q[self.do + i] = o
+
+    def snapshot(self, t: int) -> list[dict[str, Any]]:
+        out = []
+        for i, ax in enumerate(self.axes):
+            if i not in self.configured:
+                continue
+            out.append({
+                "slot": self.slot, "axis": i,
+                "position": ax.position(t), "mechanical": ax.mechanical(t),
+                "speed": ax.speed(t),
+                "status": "moving" if ax.moving else "stopped",
+                "masked": ax.masked, "stf": ax.stf,
+            })
+        return out

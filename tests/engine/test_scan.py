@@ -132,7 +132,7 @@ def test_outputs_reach_the_terminals_at_the_scan_end() -> None:
         def __init__(self) -> None:
             self.pq: list[int] = []
 
-        def step(self, plc: plcrt.Plc, scan_us: int) -> None:
+        def step(self, plc: plcrt.Plc, t_from: int, t_to: int) -> None:
             self.pq.append(plc.mem.areas["PQ"][0])
 
     p = plcrt.load(IO_PROGRAM, scan_ms=10)

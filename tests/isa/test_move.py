@@ -250,7 +250,7 @@ class _PqProbe:
     def __init__(self) -> None:
         self.seen: list[int] = []
 
-    def step(self, plc: plcrt.Plc, scan_us: int) -> None:
+    def step(self, plc: plcrt.Plc, t_from: int, t_to: int) -> None:
         self.seen.append(plc.mem.areas["PQ"][1])
 
 

@@ -12,7 +12,12 @@ the PLC program (the CPU went to STOP).  No path prints a Python traceback;
 an unexpected exception is reported as an internal error, and the traceback
 is shown only when the environment variable ``PLCRT_TRACEBACK`` is set.
 
-``rich`` is imported lazily and only for the watch table on a terminal.
+``rich`` is imported lazily and only for the tables on a terminal.
+
+``--plant F`` attaches simulated modules (an EM253 and the machine around
+its axes, see :mod:`plcrt.devices.plant`); ``run`` then reports the state
+of every configured axis after the watch values, or under ``"axes"`` in the
+JSON object.
 """
 
 from __future__ import annotations
@@ -110,7 +115,8 @@ def _build_parser() -> _Parser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    def common(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True) -> None:
+    def common(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True,
+               plant: bool = True) -> None:
         p.add_argument("programs", nargs="+", metavar="PROGRAM",
                        help="STL export (.awl); several files are merged into one program")
         p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
@@ -118,6 +124,10 @@ def _build_parser() -> _Parser:
             p.add_argument("--data", metavar="F", help="data block (V memory initial values)")
         if cpu:
             p.add_argument("--cpu", metavar="NAME", help="CPU model, e.g. CPU224 (default CPU226)")
+        if plant:
+            p.add_argument("--plant", metavar="F",
+                           help="plant file (TOML): EM253 modules and the machine around "
+                                "their axes")
 
     p = sub.add_parser("check", help="parse and compile; list every error and warning",
                        description="Parse and compile a program and list every error and "
@@ -146,7 +156,7 @@ def _build_parser() -> _Parser:
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",
                        description="Print the Python the program compiles to, network by "
                                    "network, each instruction's code under its STL line.")
-    common(p, data=False)
+    common(p, data=False, plant=False)
     p.set_defaults(func=cmd_dump)
     return parser
 
@@ -158,12 +168,14 @@ def _build_parser() -> _Parser:
 def _load(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
     """Load the program named on the command line (raises PlcError)."""
     data = getattr(args, "data", None)
+    plant = getattr(args, "plant", None)
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
     # Path objects make load() read files, never take the argument as text.
     return load([Path(p) for p in args.programs],
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
-                scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace)
+                scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
+                plant=Path(plant) if plant else None)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -186,7 +198,8 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """``plcrt run``: load, apply --set, run, print --watch values."""
+    """``plcrt run``: load, apply --set, run, print --watch values (and the
+    axes of a --plant)."""
     program = args.programs[0]
     try:
         if args.scans is not None and args.scans < 0:
@@ -211,15 +224,21 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     fault: PlcError | None = None
+    loaded = len(plc.diagnostics)
     try:
         plc.run(seconds=args.seconds, scans=args.scans)
     except PlcRuntimeError as e:
         fault = e
+    # Warnings raised while running (library blocks such as the EM253's
+    # report bad parameters only when they execute) go to stderr as well.
+    _print_diagnostics(plc.diagnostics[loaded:])
     values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
     if args.json:
         _emit_json(args, plc, values, str(fault) if fault else None)
     else:
         _print_values(program, plc, values)
+        if args.plant:
+            _print_axes(plc.axes())
     if fault is not None:
         _print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
@@ -397,6 +416,8 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         "mode": plc.mode if plc else None,
         "values": values,
     }
+    if plc is not None and getattr(args, "plant", None):
+        obj["axes"] = plc.axes()
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
@@ -437,6 +458,59 @@ def _print_rich_table(summary: str, values: dict[str, int | float]) -> bool:
     for key, value in values.items():
         table.add_row(key, _fmt(value))
     console.print(table)
+    return True
+
+
+#: columns of the axes table (keys of :meth:`plcrt.Plc.axes` entries)
+_AXIS_COLUMNS = ("slot", "axis", "position", "mechanical", "speed", "status")
+
+
+def _axis_rows(axes: Sequence[dict[str, Any]]) -> list[list[str]]:
+    rows = []
+    for a in axes:
+        row = [str(a[c]) for c in _AXIS_COLUMNS]
+        # SevOn masking and the STF input explain a position that does not
+        # move, so they are shown next to the status rather than dropped.
+        notes = [n for n, on in (("SevOn", a.get("masked")), ("STF", a.get("stf"))) if on]
+        if notes:
+            row[-1] += f" ({', '.join(notes)})"
+        rows.append(row)
+    return rows
+
+
+def _print_axes(axes: Sequence[dict[str, Any]]) -> None:
+    """The plant's axes after the watch values: a rich table on a terminal,
+    aligned plain text otherwise (numbers right-aligned)."""
+    if not axes:
+        print("axes: none configured in the plant")
+        return
+    rows = _axis_rows(axes)
+    if sys.stdout.isatty() and _print_rich_axes(rows):
+        return
+    widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(_AXIS_COLUMNS)]
+    last = len(_AXIS_COLUMNS) - 1
+
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(c.ljust(w) if i == last else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    print(line(_AXIS_COLUMNS))
+    for row in rows:
+        print(line(row))
+
+
+def _print_rich_axes(rows: list[list[str]]) -> bool:
+    try:
+        from rich.console import Console
+        from rich.table import Table
+    except ImportError:
+        return False
+    table = Table()
+    for i, col in enumerate(_AXIS_COLUMNS):
+        table.add_column(col, justify="left" if i == len(_AXIS_COLUMNS) - 1 else "right")
+    for row in rows:
+        table.add_row(*row)
+    Console().print(table)
     return True
 
 

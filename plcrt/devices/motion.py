@@ -117,62 +117,64 @@ def plan_distance(t0: Fraction, x0: Fraction, v_in: Fraction, v_max: Fraction,
     """Segments covering exactly ``length`` pulses from speed ``v_in``:
     ramp toward ``v_max``, cruise, ramp down to ``v_end`` at the end.
 
-    Returns the segments and whether the end speed could be reached (False
-    when the distance is too short to slow down from ``v_in``: the last
-    segment then ends above ``v_end``).
+    ``v_end`` above ``v_max`` is taken as ``v_max`` (the stop speed is
+    below the run speed, EM253 manual note 4).  Speeds stay within
+    ``[min(v_in, v_end), max(v_in, v_max)]``; speed increases never exceed
+    ``r_acc`` and decreases never exceed ``r_dec``; peaks and unreachable
+    end speeds are rounded (to whole Hz) in the direction that keeps both.
+
+    Returns the segments and whether the end speed is reached (False when
+    the distance is too short to slow down from ``v_in`` -- the last
+    segment then ends above ``v_end`` -- or, starting below ``v_end``, to
+    speed up to it).
     """
     segs: list[Seg] = []
-    t, x = t0, x0
     if length <= 0:
         return segs, True
-    d_dec_in = ramp_distance(v_in, v_end, r_dec) if v_in > v_end else Fraction(0)
-    if v_in >= v_max or d_dec_in >= length:
-        # already at or above the peak: slow down (to v_max, then to v_end)
-        if d_dec_in >= length:
-            # cannot reach v_end: slow down as far as the distance allows
-            v_reach = _speed_after(v_in, length, -r_dec)
-            if v_reach < v_in:
-                segs.append(ramp(t, x, v_in, v_reach, r_dec))
-            else:
-                segs.append(cruise(t, x, v_in, length))
-            return segs, v_reach <= v_end
-        top = v_max
-        if v_in > top:
-            segs.append(ramp(t, x, v_in, top, r_dec))
-            t, x = segs[-1].t1, segs[-1].x1
+    if v_max <= 0:
+        raise ValueError("plan_distance: v_max must be positive")
+    v_end = min(v_end, v_max)
+    x_end = x0 + length
+    if v_in > v_end and ramp_distance(v_in, v_end, r_dec) >= length:
+        # too short to slow down to v_end: slow down as far as it allows
+        v_reach = max(_sqrt_ceil(v_in * v_in - 2 * r_dec * length * US), v_end)
+        if v_reach >= v_in:
+            segs.append(cruise(t0, x0, v_in, length))
         else:
-            top = v_in
-        d_dec = ramp_distance(top, v_end, r_dec) if top > v_end else Fraction(0)
-        rest = x0 + length - x - d_dec
-        if rest < 0:
-            rest = Fraction(0)
-        if rest:
-            segs.append(cruise(t, x, top, rest))
+            segs.append(_final_ramp(t0, x0, v_in, v_reach, x_end))
+        return segs, v_reach == v_end
+    if v_in < v_end and ramp_distance(v_in, v_end, r_acc) >= length:
+        # too short to speed up to v_end: speed up as far as it allows
+        v_reach = min(_sqrt_floor(v_in * v_in + 2 * r_acc * length * US), v_end)
+        if v_reach <= v_in:
+            segs.append(cruise(t0, x0, v_in, length))
+        else:
+            segs.append(_final_ramp(t0, x0, v_in, v_reach, x_end))
+        return segs, v_reach == v_end
+    t, x = t0, x0
+    if v_in >= v_max:
+        # at or above the peak: slow down to v_max, cruise, slow down to v_end
+        peak = v_max
+        if v_in > peak:
+            segs.append(ramp(t, x, v_in, peak, r_dec))
             t, x = segs[-1].t1, segs[-1].x1
-        if top > v_end:
-            segs.append(_final_ramp(t, x, top, v_end, x0 + length))
-        return segs, True
-    d_acc = ramp_distance(v_in, v_max, r_acc)
-    d_dec = ramp_distance(v_max, v_end, r_dec) if v_max > v_end else Fraction(0)
-    peak = v_max
-    if d_acc + d_dec > length:
-        # triangular: peak^2 solves the two ramps; round down to whole Hz
-        num = 2 * length * US * r_acc * r_dec + r_dec * v_in * v_in + r_acc * v_end * v_end
-        peak_sq = num / (r_acc + r_dec)
-        peak = Fraction(isqrt(int(peak_sq)))
-        if peak < max(v_in, v_end):
-            peak = max(v_in, v_end)
-        d_acc = ramp_distance(v_in, peak, r_acc)
-        d_dec = ramp_distance(peak, v_end, r_dec) if peak > v_end else Fraction(0)
-    if peak > v_in:
-        segs.append(ramp(t, x, v_in, peak, r_acc))
-        t, x = segs[-1].t1, segs[-1].x1
-    rest = length - d_acc - d_dec
+    else:
+        d_acc = ramp_distance(v_in, v_max, r_acc)
+        d_dec = ramp_distance(v_max, v_end, r_dec)
+        peak = v_max
+        if d_acc + d_dec > length:
+            # triangular: peak^2 solves the two ramps; round it down
+            num = 2 * length * US * r_acc * r_dec + r_dec * v_in * v_in + r_acc * v_end * v_end
+            peak = max(_sqrt_floor(num / (r_acc + r_dec)), v_in, v_end)
+        if peak > v_in:
+            segs.append(ramp(t, x, v_in, peak, r_acc))
+            t, x = segs[-1].t1, segs[-1].x1
+    rest = x_end - x - ramp_distance(peak, v_end, r_dec)
     if rest > 0:
         segs.append(cruise(t, x, peak, rest))
         t, x = segs[-1].t1, segs[-1].x1
-    if peak > v_end:
-        segs.append(_final_ramp(t, x, peak, v_end, x0 + length))
+    if peak > v_end and x < x_end:
+        segs.append(_final_ramp(t, x, peak, v_end, x_end))
     return segs, True
 
 
@@ -180,28 +182,35 @@ def plan_hold(t0: Fraction, x0: Fraction, v_in: Fraction, v_target: Fraction,
               length: Fraction, r_up: Fraction, r_down: Fraction) -> list[Seg]:
     """Exactly ``length`` pulses: change speed toward ``v_target`` (at
     ``r_up`` / ``r_down``) as far as the distance allows, then hold it.
-    Used for the inner segments of an envelope, which do not stop."""
+    Used for the inner segments of an envelope, which do not stop.
+
+    Speeds stay between ``v_in`` and ``v_target`` (which must be positive).
+    """
     segs: list[Seg] = []
     t, x = t0, x0
     if length <= 0:
         return segs
+    if v_target <= 0:
+        raise ValueError("plan_hold: v_target must be positive")
     v = v_in
-    if v_target != v_in:
-        rate = r_up if v_target > v_in else r_down
-        d = ramp_distance(v_in, v_target, rate)
-        if d <= length:
+    if v_target > v_in:
+        if ramp_distance(v_in, v_target, r_up) <= length:
             v = v_target
         else:
-            sign = 1 if v_target > v_in else -1
-            v = _speed_after(v_in, length, sign * rate)
-            v = min(v, v_target) if sign > 0 else max(v, v_target)
-        if v != v_in:
-            segs.append(ramp(t, x, v_in, v, rate))
-            t, x = segs[-1].t1, segs[-1].x1
+            v = max(min(_sqrt_floor(v_in * v_in + 2 * r_up * length * US), v_target), v_in)
+        if v > v_in:
+            segs.append(ramp(t, x, v_in, v, r_up))
+    elif v_target < v_in:
+        if ramp_distance(v_in, v_target, r_down) <= length:
+            v = v_target
+        else:
+            v = min(max(_sqrt_ceil(v_in * v_in - 2 * r_down * length * US), v_target), v_in)
+        if v < v_in:
+            segs.append(ramp(t, x, v_in, v, r_down))
+    if segs:
+        t, x = segs[-1].t1, segs[-1].x1
     rest = x0 + length - x
     if rest > 0:
-        if v <= 0:
-            v = Fraction(1)
         segs.append(cruise(t, x, v, rest))
     return segs
 
@@ -213,39 +222,69 @@ def _final_ramp(t: Fraction, x: Fraction, v0: Fraction, v1: Fraction, x_end: Fra
     return Seg(t, t + dt, x, v0, v1)
 
 
-def _speed_after(v0: Fraction, dist: Fraction, signed_rate: Fraction) -> Fraction:
-    """Speed after ``dist`` pulses under constant (signed) rate, floored to 1 Hz."""
-    sq = v0 * v0 + 2 * signed_rate * dist * US
+_FINE = 2**20  #: resolution (1/_FINE Hz) of speeds below 1 Hz
+
+
+def _sqrt_floor(sq: Fraction) -> Fraction:
+    """A speed at most ``sqrt(sq)``: whole Hz, or finer below 1 Hz (so
+    that a positive square never gives speed 0)."""
     if sq <= 0:
         return Fraction(0)
-    return Fraction(isqrt(int(sq)))
+    if sq >= 1:
+        return Fraction(isqrt(sq.numerator // sq.denominator))
+    return Fraction(isqrt((sq * _FINE * _FINE).numerator // (sq * _FINE * _FINE).denominator),
+                    _FINE)
+
+
+def _sqrt_ceil(sq: Fraction) -> Fraction:
+    """The smallest whole Hz at least ``sqrt(sq)``."""
+    if sq <= 0:
+        return Fraction(0)
+    n = -(-sq.numerator // sq.denominator)
+    r = isqrt(n)
+    return Fraction(r if r * r == n else r + 1)
 
 
 def first_time_at(seg: Seg, target: Fraction | int, lo: int) -> Optional[int]:
     """First integer µs ``t >= lo`` inside ``seg`` at which its travel has
-    reached ``target`` pulses (``floor`` semantics: whole pulses), or None."""
+    reached ``target`` pulses (``floor`` semantics: whole pulses), or None.
+
+    At and after the segment's end ``t1`` the travel counts as ``x1`` (a
+    following segment starts there and the quadratic must not be
+    extrapolated: past the end of a ramp down to 0 it would fall again).
+    """
+    tgt = -((-target.numerator) // target.denominator) if isinstance(target, Fraction) \
+        else int(target)
     hi = seg.t1_ceil
     if hi is None:
         v = seg.v0
         if v <= 0:
             return None
-        # endless cruise: travel grows linearly; solve directly, then fix up
-        need = Fraction(target) - seg.travel(lo)
+        # endless cruise: travel grows linearly; solve directly, then bisect
+        need = tgt - seg.travel(lo)
         if need <= 0:
             return lo
         hi = lo + int(need * US / v) + 2
-    if hi < lo:
-        return None
-    tgt = int(target) if not isinstance(target, Fraction) or target.denominator == 1 \
-        else -((-target.numerator) // target.denominator)
-    if seg.pulses(hi) < tgt:
-        return None
-    if seg.pulses(lo) >= tgt:
+    else:
+        if hi < lo:
+            return None
+        x1 = seg.x1
+        if x1.numerator // x1.denominator < tgt:
+            return None
+    pulses = seg.pulses
+    end = seg.t1_ceil
+
+    def reached(t: int) -> bool:
+        if end is not None and t >= end:
+            return True  # floor(x1) >= tgt was checked above
+        return pulses(t) >= tgt
+
+    if reached(lo):
         return lo
     # travel is non-decreasing inside a segment: bisect on integers
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if seg.pulses(mid) >= tgt:
+        if reached(mid):
             hi = mid
         else:
             lo = mid

@@ -19,6 +19,7 @@ the file and the key.
 
 from __future__ import annotations
 
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,7 @@ from .em253.axis import AxisPlant
 KINDS = ("EM253",)
 EVENT_INPUTS = ("STF",)
 _AXIS_KEYS = {"start", "rps", "limit_neg", "limit_pos", "z_period", "z_offset", "events"}
+_MODULE_KEYS = {"kind", "axis"}
 
 
 @dataclass
@@ -55,6 +57,8 @@ def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
             text = path.read_text(encoding="utf-8")
         except OSError as e:
             raise PlcConfigError(f"{path}: cannot read plant file: {e.strerror}") from None
+        except UnicodeDecodeError:
+            raise PlcConfigError(f"{path}: the plant file is not UTF-8 text (TOML)") from None
         file = str(path)
     else:
         text = str(source)
@@ -74,6 +78,12 @@ def _int(v: Any, where: str) -> int:
 
 def _build(data: dict, file: str) -> Plant:
     modules: dict[int, ModuleConfig] = {}
+    # A misspelt table ([modules.0]) would otherwise give a plant without
+    # modules and only run-time warnings: reject unknown keys at every level.
+    unknown = set(data) - {"module"}
+    if unknown:
+        raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(a plant file has [module.N] tables)")
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -82,14 +92,25 @@ def _build(data: dict, file: str) -> Plant:
         if not str(key).isdigit() or not 0 <= int(key) <= 6:
             raise PlcConfigError(f"{where}: the slot (EmNo) must be 0..6")
         slot = int(key)
+        if not isinstance(mod, dict):
+            raise PlcConfigError(f"{where} must be a table")
+        unknown = set(mod) - _MODULE_KEYS
+        if unknown:
+            raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
         kind = str(mod.get("kind", "EM253")).upper()
         if kind not in KINDS:
             raise PlcConfigError(f"{where}: unknown module kind {kind!r} (known: {', '.join(KINDS)})")
         cfg = ModuleConfig(slot, kind)
-        for akey, ax in mod.get("axis", {}).items():
+        axes = mod.get("axis", {})
+        if not isinstance(axes, dict):
+            raise PlcConfigError(f"{where}.axis must be a table of axes "
+                                 f"([module.{key}.axis.0], [module.{key}.axis.1])")
+        for akey, ax in axes.items():
             awhere = f"{where}.axis.{akey}"
             if akey not in ("0", "1"):
                 raise PlcConfigError(f"{awhere}: an EM253 has axes 0 and 1")
+            if not isinstance(ax, dict):
+                raise PlcConfigError(f"{awhere} must be a table")
             unknown = set(ax) - _AXIS_KEYS
             if unknown:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
@@ -120,16 +141,24 @@ def _axis(ax: dict, where: str) -> AxisPlant:
             raise PlcConfigError(f"{where}.z_period must be positive")
         p.z_period = zp
     p.z_offset = _int(ax.get("z_offset", 0), f"{where}.z_offset")
-    for i, ev in enumerate(ax.get("events", [])):
+    events = ax.get("events", [])
+    if not isinstance(events, list):
+        raise PlcConfigError(f"{where}.events must be a list of {{ at, input, value }} tables")
+    for i, ev in enumerate(events):
         ew = f"{where}.events[{i}]"
         try:
             at = float(ev["at"])
             name = str(ev["input"]).upper()
-            value = bool(ev["value"])
+            value = ev["value"]
         except (KeyError, TypeError, ValueError):
             raise PlcConfigError(f"{ew}: needs at (seconds), input and value") from None
+        # bool('false') would be True: only a TOML boolean (or 0/1) is a value
+        if not isinstance(value, (bool, int)) or value not in (0, 1):
+            raise PlcConfigError(f"{ew}: value must be true or false, got {value!r}")
+        if not math.isfinite(at):
+            raise PlcConfigError(f"{ew}: at must be a finite number of seconds, got {at}")
         if name not in EVENT_INPUTS or at < 0:
             raise PlcConfigError(f"{ew}: input must be one of {EVENT_INPUTS}, at >= 0")
-        p.events.append((int(round(at * 1e6)), name, value))
+        p.events.append((int(round(at * 1e6)), name, bool(value)))
     p.events.sort()
     return p

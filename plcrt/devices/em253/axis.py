@@ -76,7 +76,10 @@ class Axis:
     def _seg_at(self, t: int) -> Seg:
         segs = self.segs
         i = self.si
-        # perf: time only moves forward, so the index only advances
+        # perf: time mostly moves forward, so the index mostly advances;
+        # a query at an earlier time (a reader after an event) steps back
+        while i > 0 and t < segs[i - 1].t1_ceil:  # type: ignore[operator]
+            i -= 1
         while i + 1 < len(segs) and segs[i].t1_ceil is not None and t >= segs[i].t1_ceil:
             i += 1
         self.si = i

@@ -16,7 +16,7 @@ Common rules (manual 3.2, notes 1-5; decisions in docs/em253.md):
   clears it.  E_Stop stops the pulses at once; a new start needs a new
   rising edge of Run.  C_Status: 0 before the first run, 1 while running,
   8 once stopped.
-* SpdSs must be below SpdSet (note 4), speeds are limited by the output
+* SpdSs must not be above SpdSet (note 4), speeds are limited by the output
   type (200 kHz single-ended, 500 kHz differential): otherwise the module's
   behaviour is kept (no start / clamped) and a diagnostic is emitted.
 """
@@ -122,8 +122,10 @@ class _Base:
         if v_ss < 0 or v_set <= 0:
             self.warn(f"speeds must be positive (SpdSs {v_ss}, SpdSet {v_set})", "spdneg")
             return None
-        if v_ss >= v_set:
-            self.warn(f"SpdSs ({v_ss} Hz) is not below SpdSet ({v_set} Hz): the motor does "
+        # Note 4 says the motor does not start when SpdSs is *above* SpdSet;
+        # equal speeds run (step 7 of the manual's POS_RUN table is at SpdSs).
+        if v_ss > v_set:
+            self.warn(f"SpdSs ({v_ss} Hz) is above SpdSet ({v_set} Hz): the motor does "
                       f"not start (manual note 4)", "ssset")
             return None
         lim = self.module.max_hz
@@ -516,7 +518,14 @@ def _last(t0, x, v, v_ss, top, length, ra, rd):
 
 @register_block("HOMING")
 class Homing(_Base):
+    """HOMING (manual 3.2.7); the modes and their sequence are in
+    :mod:`.homing`."""
+
     name = "HOMING"
+
+    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
+        super().__init__(plc, loc, itf)
+        self.seq: Any = None   #: the HomingSequence of the last start
 
     def __call__(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
                  run) -> tuple:
@@ -527,32 +536,45 @@ class Homing(_Base):
         ax = self.axis
         assert ax is not None
         t = self.now()
+        seq = self.seq
+        if seq is not None and seq.active:
+            seq.poll(t)   # an STF stop ends the sequence (status 8, diagnostic)
         if e_stop:
-            if getattr(self, "seq", None) is not None:
-                self.seq.abort()
+            # 3.2.7 E_Stop: the pulses stop at once, no deceleration
+            if seq is not None and seq.active:
+                seq.abort(t)
             self.estop()
-        elif getattr(self, "seq", None) is not None and self.seq.active:
+        elif seq is not None and seq.active:
             if not run:
-                self.seq.abort()
+                # Run = 0: decelerate to SpdLow and stop; no home is set
+                seq.abort(t)
                 x, v = ax.exact_state(t)
-                self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_low),
-                                                   self.seq.rate), keep=True)
-        elif rising and not ax.moving:
-            from .homing import HomingSequence, MODES
-            if mode not in MODES:
-                self.warn(f"HomingMode {mode} is not one of 0..14: nothing happens", "mode")
-            elif v_low <= 0 or v_high < v_low:
-                self.warn(f"homing needs 0 < SpdLow <= SpdHigh (got {v_low}, {v_high})",
-                          "speeds")
-            else:
-                top = min(v_high, self.module.max_hz) if self.module else v_high
-                if top < v_high:
-                    self.warn(f"SpdHigh {v_high} Hz is above the output limit; using {top} Hz",
-                              "maxhz")
-                self.seq = HomingSequence(self, ax, mode, v_low, top, offset)
-                self.status = ST_RUN
-                self.seq.start(t)
+                self.begin(ax.direction, stop_plan(t, x, v, seq.v_low, seq.rate), keep=True)
+        elif rising and ax.moving:
+            self.warn("the axis is already moved by another instruction: the homing does "
+                      "not start", "busy")
+        elif rising:
+            self._start(t, mode, v_low, v_high, offset)
         spd = ax.speed(t) if self.owns() else 0
-        if self.status == ST_RUN and not (getattr(self, "seq", None) and self.seq.active):
+        # C_Status stays 1 while the axis still moves for this block (also
+        # while it decelerates after Run = 0) and reads 8 once it stopped
+        if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
         return INNER_OK, self.status, spd
+
+    def _start(self, t: int, mode: int, v_low: int, v_high: int, offset: int) -> None:
+        from .homing import MODES, HomingSequence
+        assert self.axis is not None
+        if mode not in MODES:
+            self.warn(f"HomingMode {mode} is not one of 0..14: nothing happens", "mode")
+            return
+        if v_low <= 0 or v_high < v_low:
+            self.warn(f"homing needs 0 < SpdLow <= SpdHigh (got {v_low}, {v_high})", "speeds")
+            return
+        top = min(v_high, self.module.max_hz) if self.module else v_high
+        if top < v_high:
+            self.warn(f"SpdHigh {v_high} Hz is above the output limit; using {top} Hz",
+                      "maxhz")
+        self.seq = HomingSequence(self, self.axis, mode, min(v_low, top), top, offset)
+        self.status = ST_RUN
+        self.seq.start(t)

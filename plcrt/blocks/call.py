@@ -59,7 +59,9 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
                 role = Role.D_PTR if p.pointer else _READ[p.type]
                 op = check_role(op, role, op_ir.text, g.unit.model)
         except ResolveError as e:
-            g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}")
+            where = op_ir.loc if op_ir.loc.block is not None else op_ir.loc.within(
+                g.loc.block, g.loc.network)
+            g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}", where)
         if p.dir == "IN":
             reads.append(g.rbit(op) if p.type == "BOOL" else g.rd(op, _KIND[p.type]))
         if p.dir == "OUT" or p.written:

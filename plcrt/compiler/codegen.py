@@ -367,7 +367,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         except (CodegenError, ResolveError) as e:
             gen.lines, gen.depth, gen.indent, gen.pending = saved
             if not (broken and "logic stack" in str(e)):
-                unit.diag.error(f"{insn.mnemonic}: {e}", loc)
+                unit.diag.error(f"{insn.mnemonic}: {e}", getattr(e, "loc", None) or loc)
             broken = True
             _assume_stack_effect(gen, insn.mnemonic)
         if not spec.may_fail and spec.family != "stack":

@@ -33,7 +33,12 @@ VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
 
 
 class CodegenError(Exception):
-    """An instruction cannot be generated; becomes a diagnostic at its location."""
+    """An instruction cannot be generated; becomes a diagnostic at its
+    location, or at ``loc`` (an operand's) when given."""
+
+    def __init__(self, message: str, loc: SourceLoc | None = None) -> None:
+        super().__init__(message)
+        self.loc = loc
 
 
 class Gen:
@@ -111,8 +116,8 @@ class Gen:
     def warn(self, message: str, code: str = "") -> None:
         self.unit.diag.warning(message, self.loc, code)
 
-    def fail(self, message: str) -> None:
-        raise CodegenError(message)
+    def fail(self, message: str, loc: SourceLoc | None = None) -> None:
+        raise CodegenError(message, loc)
 
     # -- logic stack ----------------------------------------------------
     @property

@@ -32,15 +32,18 @@ class CpuModel:
     sm_readonly: int = 30  #: SMB0..SMB29 are read-only to the program
     onboard_di_bytes: int = 3  #: bytes of I used by the CPU's own inputs
     onboard_do_bytes: int = 2  #: bytes of Q used by the CPU's own outputs
+    max_modules: int = 7       #: expansion modules the CPU takes
 
 
 CPU_MODELS: dict[str, CpuModel] = {
     m.name: m
     for m in (
         # onboard I/O: 221 6 DI/4 DO, 222 8/6, 224 and 224XP 14/10, 226 24/16
+        # expansion: CPU 221 none, CPU 222 two modules, the others seven
         CpuModel("CPU221", v_bytes=2048, sm_bytes=180, ai_bytes=0, aq_bytes=0,
-                 onboard_di_bytes=1, onboard_do_bytes=1),
-        CpuModel("CPU222", v_bytes=2048, sm_bytes=300, onboard_di_bytes=1, onboard_do_bytes=1),
+                 onboard_di_bytes=1, onboard_do_bytes=1, max_modules=0),
+        CpuModel("CPU222", v_bytes=2048, sm_bytes=300, onboard_di_bytes=1, onboard_do_bytes=1,
+                 max_modules=2),
         CpuModel("CPU224", v_bytes=8192, sm_bytes=550, onboard_di_bytes=2, onboard_do_bytes=2),
         CpuModel("CPU224XP", v_bytes=10240, sm_bytes=550, onboard_di_bytes=2,
                  onboard_do_bytes=2),

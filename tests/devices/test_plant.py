@@ -243,8 +243,6 @@ def test_stf_makes_motion_en3_report_status_4() -> None:
     assert plc["VW0"] == 4
 
 
-@pytest.mark.xfail(strict=True, reason="MOTION_EN3 returns its cached Status 4 once STF "
-                   "is released (blocks.py: the shortcut skips the recomputation)")
 def test_status_returns_to_1_when_stf_is_released() -> None:
     plant = _plant(events=[{"at": 0.005, "input": "STF", "value": True},
                            {"at": 0.010, "input": "STF", "value": False}])

@@ -424,7 +424,7 @@ def test_pos_run_step_6_speed_limit(scan_ms: int, differential: bool) -> None:
     speed = plc.axis(0, 1)["speed"]
     assert speed == pytest.approx(v5 + rate6 * (t - t5), abs=2)
     assert v6 == pytest.approx({False: 62_948.4, True: 78_819.4}[differential], abs=0.1)
-    run_to(plc, 64.0)
+    run_to(plc, 70.0)
     assert plc.axis(0, 1)["position"] == 1_530_000
     limited = [d for d in plc.diagnostics if "output limit" in d.message]
     if differential:

@@ -61,6 +61,8 @@ class _Base:
         self._axis_no: Optional[int] = None
         self.stopping = False
         self.last_pos = 0
+        self.last_spd = 0
+        self.top = 0  #: SpdSet in force (after clamping to the output limit)
 
     # -- helpers -----------------------------------------------------------
     def warn(self, msg: str, code: str) -> None:
@@ -106,9 +108,12 @@ class _Base:
             self.initialised = True
             return True
         if value != INNER_OK:
+            moving = self.axis is not None and self.axis.moving and self.owns()
             self.warn(f"InnerState was changed by the program (reads {value}, the block "
-                      f"keeps it at 257); the axis is stopped", "innerw")
-            if self.axis is not None and self.axis.moving and self.owns():
+                      f"keeps it at 257)" + ("; the axis is stopped at once" if moving else ""),
+                      f"innerw{self.plc.scans}" if moving else "innerw")
+            if moving:
+                assert self.axis is not None
                 self.axis.stop_now(self.now())
                 self.status = ST_STOPPED
         return True
@@ -116,16 +121,19 @@ class _Base:
     def owns(self) -> bool:
         return self.axis is not None and getattr(self.axis, "owner", None) is self
 
-    def speeds_ok(self, v_ss: int, v_set: int) -> Optional[int]:
-        """Validate speeds; returns the (possibly clamped) SpdSet or None."""
+    def speeds_ok(self, v_ss: int, v_set: int, allow_equal: bool = False) -> Optional[int]:
+        """Validate speeds; returns the (possibly clamped) SpdSet or None.
+
+        Note 4: the start speed must be below the run speed, else the motor
+        does not start.  An envelope step may run at SpdSs itself
+        (``allow_equal``): the manual's own POS_RUN table ends with one.
+        """
         assert self.module is not None
         if v_ss < 0 or v_set <= 0:
             self.warn(f"speeds must be positive (SpdSs {v_ss}, SpdSet {v_set})", "spdneg")
             return None
-        # Note 4 says the motor does not start when SpdSs is *above* SpdSet;
-        # equal speeds run (step 7 of the manual's POS_RUN table is at SpdSs).
-        if v_ss > v_set:
-            self.warn(f"SpdSs ({v_ss} Hz) is above SpdSet ({v_set} Hz): the motor does "
+        if v_ss > v_set or (v_ss == v_set and not allow_equal):
+            self.warn(f"SpdSs ({v_ss} Hz) is not below SpdSet ({v_set} Hz): the motor does "
                       f"not start (manual note 4)", "ssset")
             return None
         lim = self.module.max_hz
@@ -192,6 +200,24 @@ class _Base:
         ax = self.axis
         return ax is not None and ax.owner is self and bool(ax.segs)
 
+    def can_start(self, direction: int) -> bool:
+        """Checks before a Run edge starts a motion; each refusal is reported."""
+        ax = self.axis
+        assert ax is not None
+        if ax.segs:
+            self.warn("the axis is already moved by another instruction: this Run edge "
+                      "is ignored", "busy")
+            return False
+        if ax.stf:
+            self.warn("the STF emergency-stop input of the axis is active: the axis does "
+                      "not start", "stfstart")
+            return False
+        if self.limit_active(direction):
+            self.warn("the hard limit in the moving direction is active: the axis does "
+                      "not start", "limstart")
+            return False
+        return True
+
 
 @register_block("MOTION_EN3")
 class MotionEn3(_Base):
@@ -212,7 +238,8 @@ class MotionEn3(_Base):
         key = (em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
         # perf: nothing to do when the inputs are as last scan and no CLR
         # pulse or emergency stop is pending
-        if key == self._last_key and not mod.clr_pending and not mod.stf_any:
+        if key == self._last_key and not mod.clr_pending and not mod.stf_any \
+                and self._last_out[2] == 1:
             return self._last_out
         t = self.now()
         mod.differential = bool(p_dor_ccw)
@@ -241,12 +268,14 @@ class MotionEn3(_Base):
 @register_block("GET_AbsPos")
 class GetAbsPos(_Base):
     name = "GET_AbsPos"
+    last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
         if not self.find(em_no, axis_no):
-            return 0, 0
+            return self.last_out
         assert self.axis is not None
-        return self.axis.position(self.now()), 1
+        self.last_out = (self.axis.position(self.now()), 1)
+        return self.last_out
 
 
 @register_block("SET_AbsPos")
@@ -273,7 +302,7 @@ class SpdCtrl(_Base):
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
-            return inner, update, self.status, 0
+            return inner, update, self.status, self.last_spd
         ax = self.axis
         assert ax is not None
         t = self.now()
@@ -282,25 +311,20 @@ class SpdCtrl(_Base):
             self.estop()
         elif self.running():
             if not run:
-                self.ramp_down(t, v_ss, _rate(v_set, v_ss, dec))
+                self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec))
             elif update:
                 self._update(t, acc, dec, v_ss, v_set, d)
-        elif rising:
+        elif rising and self.can_start(d):
             top = self.speeds_ok(v_ss, v_set)
-            if top is not None and not ax.moving:
-                if self.limit_active(d):
-                    self.warn("the hard limit in the running direction is active: the "
-                              "axis does not start", "limstart")
-                else:
-                    self.params = (acc, dec, v_ss, top, d)
-                    self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
-                                                Fraction(top), _rate(top, v_ss, acc),
-                                                _rate(top, v_ss, dec)))
-            elif ax.moving:
-                self.warn("the axis is already moved by another instruction", "busy")
+            if top is not None:
+                self.top = top
+                self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                            Fraction(top), _rate(top, v_ss, acc),
+                                            _rate(top, v_ss, dec)))
         spd = ax.speed(t) if self.owns() else 0
         if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
+        self.last_spd = spd
         return INNER_OK, 0, self.status, spd
 
     def _update(self, t, acc, dec, v_ss, v_set, d) -> None:
@@ -317,6 +341,7 @@ class SpdCtrl(_Base):
             self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss),
                                                _rate(top, v_ss, dec)), keep=True)
             return
+        self.top = top
         self.begin(ax.direction, velocity_plan(t, x, v, Fraction(v_ss), Fraction(top),
                                                _rate(top, v_ss, acc), _rate(top, v_ss, dec)),
                    keep=True)
@@ -331,7 +356,7 @@ class PosGotoR(_Base):
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
-            return inner, update, self.status, 0, 0
+            return inner, update, self.status, self.last_pos, self.last_spd
         ax = self.axis
         assert ax is not None
         t = self.now()
@@ -339,28 +364,27 @@ class PosGotoR(_Base):
             self.estop()
         elif self.running():
             if not run:
-                self.ramp_down(t, v_ss, _rate(v_set, v_ss, dec))
+                self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec))
             elif update:
                 self._update(t, acc, dec, v_ss, v_set, pos)
         elif rising:
-            top = self.speeds_ok(v_ss, v_set)
             d = 1 if pos > 0 else -1
             if pos == 0:
                 self.status = ST_STOPPED
-            elif top is not None and not ax.moving:
-                if self.limit_active(d):
-                    self.warn("the hard limit in the moving direction is active: the axis "
-                              "does not start", "limstart")
-                else:
+            elif self.can_start(d):
+                top = self.speeds_ok(v_ss, v_set)
+                if top is not None:
+                    self.top = top
                     segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
                                             Fraction(top), Fraction(abs(pos)),
                                             _rate(top, v_ss, acc), _rate(top, v_ss, dec))
                     self.begin(d, segs)
-                    self.origin = ax.counter
         if ax.owner is not self:
             return INNER_OK, 0, self.status, 0, 0
         if ax.segs:
-            return INNER_OK, 0, self.status, ax.travel(t), ax.speed(t)
+            self.last_spd = ax.speed(t)
+            return INNER_OK, 0, self.status, ax.travel(t), self.last_spd
+        self.last_spd = 0
         if self.status == ST_RUN:
             self.status = ST_STOPPED
         return INNER_OK, 0, self.status, self.last_pos, 0
@@ -383,6 +407,7 @@ class PosGotoR(_Base):
                       "allowed during a move; the new PosSet is ignored", "dirchg")
             return
         remaining = Fraction(abs(pos)) - x
+        self.top = top
         ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
         segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)
         if remaining <= 0 or not ok:
@@ -401,7 +426,8 @@ class PosRun(_Base):
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
-            return inner, update, self.status, 0, 0, 0
+            step, c_pos = getattr(self, "last", (0, 0))
+            return inner, update, self.status, c_pos, self.last_spd, step
         ax = self.axis
         assert ax is not None
         t = self.now()
@@ -410,7 +436,7 @@ class PosRun(_Base):
         elif self.running():
             if not run:
                 self.ramp_down(t, v_ss, self.stop_rate)
-        elif rising and not ax.moving:
+        elif rising and self.can_start(-1 if self._first_sign(ptr, steps) < 0 else 1):
             if mode != 0:
                 self.warn(f"Mode {mode} is not defined (manual: 0); running as mode 0", "mode")
             table = self._table(ptr, steps)
@@ -420,7 +446,22 @@ class PosRun(_Base):
         if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
         spd = ax.speed(t) if self.owns() else 0
+        self.last_spd = spd
         return INNER_OK, 0, self.status, c_pos, spd, step
+
+    def _first_sign(self, ptr: int, steps: int) -> int:
+        """Direction of the envelope in the table (without diagnostics)."""
+        area = POINTER_AREA_NAMES.get(ptr >> 24)
+        buf = self.plc.mem.areas.get({"T": "TV", "C": "CV"}.get(area, area)) if area else None
+        off = ptr & 0xFFFFFF
+        for i in range(min(max(steps, 0), MAX_STEPS)):
+            b = off + i * STEP_BYTES + 8
+            if buf is None or b + 4 > len(buf):
+                break
+            v = int.from_bytes(buf[b:b + 4], "big", signed=True)
+            if v:
+                return v
+        return 1
 
     def _table(self, ptr: int, steps: int) -> Optional[list[tuple[int, int, int, int]]]:
         if not 1 <= steps <= MAX_STEPS:
@@ -461,11 +502,18 @@ class PosRun(_Base):
         bounds = []
         n = len(rows)
         for i, (acc, dec, spd, pos) in enumerate(rows):
-            top = self.speeds_ok(v_ss, spd)
+            top = self.speeds_ok(v_ss, spd, allow_equal=True)
             if top is None:
                 return
             length = Fraction(abs(pos))
-            ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
+            if top > v_ss:
+                ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
+            else:
+                # a step at SpdSs: note 3's (SpdSet - SpdSs) / time is 0, so the
+                # step's times apply to the change from the speed it enters with
+                change = max(abs(int(v) - top), 1)
+                ra = Fraction(change, max(acc, 1) * 1000)
+                rd = Fraction(change, max(dec, 1) * 1000)
             if i == n - 1:
                 part, ok = _last(tt, x, v, v_ss, top, length, ra, rd)
                 if not ok:

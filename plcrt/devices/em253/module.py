@@ -36,6 +36,10 @@ class EM253Module:
         self.configured = set(cfg.axes)
         self.axes = [Axis(cfg.axes.get(i, AxisPlant())) for i in (0, 1)]
         model = plc.model
+        if self.slot >= model.max_modules:
+            raise PlcConfigError(
+                f"the {model.name} takes {model.max_modules} expansion module(s); "
+                f"an EM253 in slot {self.slot} is not possible")
         self.di = model.onboard_di_bytes + 2 * self.slot
         self.do = model.onboard_do_bytes + 2 * self.slot
         if self.di + 2 > model.i_bytes or self.do + 2 > model.q_bytes:
@@ -47,7 +51,7 @@ class EM253Module:
         self.clr_until: list[Optional[int]] = [None, None]
         self.clr_pending = False
         self.stf_any = False
-        self._idle_written = [False, False]
+        self._cache: list[tuple[int, int] | None] = [None, None]
         self._events = [list(a.plant.events) for a in self.axes]
         self._write_terminals(0)
 
@@ -65,7 +69,7 @@ class EM253Module:
                 if name == "STF":
                     self.set_stf(i, te, value)
             ax.advance(t_to)
-        self._write_terminals(t_to)
+        self._write_terminals(t_to, t_from)
 
     def set_stf(self, i: int, t: int, value: bool) -> None:
         """Hardware emergency stop: pulses stop at once, no ramp (manual 2.1)."""
@@ -79,38 +83,47 @@ class EM253Module:
                           f"{t / 1e6:.6f} s, pulses stopped without deceleration",
                           None, f"stf-{self.slot}-{i}-{t}")
 
-    def _write_terminals(self, t: int) -> None:
+    def _write_terminals(self, t: int, t_from: int | None = None) -> None:
+        """Input terminals into PI, output terminals into Q, for time ``t``.
+
+        The bytes are written every scan (the module owns them), but only
+        recomputed for a moving axis or after a change (perf).
+        """
         pi = self.plc.mem.areas["PI"]
         q = self.plc.mem.areas["Q"]
+        t_from = t if t_from is None else t_from
         for i, ax in enumerate(self.axes):
-            # perf: a stopped axis whose terminals were written since it
-            # stopped has nothing new to show (no CLR pulse running)
-            if not ax.moving and self._idle_written[i] and self.clr_until[i] is None \
-                    and not ax.dirty:
-                continue
-            self._idle_written[i] = not ax.moving
-            ax.dirty = False
-            p = ax.plant
-            m = ax.mechanical(t)
-            b = 1 if ax.stf else 0
-            if p.rps is not None and p.rps[0] <= m <= p.rps[1]:
-                b |= 2
-            if p.limit_pos is not None and m >= p.limit_pos:
-                b |= 4
-            if p.limit_neg is not None and m <= p.limit_neg:
-                b |= 8
-            if p.z_period and (m - p.z_offset) % p.z_period == 0:
-                b |= 16
-            pi[self.di + i] = b
-            o = 1 if ax.masked else 0
             until = self.clr_until[i]
-            if until is not None and t < until:
-                o |= 2
-            if ax.moving and not ax.masked:
-                o |= 4
-            if ax.direction > 0 and not ax.masked:
-                o |= 8
+            clr = until is not None and t_from < until
+            cached = self._cache[i]
+            if ax.segs or ax.dirty or cached is None or bool(cached[1] & 2) != clr:
+                ax.dirty = False
+                cached = self._cache[i] = self._bytes(ax, t, clr)
+            b, o = cached
+            pi[self.di + i] = b
             q[self.do + i] = o
+
+    @staticmethod
+    def _bytes(ax: Axis, t: int, clr: bool) -> tuple[int, int]:
+        p = ax.plant
+        m = ax.mechanical(t)
+        b = 1 if ax.stf else 0
+        if p.rps is not None and p.rps[0] <= m <= p.rps[1]:
+            b |= 2
+        if p.limit_pos is not None and m >= p.limit_pos:
+            b |= 4
+        if p.limit_neg is not None and m <= p.limit_neg:
+            b |= 8
+        if p.z_period and (m - p.z_offset) % p.z_period == 0:
+            b |= 16
+        o = 1 if ax.masked else 0
+        if clr:
+            o |= 2
+        if ax.segs and not ax.masked:
+            o |= 4
+        if ax.direction > 0 and not ax.masked:
+            o |= 8
+        return b, o
 
     def snapshot(self, t: int) -> list[dict[str, Any]]:
         out = []

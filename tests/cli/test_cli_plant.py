@@ -77,7 +77,7 @@ def test_run_json_without_plant_has_no_axes(capsys: pytest.CaptureFixture[str]) 
 def test_run_json_with_data_block(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run_cli(capsys, "run", str(EM253 / "pos_run.awl"),
                              "--data", str(EM253 / "pos_run.db"), "--plant", PLANT,
-                             "--seconds", "64", "--set", "M3.0=1",
+                             "--seconds", "70", "--set", "M3.0=1",
                              "--watch", "VB316", "--watch", "VW306", "--json")
     assert code == 0
     obj = json.loads(out)

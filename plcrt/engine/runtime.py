@@ -108,6 +108,8 @@ class Plc:
                                  f"with the program") from None
         exec(code, ns)  # noqa: S102 - source built only from validated numbers
         self._ns = ns
+        a = self.mem.areas
+        self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
         if data is not None:
             data.apply(self.mem.areas["V"])
@@ -151,41 +153,44 @@ class Plc:
         self.scan(scans)
 
     def _scan_once(self) -> None:
-        m = self.mem.areas
+        # perf: buffers are bound once in __init__ (self._bufs)
+        i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
-        m["I"][:] = m["PI"]
-        sm = m["SM"]
-        first = self.scans == 0
-        b0 = 1 | (0x0A if first else 0) | 0x80
+        i_img[:] = pi
+        scans = self.scans
+        b0 = 0x81 if scans else 0x8B  # SM0.0 and SM0.7; SM0.1/SM0.3 on the first scan
         if now % 60_000_000 >= 30_000_000:
             b0 |= 0x10
         if now % 1_000_000 >= 500_000:
             b0 |= 0x20
-        if self.scans % 2 == 0:
+        if not scans & 1:
             b0 |= 0x40
         sm[0] = b0
         self.timers.start_scan(self._prev_start, now)
         self._prev_start = now
-        self.wd[0] = 0
-        self.wd[2] = 0
+        wd = self.wd
+        wd[0] = 0
+        wd[2] = 0
         try:
             if self._ob1 is not None:
-                self._ob1(m["L"])
-            for dev in self.devices:
-                dev.step(self, now, now + self.scan_us)
+                self._ob1(l_ob1)
+            if self.devices:
+                t_to = now + self.scan_us
+                for dev in self.devices:
+                    dev.step(self, now, t_to)
         except PlcError as e:
             self._fail(e)
         except Exception as e:  # an internal fault: map it to the program location
             self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
                                        self._loc_from_tb(e)), e)
-        m["PQ"][:] = m["Q"]
-        self.scans += 1
-        self._t_us += self.scan_us
+        pq[:] = q
+        self.scans = scans + 1
+        self._t_us = now + self.scan_us
         if self.stop_requested:
             # STOP instruction: the scan completes, then the CPU switches to
             # STOP and the outputs take their STOP state (off).
             self.mode = "STOP"
-            m["PQ"][:] = bytes(len(m["PQ"]))
+            pq[:] = bytes(len(pq))
 
     def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
         self.mode = "STOP"

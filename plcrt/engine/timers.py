@@ -77,7 +77,7 @@ class TimerBank:
     # -- engine side ----------------------------------------------------
     def start_scan(self, prev_us: int | None, now_us: int) -> None:
         """Compute tick deltas and advance running 1 ms / 10 ms timers."""
-        if prev_us is None:
+        if prev_us is None or now_us == prev_us:
             self.d1 = self.d10 = self.d100 = 0
         else:
             self.d1 = now_us // 1000 - prev_us // 1000

@@ -157,7 +157,9 @@ class Axis:
         (used when the plan changes mid-move); otherwise the emitted pulses
         are folded into the counter and the new move starts at travel 0.
         """
-        if not keep_travel:
+        if not keep_travel or not segs:
+            # an empty plan has no travel of its own: fold the pulses of the
+            # current move in now, or they would be lost from the counter
             self._rebase(t)
         self.direction = direction
         self.segs = segs

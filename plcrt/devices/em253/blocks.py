@@ -271,6 +271,12 @@ class GetAbsPos(_Base):
     last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
+        mod = self.module
+        if mod is not None and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
+                and self._axis_no == axis_no:  # perf: the usual case
+            assert self.axis is not None
+            self.last_out = (self.axis.position(self.plc._t_us), 1)
+            return self.last_out
         if not self.find(em_no, axis_no):
             return self.last_out
         assert self.axis is not None
@@ -299,6 +305,14 @@ class SpdCtrl(_Base):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
+        # perf: steady running (Run held, nothing to update) only reports speed
+        mod, ax = self.module, self.axis
+        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
+                and mod is not None and ax is not None and ax.owner is self and ax.segs \
+                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
+                and self._axis_no == axis_no and self.initialised:
+            self.last_spd = spd = ax.speed(self.plc._t_us)
+            return INNER_OK, 0, self.status, spd
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -353,6 +367,15 @@ class PosGotoR(_Base):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
                  run) -> tuple:
+        # perf: a move in progress with Run held only reports C_Pos and C_Spd
+        mod, ax = self.module, self.axis
+        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
+                and mod is not None and ax is not None and ax.owner is self and ax.segs \
+                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
+                and self._axis_no == axis_no and self.initialised:
+            t = self.plc._t_us
+            self.last_spd = spd = ax.speed(t)
+            return INNER_OK, 0, self.status, ax.travel(t), spd
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):

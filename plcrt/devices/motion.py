@@ -14,9 +14,12 @@ resolution, never by stepping through pulses, so simulating a second costs
 the same at 5 kHz and at 500 kHz.
 
 Speeds are in Hz (pulses per second), rates in Hz per µs, times in µs.
-Where a ramp would end at an irrational speed (a triangular profile), the
-peak is rounded down to a whole Hz and a short cruise makes up the exact
-distance, so speed limits and ramp rates are never exceeded.
+Where a ramp would end at an irrational speed (the peak of a triangular
+profile, the speed a too-short distance can reach), the speed is rounded
+to a whole Hz (finer below 1 Hz) in the direction that keeps the ramp
+within its rate -- a peak down, with a short cruise making up the exact
+distance; the end speed of a too-short deceleration up -- so distances are
+exact and speed limits and ramp rates are never exceeded.
 
 This module knows nothing about PLCs, modules or instructions.
 """
@@ -91,6 +94,12 @@ class Seg:
         assert self.t1 is not None
         return self.travel(self.t1)
 
+    @property
+    def end(self) -> tuple[Fraction, Fraction]:
+        """(t1, x1): where a segment that ends hands over to the next."""
+        assert self.t1 is not None
+        return self.t1, self.travel(self.t1)
+
 
 def ramp(t0: Fraction, x0: Fraction, v0: Fraction, v1: Fraction, rate: Fraction) -> Seg:
     """A linear speed change from v0 to v1 at ``rate`` Hz/µs (> 0)."""
@@ -157,7 +166,7 @@ def plan_distance(t0: Fraction, x0: Fraction, v_in: Fraction, v_max: Fraction,
         peak = v_max
         if v_in > peak:
             segs.append(ramp(t, x, v_in, peak, r_dec))
-            t, x = segs[-1].t1, segs[-1].x1
+            t, x = segs[-1].end
     else:
         d_acc = ramp_distance(v_in, v_max, r_acc)
         d_dec = ramp_distance(v_max, v_end, r_dec)
@@ -168,11 +177,11 @@ def plan_distance(t0: Fraction, x0: Fraction, v_in: Fraction, v_max: Fraction,
             peak = max(_sqrt_floor(num / (r_acc + r_dec)), v_in, v_end)
         if peak > v_in:
             segs.append(ramp(t, x, v_in, peak, r_acc))
-            t, x = segs[-1].t1, segs[-1].x1
+            t, x = segs[-1].end
     rest = x_end - x - ramp_distance(peak, v_end, r_dec)
     if rest > 0:
         segs.append(cruise(t, x, peak, rest))
-        t, x = segs[-1].t1, segs[-1].x1
+        t, x = segs[-1].end
     if peak > v_end and x < x_end:
         segs.append(_final_ramp(t, x, peak, v_end, x_end))
     return segs, True
@@ -208,7 +217,7 @@ def plan_hold(t0: Fraction, x0: Fraction, v_in: Fraction, v_target: Fraction,
         if v < v_in:
             segs.append(ramp(t, x, v_in, v, r_down))
     if segs:
-        t, x = segs[-1].t1, segs[-1].x1
+        t, x = segs[-1].end
     rest = x0 + length - x
     if rest > 0:
         segs.append(cruise(t, x, v, rest))

@@ -78,9 +78,12 @@ class Axis:
         i = self.si
         # perf: time mostly moves forward, so the index mostly advances;
         # a query at an earlier time (a reader after an event) steps back
-        while i > 0 and t < segs[i - 1].t1_ceil:  # type: ignore[operator]
+        while i > 0 and t < (segs[i - 1].t1_ceil or 0):  # earlier segments all end
             i -= 1
-        while i + 1 < len(segs) and segs[i].t1_ceil is not None and t >= segs[i].t1_ceil:
+        while i + 1 < len(segs):
+            end = segs[i].t1_ceil
+            if end is None or t < end:
+                break
             i += 1
         self.si = i
         return segs[i]
@@ -269,7 +272,7 @@ def velocity_plan(t: int, x: Fraction, v_now: Fraction, v_ss: Fraction, v_set: F
     elif v > v_set:
         segs.append(ramp(t0, x, v, v_set, r_dec))
     if segs:
-        t0, x = segs[-1].t1, segs[-1].x1
+        t0, x = segs[-1].end
     segs.append(cruise(t0, x, v_set))
     return segs
 

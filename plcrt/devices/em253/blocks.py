@@ -459,6 +459,8 @@ class PosRun(_Base):
         elif self.running():
             if not run:
                 self.ramp_down(t, v_ss, self.stop_rate)
+            elif update and not self.stopping:
+                self._update(t, v_ss, ptr, steps)
         elif rising and self.can_start(-1 if self._first_sign(ptr, steps) < 0 else 1):
             if mode != 0:
                 self.warn(f"Mode {mode} is not defined (manual: 0); running as mode 0", "mode")
@@ -515,20 +517,22 @@ class PosRun(_Base):
             return None
         return rows
 
-    def _start(self, t: int, v_ss: int, rows: list) -> None:
-        assert self.axis is not None and self.module is not None
-        d = -1 if any(r[3] < 0 for r in rows) else 1
-        segs = []
-        x = Fraction(0)
-        v = Fraction(v_ss)
-        tt = Fraction(t)
-        bounds = []
+    def _plan(self, t: int, x0: Fraction, v0: Fraction, v_ss: int, rows: list,
+              first: int, start: Fraction) -> Optional[tuple[list, list]]:
+        """Segments and step end positions for steps ``first``.. of ``rows``,
+        starting at time ``t`` with travel ``x0`` and speed ``v0``; ``start``
+        is where step ``first`` began (its PosSet counts from there)."""
+        segs: list = []
+        x, v, tt = x0, v0, Fraction(t)
+        bounds: list = []
         n = len(rows)
-        for i, (acc, dec, spd, pos) in enumerate(rows):
+        for i in range(first, n):
+            acc, dec, spd, pos = rows[i]
             top = self.speeds_ok(v_ss, spd, allow_equal=True)
             if top is None:
-                return
-            length = Fraction(abs(pos))
+                return None
+            end = (start if i == first else x) + abs(pos)
+            length = max(end - x, Fraction(0))
             if top > v_ss:
                 ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
             else:
@@ -540,8 +544,8 @@ class PosRun(_Base):
             if i == n - 1:
                 part, ok = _last(tt, x, v, v_ss, top, length, ra, rd)
                 if not ok:
-                    self.warn(f"the last step is too short to decelerate to SpdSs; the "
-                              f"pulses stop at a higher speed", "short")
+                    self.warn("the last step is too short to decelerate to SpdSs; the "
+                              "pulses stop at a higher speed", "short")
                 self.stop_rate = rd
             else:
                 part = plan_hold(tt, x, v, Fraction(top), length, ra, rd)
@@ -549,12 +553,43 @@ class PosRun(_Base):
                 segs.extend(part)
                 tt, x, v = part[-1].t1, part[-1].x1, part[-1].v1
             bounds.append(x)
-        if self.limit_active(d):
-            self.warn("the hard limit in the moving direction is active: the envelope does "
-                      "not start", "limstart")
+        return segs, bounds
+
+    def _start(self, t: int, v_ss: int, rows: list) -> None:
+        assert self.axis is not None and self.module is not None
+        d = -1 if any(r[3] < 0 for r in rows) else 1
+        plan = self._plan(t, Fraction(0), Fraction(v_ss), v_ss, rows, 0, Fraction(0))
+        if plan is None:
             return
+        segs, bounds = plan
         self.bounds = bounds
+        self.direction = d
         self.begin(d, segs)
+
+    def _update(self, t: int, v_ss: int, ptr: int, steps: int) -> None:
+        """Update while the envelope runs: re-read the table and continue
+        from the current step with its new values (manual 3.2.6: positions
+        may change in the same direction, not the direction)."""
+        ax = self.axis
+        assert ax is not None
+        rows = self._table(ptr, steps)
+        if rows is None:
+            return
+        d = -1 if any(r[3] < 0 for r in rows) else 1
+        if any(r[3] for r in rows) and d != self.direction:
+            self.warn("Update changes the direction of the running envelope, which the "
+                      "module does not allow (manual 3.2.6): the change is ignored", "upddir")
+            return
+        x, v = ax.exact_state(t)
+        k = next((i for i, b in enumerate(self.bounds) if x < b), len(self.bounds) - 1)
+        k = min(k, len(rows) - 1)
+        start = Fraction(self.bounds[k - 1]) if k > 0 else Fraction(0)
+        plan = self._plan(t, x, v, v_ss, rows, k, start)
+        if plan is None:
+            return
+        segs, bounds = plan
+        self.bounds = self.bounds[:k] + bounds
+        self.begin(ax.direction, segs, keep=True)
 
     def _progress(self, t: int) -> tuple[int, int]:
         if not self.owns() or not hasattr(self, "bounds"):

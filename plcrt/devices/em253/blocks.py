@@ -275,7 +275,7 @@ class GetAbsPos(_Base):
         if mod is not None and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
                 and self._axis_no == axis_no:  # perf: the usual case
             assert self.axis is not None
-            self.last_out = (self.axis.position(self.plc._t_us), 1)
+            self.last_out = (self.axis.position(self.plc.now_us), 1)
             return self.last_out
         if not self.find(em_no, axis_no):
             return self.last_out
@@ -311,7 +311,7 @@ class SpdCtrl(_Base):
                 and mod is not None and ax is not None and ax.owner is self and ax.segs \
                 and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            self.last_spd = spd = ax.speed(self.plc._t_us)
+            self.last_spd = spd = ax.speed(self.plc.now_us)
             return INNER_OK, 0, self.status, spd
         rising = run and not self.prev_run
         self.prev_run = run
@@ -373,7 +373,7 @@ class PosGotoR(_Base):
                 and mod is not None and ax is not None and ax.owner is self and ax.segs \
                 and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            t = self.plc._t_us
+            t = self.plc.now_us
             self.last_spd = spd = ax.speed(t)
             return INNER_OK, 0, self.status, ax.travel(t), spd
         rising = run and not self.prev_run

@@ -140,7 +140,8 @@ class Axis:
         self.last_travel = n  #: pulses of the move just folded in (for C_Pos)
 
     def stop_now(self, t: int) -> None:
-        """Stop the pulse train at once (E_Stop, STF, a hard limit)."""
+        """Stop the pulse train at ``t`` (E_Stop, STF, a hard limit, or the
+        end of the move) and tell the move's owner."""
         self._rebase(t)
         self.segs = []
         self.si = 0
@@ -248,15 +249,8 @@ class Axis:
                     self._arm(t)
                 continue
             if te_done is not None and te_done <= t_to:
-                self._rebase(te_done)
-                self.segs = []
-                self.si = 0
-                self.t_end = None
-                self.watch = []
-                self._next = None
-                done, self.on_done = self.on_done, None
-                if done is not None:
-                    done(te_done)
+                # the move ends on its last pulse: the same as stopping there
+                self.stop_now(te_done)
                 continue
             break
 

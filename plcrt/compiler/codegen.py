@@ -58,6 +58,7 @@ class PouInfo:
     calls: dict[str, SourceLoc] = field(default_factory=dict)  #: callee -> first CALL
     flow: bool = False
     cost: list[int] = field(default_factory=list)
+    depth_after: dict[int, int] = field(default_factory=dict)  #: piece -> stack depth at its end
 
 
 class Unit:
@@ -272,13 +273,11 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
                 # A loop body is entered only when FOR's enable was 1: the
                 # stack continues with ones (only relevant when the body
                 # shares the FOR's network).
-                for_piece = info.pieces[loop_body]
-                d = unit.hooks.get(("depth_after", p.ident, for_piece.index), 0)
-                for _ in range(d):
+                for _ in range(info.depth_after.get(loop_body, 0)):
                     gen.push("1")
             emit_piece(unit, gen, piece, resolver)
             gen.pending = None  # a value left on the stack at the end is dead
-            unit.hooks[("depth_after", p.ident, piece.index)] = gen.depth
+            info.depth_after[piece.index] = gen.depth
             args = ["L"] + [f"{n}={n}" for n in sorted(gen.used - {"L"})]
             header = f"def {fname}({', '.join(args)}):"
             base = len(out)

@@ -18,10 +18,9 @@ wall-clock pace (for demos); it never changes results.
 
 from __future__ import annotations
 
-import sys
 import time as _time
 from pathlib import Path
-from typing import Any, Iterable, Sequence
+from typing import Any, Sequence
 
 from ..compiler import compile_program
 from ..compiler.operands import Addr, OperandError, parse_operand
@@ -401,4 +400,3 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
 
 
 __all__ = ["Plc", "load", "parse_sources"]
-_ = (sys, Iterable)

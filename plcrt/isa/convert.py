@@ -44,16 +44,23 @@ WIDEN: dict[str, tuple[Role, Role, str, str, str]] = {
 }
 
 
-def _overflow(g: Gen, ok: str, write: Callable[[], None]) -> None:
-    """``if ok``: write, clear SM1.1, ENO 1; else set SM1.1, ENO 0."""
+def _flagged(g: Gen, ok: str, write: Callable[[], None], bit: int) -> None:
+    """``if ok``: write, clear SM1.<bit>, ENO 1; else set SM1.<bit>, ENO 0
+    (output unchanged)."""
     sm = g.use("SM")
+    mask = 1 << bit
     with g.block(f"if {ok}:"):
         write()
-        g.line(f"{sm}[1] &= 253")
+        g.line(f"{sm}[1] &= {~mask & 255}")
         g.eno("1")
     with g.block("else:"):
-        g.line(f"{sm}[1] |= 2")
+        g.line(f"{sm}[1] |= {mask}")
         g.line("eno = 0")
+
+
+def _overflow(g: Gen, ok: str, write: Callable[[], None]) -> None:
+    """SM1.1: overflow / illegal value (conversion out of range)."""
+    _flagged(g, ok, write, 1)
 
 
 def _make_narrow(mn: str) -> None:
@@ -141,15 +148,8 @@ BCD_TO_INT: dict[int, int] = {b: i for i, b in enumerate(INT_TO_BCD)}
 
 
 def _bcd_error(g: Gen, ok: str, write: Callable[[], None]) -> None:
-    """``if ok``: write, clear SM1.6, ENO 1; else set SM1.6 (non-BCD), ENO 0."""
-    sm = g.use("SM")
-    with g.block(f"if {ok}:"):
-        write()
-        g.line(f"{sm}[1] &= 191")
-        g.eno("1")
-    with g.block("else:"):
-        g.line(f"{sm}[1] |= 64")
-        g.line("eno = 0")
+    """SM1.6: illegal BCD value."""
+    _flagged(g, ok, write, 6)
 
 
 @insn("BCDI", Role.W_W, family=F, may_fail=True,

@@ -14,9 +14,7 @@ depths reach 11, past the nine levels of the S7-200 logic stack.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, example, given, settings
@@ -25,10 +23,7 @@ from hypothesis import strategies as st
 import plcrt
 from plcrt.isa.registry import lookup
 
-_TESTS = str(Path(__file__).resolve().parents[1])
-if _TESTS not in sys.path:
-    sys.path.insert(0, _TESTS)
-from reference_interp import ReferencePlc, Unsupported  # noqa: E402
+from reference_interp import ReferencePlc, Unsupported  # tests/ is on sys.path (conftest)
 
 #: Areas both sides model (and that OB1 can change or read).
 COMPARED_AREAS = ("PI", "I", "Q", "PQ", "M", "V", "SM", "S", "TV", "TB", "CV", "CB")

@@ -10,17 +10,8 @@ from pathlib import Path
 import pytest
 
 import plcrt
+from stl_helpers import load_ob1 as _load
 from plcrt.errors import PlcCompileError
-
-
-def _load(*networks: str, scan_ms: float = 10.0) -> plcrt.Plc:
-    """An OB1 made of ``networks`` (each a block of STL lines)."""
-    lines = ["ORGANIZATION_BLOCK OB1", "BEGIN"]
-    for i, net in enumerate(networks, 1):
-        lines.append(f"Network {i}")
-        lines.extend(ln.strip() for ln in net.strip().splitlines())
-    lines.append("END_ORGANIZATION_BLOCK")
-    return plcrt.load("\n".join(lines) + "\n", scan_ms=scan_ms)
 
 
 def _scan_with(p: plcrt.Plc, inputs: dict[str, int]) -> plcrt.Plc:

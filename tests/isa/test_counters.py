@@ -11,16 +11,7 @@ from __future__ import annotations
 import pytest
 
 import plcrt
-
-
-def _load(*networks: str) -> plcrt.Plc:
-    """An OB1 made of ``networks`` (each a block of STL lines)."""
-    lines = ["ORGANIZATION_BLOCK OB1", "BEGIN"]
-    for i, net in enumerate(networks, 1):
-        lines.append(f"Network {i}")
-        lines.extend(ln.strip() for ln in net.strip().splitlines())
-    lines.append("END_ORGANIZATION_BLOCK")
-    return plcrt.load("\n".join(lines) + "\n")
+from stl_helpers import load_ob1 as _load
 
 
 def _cbit(p: plcrt.Plc, n: int) -> int:

@@ -7,17 +7,8 @@ from __future__ import annotations
 import pytest
 
 import plcrt
+from stl_helpers import load_ob1 as _load
 from plcrt.errors import PlcCompileError, PlcRuntimeError
-
-
-def _load(*networks: str) -> plcrt.Plc:
-    """An OB1 made of ``networks`` (each a block of STL lines)."""
-    lines = ["ORGANIZATION_BLOCK OB1", "BEGIN"]
-    for i, net in enumerate(networks, 1):
-        lines.append(f"Network {i}")
-        lines.extend(ln.strip() for ln in net.strip().splitlines())
-    lines.append("END_ORGANIZATION_BLOCK")
-    return plcrt.load("\n".join(lines) + "\n")
 
 
 def _run(body: str, preset: dict | None = None) -> plcrt.Plc:

@@ -14,11 +14,24 @@ Everything else is internal and may change.
 
 from __future__ import annotations
 
-from .engine.runtime import Plc, load
+from typing import TYPE_CHECKING, Any
+
 from .errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError,
                      PlcError, PlcRuntimeError, PlcSyntaxError, SourceLoc)
 
 __version__ = "0.1.0"
+
+if TYPE_CHECKING:
+    from .engine.runtime import Plc, load
+
+
+def __getattr__(name: str) -> Any:
+    # perf: the engine (lark, the compiler) loads on first use, so that
+    # `import plcrt` stays cheap for the pytest plugin and the CLI's --help
+    if name in ("Plc", "load"):
+        from .engine import runtime
+        return getattr(runtime, name)
+    raise AttributeError(f"module 'plcrt' has no attribute {name!r}")
 
 __all__ = [
     "load", "Plc", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",

@@ -23,6 +23,7 @@ JSON object.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import math
 import os
@@ -102,8 +103,29 @@ def _main(argv: list[str]) -> int:
         return int(args.func(args))
     except PlcError as e:
         # Errors a command does not handle itself: report them all.
-        _print_diagnostics(e.diagnostics)
+        print_diagnostics(e.diagnostics)
         return EXIT_FAULT if isinstance(e, PlcRuntimeError) else EXIT_ERROR
+
+
+def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True,
+                     plant: bool = True) -> None:
+    """The program, symbol table, data, CPU and plant options commands share."""
+    p.add_argument("programs", nargs="+", metavar="PROGRAM",
+                   help="STL export (.awl); several files are merged into one program")
+    p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
+    if data:
+        p.add_argument("--data", metavar="F", help="data block (V memory initial values)")
+    if cpu:
+        p.add_argument("--cpu", metavar="NAME", help="CPU model, e.g. CPU224 (default CPU226)")
+    if plant:
+        p.add_argument("--plant", metavar="F",
+                       help="plant file (TOML): EM253 modules and the machine around "
+                            "their axes")
+
+
+#: Subcommands defined beside the feature they present; each module has
+#: ``register(sub)`` adding its parser with ``func`` set.
+_COMMAND_MODULES = ("plcrt.view.cli", "plcrt.debug.cli", "plcrt.trace.cli")
 
 
 def _build_parser() -> _Parser:
@@ -115,19 +137,7 @@ def _build_parser() -> _Parser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    def common(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True,
-               plant: bool = True) -> None:
-        p.add_argument("programs", nargs="+", metavar="PROGRAM",
-                       help="STL export (.awl); several files are merged into one program")
-        p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
-        if data:
-            p.add_argument("--data", metavar="F", help="data block (V memory initial values)")
-        if cpu:
-            p.add_argument("--cpu", metavar="NAME", help="CPU model, e.g. CPU224 (default CPU226)")
-        if plant:
-            p.add_argument("--plant", metavar="F",
-                           help="plant file (TOML): EM253 modules and the machine around "
-                                "their axes")
+    common = add_program_args
 
     p = sub.add_parser("check", help="parse and compile; list every error and warning",
                        description="Parse and compile a program and list every error and "
@@ -151,6 +161,9 @@ def _build_parser() -> _Parser:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--realtime", action="store_true",
                    help="keep wall-clock pace (sleep between scans); results are unchanged")
+    p.add_argument("--quiet", action="store_true",
+                   help="print only errors: no summary, value table, axes, warnings or "
+                        "progress bar (--json still prints its object)")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",
@@ -158,6 +171,14 @@ def _build_parser() -> _Parser:
                                    "network, each instruction's code under its STL line.")
     common(p, data=False, plant=False)
     p.set_defaults(func=cmd_dump)
+    for name in _COMMAND_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as e:
+            if e.name is None or not name.startswith(e.name):
+                raise
+            continue
+        module.register(sub)
     return parser
 
 
@@ -165,7 +186,7 @@ def _build_parser() -> _Parser:
 # Commands
 # ---------------------------------------------------------------------------
 
-def _load(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
+def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
     """Load the program named on the command line (raises PlcError)."""
     data = getattr(args, "data", None)
     plant = getattr(args, "plant", None)
@@ -182,14 +203,14 @@ def cmd_check(args: argparse.Namespace) -> int:
     """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors."""
     name = ", ".join(args.programs)
     try:
-        plc = _load(args)
+        plc = load_from_args(args)
     except PlcError as e:
         diags = e.diagnostics
-        _print_diagnostics(diags)
+        print_diagnostics(diags)
         print(f"{name}: {_count(diags)}", file=sys.stderr)
         return EXIT_ERROR
     diags = plc.diagnostics
-    _print_diagnostics(diags)
+    print_diagnostics(diags)
     prog = plc.program
     print(f"{name}: {_count(diags)} ({len(prog.pous)} block(s), "
           f"{prog.network_count()} network(s), {prog.instruction_count()} instruction(s))",
@@ -199,8 +220,16 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """``plcrt run``: load, apply --set, run, print --watch values (and the
-    axes of a --plant)."""
+    axes of a --plant).  A long run on a terminal shows a progress bar on
+    stderr; ``--quiet`` prints nothing but errors (and the --json object)."""
+    from .trace.progress import run_with_progress
+
     program = args.programs[0]
+    quiet = getattr(args, "quiet", False)
+
+    def report(diags: Sequence[Diagnostic]) -> None:
+        print_diagnostics([d for d in diags if d.severity == "error"] if quiet else diags)
+
     try:
         if args.scans is not None and args.scans < 0:
             raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
@@ -208,8 +237,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
         writes = [_parse_set(item) for item in args.set]
         watches = [_parse_watch(item) for item in args.watch]
-        plc = _load(args, args.scan_ms)
-        _print_diagnostics(plc.diagnostics)  # warnings
+        plc = load_from_args(args, args.scan_ms)
+        report(plc.diagnostics)  # warnings
         if "OB1" not in plc.unit.pous:
             raise PlcConfigError("the program has no main program block (OB1), so there "
                                  "is nothing to run; give the file with OB1 as well")
@@ -218,7 +247,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         for spec, addr, kind in watches:
             plc.read(addr, kind)  # reject a bad address before running
     except PlcError as e:
-        _print_diagnostics(e.diagnostics)
+        print_diagnostics(e.diagnostics)
         if args.json:
             _emit_json(args, None, {}, str(e))
         return EXIT_ERROR
@@ -226,21 +255,22 @@ def cmd_run(args: argparse.Namespace) -> int:
     fault: PlcError | None = None
     loaded = len(plc.diagnostics)
     try:
-        plc.run(seconds=args.seconds, scans=args.scans)
+        # same scans and results as plc.run(); only the bar differs
+        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=quiet)
     except PlcRuntimeError as e:
         fault = e
     # Warnings raised while running (library blocks such as the EM253's
     # report bad parameters only when they execute) go to stderr as well.
-    _print_diagnostics(plc.diagnostics[loaded:])
+    report(plc.diagnostics[loaded:])
     values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
     if args.json:
         _emit_json(args, plc, values, str(fault) if fault else None)
-    else:
+    elif not quiet:
         _print_values(program, plc, values)
         if args.plant:
             _print_axes(plc.axes())
     if fault is not None:
-        _print_diagnostics(fault.diagnostics)
+        print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
     return EXIT_OK
 
@@ -248,11 +278,11 @@ def cmd_run(args: argparse.Namespace) -> int:
 def cmd_dump(args: argparse.Namespace) -> int:
     """``plcrt dump``: the generated module with STL lines as comments."""
     try:
-        plc = _load(args)
+        plc = load_from_args(args)
     except PlcError as e:
-        _print_diagnostics(e.diagnostics)
+        print_diagnostics(e.diagnostics)
         return EXIT_ERROR
-    _print_diagnostics(plc.diagnostics)
+    print_diagnostics(plc.diagnostics)
     sys.stdout.write(render_dump(plc))
     return EXIT_OK
 
@@ -518,7 +548,7 @@ def _print_rich_axes(rows: list[list[str]]) -> bool:
 # Reporting
 # ---------------------------------------------------------------------------
 
-def _print_diagnostics(diags: Sequence[Diagnostic], stream: TextIO | None = None) -> None:
+def print_diagnostics(diags: Sequence[Diagnostic], stream: TextIO | None = None) -> None:
     """GNU-style lines, in source order (stable for equal positions)."""
     stream = stream or sys.stderr
 

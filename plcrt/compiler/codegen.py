@@ -19,6 +19,7 @@ from typing import Any, Callable
 
 from ..errors import DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
+from ..isa.shape import shape
 from ..lang import ir
 from ..memory.cpu import CpuModel
 from .emit import CodegenError, Gen
@@ -84,6 +85,9 @@ class Unit:
         self.hooks: dict[str, Any] = {}       #: family-specific run-time tables
         self.current: PouInfo | None = None
         self.current_piece: Piece | None = None
+        #: a :class:`plcrt.engine.coverage.CoverageMap` to add probes for
+        #: (coverage and breakpoints), or None for the plain fast code
+        self.probes: Any = None
 
     def fresh(self, hint: str) -> str:
         self._counter += 1
@@ -267,6 +271,8 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
             unit.current_piece = piece
             fname = f"n_{p.ident}_{piece.network.number}{piece.suffix}_{piece.index}"
             gen = Gen(unit, piece.network.loc, 0)
+            if unit.probes is not None:
+                _network_probe(unit, gen, piece)
             loop_body = next((fp for fp, (body, _e, _f) in info.loops.items()
                               if body == piece.index), None)
             if loop_body is not None:
@@ -295,6 +301,35 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
         out.extend(_runner(unit, info, fnames))
         out.append("")
     return "\n".join(out) + "\n", line_locs
+
+
+def _network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:
+    """Mark the network as run; the first piece also checks for a breakpoint."""
+    net = piece.network
+    k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
+                                net.loc.within(piece.pou.ident, net.number))
+    nc = gen.bind(unit.probes.hits, "NC")
+    gen.line(f"{nc}[{k}] = 1")
+    if not piece.suffix:
+        bp = gen.bind(unit.probes.breakpoints, "BP")
+        hit = gen.bind(unit.probes.call_hit, "HIT")
+        with gen.block(f"if {bp}[{k}]:"):
+            gen.line(f"{hit}({k})")
+
+
+def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: SourceLoc) -> None:
+    """Record whether a coil or box is reached with or without power flow."""
+    shp = shape(insn.mnemonic)
+    if shp.kind not in ("coil", "box") or shp.inputs < 1 or gen.depth < shp.inputs:
+        return
+    net = piece.network
+    k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
+                                net.loc.within(piece.pou.ident, net.number))
+    j = unit.probes.add_output(k, insn.mnemonic,
+                               insn.operands[0].text if insn.operands else "", loc)
+    oc = gen.bind(unit.probes.power, "OC")
+    # the first power input (EN; CU of a counter) is the deepest of them
+    gen.line(f"{oc}[{j}] |= 2 if {gen.level(shp.inputs - 1)} else 1")
 
 
 def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
@@ -357,6 +392,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         gen.line_map.append((len(gen.lines), insn_id))
         # The comment carries only the instruction id and line number.
         gen.comment(f"[{insn_id}] line {int(loc.line)}")
+        if unit.probes is not None and not broken:
+            _output_probe(unit, gen, piece, insn, loc)
         saved = (list(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
             if spec.variadic:

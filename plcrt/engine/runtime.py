@@ -18,9 +18,11 @@ wall-clock pace (for demos); it never changes results.
 
 from __future__ import annotations
 
+import copy
 import time as _time
+import types
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from ..compiler import compile_program
 from ..compiler.operands import Addr, OperandError, parse_operand
@@ -30,6 +32,7 @@ from ..errors import (PlcAddressError, PlcConfigError, PlcError,
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
 from .counters import CounterBank
+from .coverage import CoverageMap
 from .timers import TimerBank
 
 #: Estimated execution time per instruction for the watchdog (µs).  Only
@@ -49,13 +52,24 @@ class Plc:
                  scan_ms: float = 10.0, cpu: str | None = None,
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
-                 plant: Any = None) -> None:
+                 plant: Any = None, instrument: bool = False) -> None:
         if not (isinstance(scan_ms, (int, float)) and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
         if pace not in ("simulated", "realtime"):
             raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
         self.program = program
         self.symbols = symbols
+        # what fork() needs to build a twin (the data block is in V already)
+        self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
+                            system_symbols=system_symbols, watchdog_ms=watchdog_ms,
+                            pace=pace, plant=plant, instrument=instrument)
+        #: network/output coverage and breakpoints (``instrument=True`` only)
+        self.coverage: CoverageMap | None = CoverageMap() if instrument else None
+        #: callables ``fn(plc)`` run after every scan (traces, test harness)
+        self.observers: list[Callable[[Plc], None]] = []
+        #: forced addresses -> value (see :meth:`force`)
+        self.forces: dict[str, int | float] = {}
+        self._force_slots: list[tuple[bytearray, int, int, int, int | float]] = []
         self.model = cpu_model(cpu)
         self.mem = MemoryImage(self.model)
         self.scan_us = int(round(scan_ms * 1000))
@@ -90,7 +104,8 @@ class Plc:
             unit.hooks["counters"] = self.counters
 
         self.unit, self.source, self.line_locs = compile_program(
-            program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup)
+            program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup,
+            probes=self.coverage)
         self.diagnostics = list(self.unit.diag.items) + self.diagnostics
         self._filename = f"<plcrt {program.file}>"
         ns: dict[str, Any] = dict(CODECS)
@@ -156,6 +171,8 @@ class Plc:
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
         i_img[:] = pi
+        if self._force_slots:
+            self._apply_forces()
         scans = self.scans
         b0 = 0x81 if scans else 0x8B  # SM0.0 and SM0.7; SM0.1/SM0.3 on the first scan
         if now % 60_000_000 >= 30_000_000:
@@ -182,6 +199,8 @@ class Plc:
         except Exception as e:  # an internal fault: map it to the program location
             self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
                                        self._loc_from_tb(e)), e)
+        if self._force_slots:
+            self._apply_forces()
         pq[:] = q
         self.scans = scans + 1
         self._t_us = now + self.scan_us
@@ -190,6 +209,9 @@ class Plc:
             # STOP and the outputs take their STOP state (off).
             self.mode = "STOP"
             pq[:] = bytes(len(pq))
+        if self.observers:
+            for fn in self.observers:
+                fn(self)
 
     def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
         self.mode = "STOP"
@@ -303,26 +325,117 @@ class Plc:
         so it keeps its value over the next scans (a switch left on)."""
         a = self._addr(address)
         buf, off, width, bit = self._locate(a)
-        targets = [buf]
+        value = _check_value(address, width, value)
+        _store(buf, off, width, bit, value)
         if a.area == "I":
-            targets.append(self.mem.areas["PI"])
-        for b in targets:
-            if width == 0:
-                if value:
-                    b[off] |= 1 << bit
-                else:
-                    b[off] &= ~(1 << bit) & 0xFF
-            elif isinstance(value, float) and width == 4:
-                CODECS["_wf"](b, off, value)
-            elif isinstance(value, float) and not value.is_integer():
-                raise PlcAddressError(f"{address}: a real value needs a double word")
+            _store(self.mem.areas["PI"], off, width, bit, value)
+
+    # -- forcing (System Manual, "Forcing specific values") ----------------
+    def force(self, address: str, value: int | float | bool) -> None:
+        """Force an address to a value until :meth:`unforce`.
+
+        As on the S7-200 the forced value is written into the image at the
+        start of every scan (after the inputs are read) and again after the
+        program has run (before the outputs are written), so the program
+        cannot change what the terminals and the next scan see.  A program
+        write in between is visible to the rest of that scan, as on the CPU.
+        """
+        a = self._addr(address)
+        buf, off, width, bit = self._locate(a)
+        value = _check_value(address, width, value)
+        key = address.strip()
+        self.forces[key] = value
+        self._force_slots = [s for s in self._force_slots
+                             if (s[0], s[1], s[2], s[3]) != (buf, off, width, bit)]
+        self._force_slots.append((buf, off, width, bit, value))
+        _store(buf, off, width, bit, value)
+
+    def unforce(self, address: str | None = None) -> None:
+        """Release one forced address, or all of them (the value stays)."""
+        if address is None:
+            self.forces.clear()
+            self._force_slots = []
+            return
+        key = address.strip()
+        if key not in self.forces:
+            raise PlcAddressError(f"{address} is not forced")
+        buf, off, width, bit = self._locate(self._addr(address))
+        del self.forces[key]
+        self._force_slots = [s for s in self._force_slots
+                             if (s[0], s[1], s[2], s[3]) != (buf, off, width, bit)]
+
+    def _apply_forces(self) -> None:
+        for buf, off, width, bit, value in self._force_slots:
+            _store(buf, off, width, bit, value)
+
+    # -- snapshots ------------------------------------------------------------
+    def fork(self) -> Plc:
+        """An independent twin in exactly this state (memory, timers,
+        counters, edges, library blocks, devices, time, forces); running one
+        never affects the other."""
+        twin = Plc(self.program, **self._config)
+        self._copy_state(twin)
+        return twin
+
+    def snapshot(self) -> Plc:
+        """The current state, to :meth:`restore` later (a stopped twin)."""
+        return self.fork()
+
+    def restore(self, snapshot: Plc) -> None:
+        """Go back to a state taken with :meth:`snapshot` of this PLC."""
+        if snapshot.program is not self.program:
+            raise PlcConfigError("this snapshot was taken from a different program")
+        snapshot._copy_state(self)
+
+    def _copy_state(self, dst: Plc) -> None:
+        """Make ``dst`` (the same program, compiled the same way) equal to self.
+
+        Everything stateful is either a memory buffer (copied in place) or a
+        Python object bound into the generated code or held by the engine
+        (timer and counter banks, library blocks, devices); those are deep-
+        copied in one pass with a memo that maps each of our objects to its
+        twin, so references between them (a block's axis, an axis's
+        end-of-move handler) land on the twin's objects.
+        """
+        areas, dareas = self.mem.areas, dst.mem.areas
+        memo: dict[int, Any] = {id(self): dst, id(self.mem): dst.mem}
+        for k, buf in areas.items():
+            dareas[k][:] = buf
+            memo[id(buf)] = dareas[k]
+        pairs: list[tuple[Any, Any]] = [(self.timers, dst.timers),
+                                        (self.counters, dst.counters)]
+        pairs += list(zip(self.devices, dst.devices))
+        for name, obj in self.unit.bindings.items():
+            other = dst.unit.bindings.get(name)
+            if other is None or type(other) is not type(obj):
+                raise PlcConfigError("internal error: the twin was compiled differently")
+            if isinstance(obj, bytearray):
+                other[:] = obj
+                memo[id(obj)] = other
+            elif isinstance(obj, (types.FunctionType, types.MethodType,
+                                  types.BuiltinFunctionType)):
+                continue   # code and bound methods of the banks: no own state
+            elif hasattr(obj, "__dict__"):
+                pairs.append((obj, other))   # library blocks
             else:
-                v = int(value)
-                lo, hi = -(1 << (8 * width - 1)), (1 << (8 * width)) - 1
-                if not lo <= v <= hi:
-                    raise PlcAddressError(f"{address}: value {v} does not fit in "
-                                          f"{width} byte(s)")
-                b[off:off + width] = (v & ((1 << 8 * width) - 1)).to_bytes(width, "big")
+                raise PlcConfigError(f"internal error: cannot copy the state of "
+                                     f"{type(obj).__name__}")
+        for a, b in pairs:
+            memo[id(a)] = b
+        states = copy.deepcopy([a.__dict__ for a, _ in pairs], memo)
+        for (_, b), state in zip(pairs, states):
+            b.__dict__.clear()
+            b.__dict__.update(state)
+        dst.modules = {d.slot: d for d in dst.devices}
+        for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested"):
+            setattr(dst, name, getattr(self, name))
+        dst._warned = set(self._warned)
+        dst.diagnostics = list(self.diagnostics)
+        dst.wd[:] = self.wd
+        dst.forces = {}
+        dst._force_slots = []
+        for key, value in self.forces.items():
+            dst.force(key, value)
 
     def _locate(self, a: Addr) -> tuple[bytearray, int, int, int]:
         """(buffer, byte offset, width, bit) of an address; T/C by name
@@ -335,6 +448,33 @@ class Plc:
         if a.area in ("AC", "HC"):
             return m[a.area], a.offset * 4, 4, 0
         return m[a.area], a.offset, a.width or 0, a.bit
+
+
+def _check_value(address: str, width: int, value: int | float | bool) -> int | float:
+    """Validate a value for a location of ``width`` bytes (0 = a bit)."""
+    if width == 0:
+        return 1 if value else 0
+    if isinstance(value, float) and width == 4:
+        return value
+    if isinstance(value, float) and not value.is_integer():
+        raise PlcAddressError(f"{address}: a real value needs a double word")
+    v = int(value)
+    lo, hi = -(1 << (8 * width - 1)), (1 << (8 * width)) - 1
+    if not lo <= v <= hi:
+        raise PlcAddressError(f"{address}: value {v} does not fit in {width} byte(s)")
+    return v
+
+
+def _store(b: bytearray, off: int, width: int, bit: int, value: int | float) -> None:
+    if width == 0:
+        if value:
+            b[off] |= 1 << bit
+        else:
+            b[off] &= ~(1 << bit) & 0xFF
+    elif isinstance(value, float):
+        CODECS["_wf"](b, off, value)
+    else:
+        b[off:off + width] = (value & ((1 << 8 * width) - 1)).to_bytes(width, "big")
 
 
 def _system_symbols() -> dict[str, str]:

@@ -79,6 +79,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import partial
 from typing import Any
 
 from ..motion import Seg, cruise, plan_distance
@@ -196,7 +197,12 @@ class HomingSequence:
         lim = self._limit(d)
         if lim is None:
             return []
-        return [(lim, lambda t, pos: self._on_limit(t, d))]
+        # partials of bound methods, not closures: a PLC snapshot deep-copies
+        # the device state, and copied closures would still point here
+        return [(lim, partial(self._limit_reached, d))]
+
+    def _limit_reached(self, d: int, t: int, pos: int) -> None:
+        self._on_limit(t, d)
 
     def _guarded(self, fn: Callable[[int], None]) -> Callable[[int], None]:
         """Wrap the end-of-move continuation of a phase.
@@ -205,18 +211,19 @@ class HomingSequence:
         something stops it early (STF, InnerState written by the program);
         only the planned end may continue the homing.
         """
-        def done(t: int) -> None:
-            if not self.active:
-                return
-            if self.ax.stf:
-                self._interrupted(t, "the STF emergency stop input stopped the axis")
-                return
-            if t != self._end:
-                self._interrupted(t, "the axis was stopped from outside (InnerState "
-                                     "written by the program?)")
-                return
-            fn(t)
-        return done
+        return partial(self._guarded_done, fn)
+
+    def _guarded_done(self, fn: Callable[[int], None], t: int) -> None:
+        if not self.active:
+            return
+        if self.ax.stf:
+            self._interrupted(t, "the STF emergency stop input stopped the axis")
+            return
+        if t != self._end:
+            self._interrupted(t, "the axis was stopped from outside (InnerState "
+                                 "written by the program?)")
+            return
+        fn(t)
 
     def _move(self, t: int, d: int, segs: list[Seg], watch: list,
               on_done: Callable[[int], None] | None = None, keep: bool = False) -> None:

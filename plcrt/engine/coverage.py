@@ -1,0 +1,126 @@
+"""Network and rung-output coverage, filled in by instrumented code.
+
+When a program is loaded with ``instrument=True`` the code generator adds
+two kinds of probes (and nothing else changes in what the program does):
+
+* at the start of every network piece ``_NC[k] = 1``: network ``k`` ran in
+  this scan (it is skipped when a JMP jumps over it, its SCR segment is
+  inactive, or its subroutine is not called);
+* before every coil and box (the outputs of a rung, see
+  :mod:`plcrt.isa.shape`) ``_OC[j] |= 2 if <power> else 1``: bit 0 = the
+  output was reached without power flow, bit 1 = with power flow.  An output
+  that saw both has had each of its rung's outcomes exercised: the ladder
+  equivalent of branch coverage.
+
+The first piece of every network also checks ``_BP[k]`` and calls the
+break handler, which the debugger uses for breakpoints on networks.
+
+This module holds the tables and the report; it does not run anything.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from ..errors import SourceLoc
+
+
+@dataclass(frozen=True)
+class NetworkRef:
+    """One network of the program, as Micro/WIN numbers it."""
+
+    index: int
+    block: str          #: "OB1", "SBR0", ...
+    number: int
+    title: str
+    loc: SourceLoc
+
+    @property
+    def name(self) -> str:
+        return f"{self.block}/{self.number}"
+
+
+@dataclass(frozen=True)
+class OutputRef:
+    """One coil or box of a rung (an outcome of the network's logic)."""
+
+    index: int
+    network: int        #: index into the network list
+    mnemonic: str
+    operand: str        #: first operand as written ("" when none)
+    loc: SourceLoc
+
+
+class CoverageMap:
+    """Probe tables of one instrumented program."""
+
+    def __init__(self) -> None:
+        self.networks: list[NetworkRef] = []
+        self.outputs: list[OutputRef] = []
+        self.hits = bytearray()          #: per network: 1 = ran (since reset)
+        self.power = bytearray()         #: per output: bit0 unpowered, bit1 powered
+        self.breakpoints = bytearray()   #: per network: 1 = break before it
+        self.on_break: Callable[[NetworkRef], None] | None = None
+        #: perf: one bound method for every probe to share
+        self.call_hit = self.hit
+        self._by_key: dict[tuple[str, int], int] = {}
+
+    # -- filled by the code generator -------------------------------------
+    def add_network(self, block: str, number: int, title: str, loc: SourceLoc) -> int:
+        key = (block, number)
+        if key in self._by_key:
+            return self._by_key[key]
+        k = len(self.networks)
+        self.networks.append(NetworkRef(k, block, number, title, loc))
+        self._by_key[key] = k
+        self.hits.append(0)
+        self.breakpoints.append(0)
+        return k
+
+    def add_output(self, network: int, mnemonic: str, operand: str, loc: SourceLoc) -> int:
+        j = len(self.outputs)
+        self.outputs.append(OutputRef(j, network, mnemonic, operand, loc))
+        self.power.append(0)
+        return j
+
+    # -- run time ---------------------------------------------------------
+    def hit(self, k: int) -> None:
+        """Called by generated code before network ``k`` when it has a breakpoint."""
+        if self.on_break is not None:
+            self.on_break(self.networks[k])
+
+    def find(self, block: str, number: int) -> NetworkRef | None:
+        k = self._by_key.get((block.upper(), number))
+        return None if k is None else self.networks[k]
+
+    def reset(self) -> None:
+        """Forget what ran (breakpoints stay)."""
+        self.hits[:] = bytes(len(self.hits))
+        self.power[:] = bytes(len(self.power))
+
+    # -- results ----------------------------------------------------------
+    def data(self) -> dict[str, Any]:
+        """Plain data (JSON-able): what ran, keyed by stable names."""
+        return {
+            "networks": {n.name: int(self.hits[n.index]) for n in self.networks},
+            "outputs": {self.output_key(o): int(self.power[o.index]) for o in self.outputs},
+        }
+
+    def output_key(self, o: OutputRef) -> str:
+        net = self.networks[o.network]
+        return f"{net.name}:{o.loc.line}:{o.loc.column}:{o.mnemonic}"
+
+
+def merge_data(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
+    """Union of two :meth:`CoverageMap.data` results of the same program."""
+    out: dict[str, Any] = {"networks": dict(a.get("networks", {})),
+                           "outputs": dict(a.get("outputs", {}))}
+    for key, v in b.get("networks", {}).items():
+        out["networks"][key] = out["networks"].get(key, 0) | v
+    for key, v in b.get("outputs", {}).items():
+        out["outputs"][key] = out["outputs"].get(key, 0) | v
+    return out
+
+
+__all__ = ["CoverageMap", "NetworkRef", "OutputRef", "merge_data"]

@@ -1,0 +1,497 @@
+"""A test harness around a loaded PLC: time control, stimuli, forcing, motion.
+
+:class:`Harness` is what a unit test of a ladder program talks to, with or
+without pytest (the pytest plugin only creates harnesses and reports on
+them).  Everything runs in simulated time, so a test that waits "5 s" for a
+condition costs only the scans it needs, and gives the same result on every
+machine.
+
+It is not a second engine: every scan is :meth:`plcrt.engine.Plc.scan`, and
+every read and write goes through the PLC's memory image.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Union
+
+from ..engine.runtime import Plc, load
+from ..errors import PlcAddressError, PlcConfigError
+
+Value = Union[int, float, bool]
+Duration = Union[int, float, str]
+Condition = Union[str, Callable[[], Any], Callable[["Harness"], Any]]
+
+_UNITS = {"us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0}
+_DURATION_RE = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(us|µs|ms|s|sec|min|h)?\s*$")
+
+
+class PlcTimeout(AssertionError):
+    """A condition was not met within its simulated-time limit.
+
+    An ``AssertionError``, so pytest reports it as a test failure (with the
+    PLC trace), not as an error in the test code.
+    """
+
+
+def seconds(d: Duration) -> float:
+    """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``, ``"2min"``."""
+    if isinstance(d, bool):
+        raise PlcConfigError(f"not a duration: {d!r}")
+    if isinstance(d, (int, float)):
+        value = float(d)
+    else:
+        m = _DURATION_RE.match(str(d))
+        if m is None:
+            raise PlcConfigError(f"not a duration: {d!r} (write e.g. 2, '1.5s', '200ms', '2min')")
+        value = float(m.group(1)) * _UNITS[m.group(2) or "s"]
+    if not value >= 0 or value == float("inf"):
+        raise PlcConfigError(f"a duration must be a non-negative number, got {d!r}")
+    return value
+
+
+# ---------------------------------------------------------------------------
+# Fast readers
+# ---------------------------------------------------------------------------
+
+def reader(plc: Plc, spec: str) -> Callable[[], Value]:
+    """A function reading one address (``VW100``, ``VD4:REAL``, ``T37:BIT``,
+    symbol names) resolved once, for per-scan use."""
+    text, _, kind = spec.partition(":")
+    kind = kind.strip().upper()
+    if kind not in ("", "REAL", "BIT"):
+        raise PlcAddressError(f"{spec!r}: unknown kind {kind!r} (use :REAL or :BIT)")
+    plc.read(text, kind or None)  # validates, with the engine's messages
+    a = plc._addr(text)
+    if kind == "BIT":
+        from ..compiler.operands import Addr
+        a = Addr(a.area, a.offset, 0, 0, a.text)
+    buf, off, width, bit = plc._locate(a)
+    # perf: closures over the buffer and offset; no parsing per read
+    if width == 0:
+        return lambda: buf[off] >> bit & 1
+    if kind == "REAL":
+        unpack = struct.Struct(">f").unpack_from
+        return lambda: unpack(buf, off)[0]
+    if width == 1:
+        return lambda: buf[off]
+    end = off + width
+    return lambda: int.from_bytes(buf[off:end], "big", signed=True)
+
+
+_COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*(?:(==|!=|<>|<=|>=|<|>|=)\s*(\S+))?\s*$",
+                      re.IGNORECASE)
+_OPS: dict[str, Callable[[Any, Any], bool]] = {
+    "==": lambda a, b: a == b, "=": lambda a, b: a == b, "!=": lambda a, b: a != b,
+    "<>": lambda a, b: a != b, "<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
+    ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
+}
+
+
+def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
+    """A no-argument predicate and its description from a condition:
+    ``"Q0.0"``, ``"not M0.1"``, ``"VW100 >= 25"``, ``"VD8:REAL > 1.5"``, a
+    callable taking no argument, or a callable taking the harness."""
+    if callable(cond):
+        import inspect
+        try:
+            takes_arg = len(inspect.signature(cond).parameters) >= 1
+        except (TypeError, ValueError):
+            takes_arg = False
+        name = getattr(cond, "__name__", "condition")
+        if takes_arg:
+            return (lambda: bool(cond(h))), name   # type: ignore[call-arg]
+        return (lambda: bool(cond())), name        # type: ignore[call-arg]
+    m = _COND_RE.match(str(cond))
+    if m is None:
+        raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
+                             f"or 'ADDR <op> value' with op one of == != < <= > >=")
+    neg, addr, op, value = m.groups()
+    rd = reader(h.plc, addr)
+    if op is None:
+        return ((lambda: not rd()) if neg else (lambda: bool(rd()))), str(cond).strip()
+    from ..cli import parse_value
+    try:
+        v = parse_value(value)
+    except PlcConfigError:
+        raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
+    fn = _OPS[op]
+    if neg:
+        return (lambda: not fn(rd(), v)), str(cond).strip()
+    return (lambda: fn(rd(), v)), str(cond).strip()
+
+
+@dataclass(frozen=True)
+class AxisState:
+    """One EM253 axis at a moment of simulated time."""
+
+    slot: int
+    axis: int
+    position: int       #: the module's position counter (pulses)
+    mechanical: int     #: where the machine really is (pulses from the plant origin)
+    speed: int          #: pulse frequency in Hz, signed by direction
+    status: str         #: "stopped", "moving", ...
+
+    @property
+    def moving(self) -> bool:
+        return self.status == "moving"
+
+
+class Harness:
+    """Drive one PLC from a test: run, stimulate, force, read, fork.
+
+    Create it with :meth:`Harness.load` (or wrap an existing
+    :class:`~plcrt.engine.Plc`).  ``watch`` names addresses whose values
+    over the last ``history`` scans are kept for failure reports.
+    """
+
+    def __init__(self, plc: Plc, *, watch: Sequence[str] = (), history: int = 20,
+                 name: str = "") -> None:
+        self.plc = plc
+        self.name = name or str(plc.program.file)
+        self.history: deque[tuple[int, float, tuple[Value, ...]]] = deque(maxlen=max(1, history))
+        self.watched: list[str] = []
+        self._readers: list[Callable[[], Value]] = []
+        self._recording = False
+        #: harnesses made by :meth:`fork` (the pytest plugin reports on them too)
+        self.forks: list[Harness] = []
+        self.watch(*watch)
+
+    @classmethod
+    def load(cls, program: str | Path | Sequence[str | Path], *, symbols: Any = None,
+             data: Any = None, plant: Any = None, scan_ms: float = 10.0,
+             cpu: str | None = None, watch: Sequence[str] = (), history: int = 20,
+             instrument: bool = False) -> Harness:
+        """Load a program (paths, STL text, or an already parsed
+        :class:`plcrt.lang.ir.Program`) and wrap it.
+
+        ``instrument=True`` compiles the network-coverage and breakpoint
+        probes in (slightly slower scans).
+        """
+        from ..lang import ir
+        symbols = Path(symbols) if isinstance(symbols, str) and "\n" not in symbols else symbols
+        data = Path(data) if isinstance(data, str) and "\n" not in data else data
+        plant = Path(plant) if isinstance(plant, str) and "\n" not in plant else plant
+        if isinstance(program, ir.Program):
+            # already parsed (the pytest plugin parses each file once per
+            # session and compiles it per test)
+            plc = _plc_from_parsed(program, symbols=symbols, data=data, plant=plant,
+                                   scan_ms=scan_ms, cpu=cpu, instrument=instrument)
+            return cls(plc, watch=watch, history=history)
+        if isinstance(program, str) and "\n" not in program:
+            program = Path(program)
+        plc = load(program, symbols=symbols, data=data, plant=plant,
+                   scan_ms=scan_ms, cpu=cpu, instrument=instrument)
+        return cls(plc, watch=watch, history=history)
+
+    # -- watching ---------------------------------------------------------
+    def watch(self, *addresses: str) -> Harness:
+        """Add addresses to the per-scan history (``VD4:REAL`` reads a float)."""
+        for a in addresses:
+            if a in self.watched:
+                continue
+            self._readers.append(reader(self.plc, a))
+            self.watched.append(a)
+        if self.watched and not self._recording:
+            self.plc.observers.append(self._record)
+            self._recording = True
+        return self
+
+    def _record(self, plc: Plc) -> None:
+        self.history.append((plc.scans, plc.time, tuple(r() for r in self._readers)))
+
+    def history_rows(self, n: int | None = None) -> list[tuple[int, float, tuple[Value, ...]]]:
+        """The last ``n`` recorded scans: (scan number, time after it, values)."""
+        rows = list(self.history)
+        return rows if n is None else rows[-n:]
+
+    def history_table(self, n: int | None = None) -> str:
+        """The watched values over the last scans as a plain text table."""
+        rows = self.history_rows(n)
+        if not self.watched:
+            return "(no addresses watched)"
+        head = ["scan", "t [s]"] + self.watched
+        body = [[str(s), f"{t:.3f}"] + [_fmt(v) for v in vals] for s, t, vals in rows]
+        if not body:
+            return "(no scan recorded yet)"
+        widths = [max(len(r[i]) for r in [head] + body) for i in range(len(head))]
+        line = lambda cells: "  ".join(c.rjust(w) for c, w in zip(cells, widths))  # noqa: E731
+        out = [line(head), line(["-" * w for w in widths])]
+        out += [line(r) for r in body]
+        return "\n".join(out)
+
+    # -- time -------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        """Simulated time in seconds."""
+        return self.plc.time
+
+    @property
+    def scans(self) -> int:
+        return self.plc.scans
+
+    def scan(self, n: int = 1) -> Harness:
+        """Run ``n`` scans."""
+        if n < 0:
+            raise PlcConfigError(f"cannot run {n} scans")
+        self.plc.scan(n)
+        return self
+
+    def run(self, duration: Duration | None = None, *, scans: int | None = None) -> Harness:
+        """Run for a simulated duration (``2``, ``"1.5s"``, ``"200ms"``) or ``scans``."""
+        if (duration is None) == (scans is None):
+            raise PlcConfigError("give a duration or scans=, not both")
+        if scans is not None:
+            return self.scan(scans)
+        self.plc.run(seconds=seconds(duration))  # type: ignore[arg-type]
+        return self
+
+    def _scans_for(self, d: Duration) -> int:
+        us = int(round(seconds(d) * 1e6))
+        return -(-us // self.plc.scan_us)
+
+    def run_until(self, cond: Condition, *, timeout: Duration = 10.0,
+                  message: str = "") -> float:
+        """Scan until ``cond`` holds after a scan; return the simulated seconds
+        that took.  Fails with :class:`PlcTimeout` when ``timeout`` (simulated)
+        passes first, or the CPU goes to STOP."""
+        pred, what = condition(self, cond)
+        t0 = self.plc.now_us
+        limit = self._scans_for(timeout)
+        plc = self.plc
+        for _ in range(limit):
+            plc.scan(1)
+            if plc.mode != "RUN":
+                self._timeout(f"the CPU went to STOP before {what!r} became true", message)
+            if pred():
+                return (plc.now_us - t0) / 1e6
+        self._timeout(f"{what!r} did not become true within {seconds(timeout):g} s of "
+                      f"simulated time ({limit} scans)", message)
+        raise AssertionError  # pragma: no cover - _timeout raises
+
+    def run_while(self, cond: Condition, *, timeout: Duration = 10.0, message: str = "") -> float:
+        """Scan while ``cond`` holds (the opposite of :meth:`run_until`)."""
+        pred, what = condition(self, cond)
+        return self.run_until(lambda: not pred(), timeout=timeout,
+                              message=message or f"{what!r} stayed true")
+
+    def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
+        """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
+        pred, what = condition(self, cond)
+        plc = self.plc
+        for _ in range(self._scans_for(duration)):
+            plc.scan(1)
+            if not pred():
+                self._timeout(f"{what!r} became false at t = {plc.time:.3f} s", message,
+                              exc=AssertionError)
+        return self
+
+    def _timeout(self, text: str, message: str, exc: type[AssertionError] = PlcTimeout) -> None:
+        parts = [message, text] if message else [text]
+        parts.append(f"at t = {self.time:.3f} s, scan {self.scans}")
+        raise exc("; ".join(parts))
+
+    # -- stimuli ----------------------------------------------------------
+    def __getitem__(self, address: str) -> Value:
+        return self.read(address)
+
+    def __setitem__(self, address: str, value: Value) -> None:
+        self.write(address, value)
+
+    def read(self, address: str, kind: str | None = None) -> Value:
+        """Read an address or symbol (``kind`` "REAL" or "BIT"; or ``VD4:REAL``)."""
+        if kind is None and ":" in address:
+            address, _, kind = address.partition(":")
+        return self.plc.read(address, kind or None)
+
+    def write(self, address: str, value: Value) -> None:
+        """Write an address or symbol; an input keeps its value (a switch left on)."""
+        self.plc.write(address, value)
+
+    def set(self, values: Mapping[str, Value]) -> Harness:
+        """Write several addresses at once (they hold until changed)."""
+        for a, v in values.items():
+            self.write(a, v)
+        return self
+
+    def values(self, *addresses: str) -> dict[str, Value]:
+        """Several addresses at once, as a dict."""
+        return {a: self.read(a) for a in addresses}
+
+    def patch(self, values: Mapping[str, Value], scans: int = 1) -> Harness:
+        """Hold values for ``scans`` scans (default one), then put the old
+        values back: a push button pressed for exactly one scan."""
+        old = {a: self.read(a) for a in values}
+        for a, v in values.items():
+            self.write(a, v)
+        self.scan(scans)
+        for a, v in old.items():
+            self.write(a, v)
+        return self
+
+    def pulse(self, address: str, scans: int = 1, value: Value = 1) -> Harness:
+        """Set ``address`` to ``value`` for ``scans`` scans, then back."""
+        return self.patch({address: value}, scans)
+
+    def force(self, address: str, value: Value) -> _Forced:
+        """Force an address until :meth:`unforce` (or the end of a ``with``)."""
+        self.plc.force(address, value)
+        return _Forced(self, [address])
+
+    @contextmanager
+    def forced(self, values: Mapping[str, Value]) -> Iterator[Harness]:
+        """``with h.forced({"I0.1": 0, "VW10": 5}):`` forces inside the block only."""
+        for a, v in values.items():
+            self.plc.force(a, v)
+        try:
+            yield self
+        finally:
+            for a in values:
+                if a.strip() in self.plc.forces:
+                    self.plc.unforce(a)
+
+    def unforce(self, address: str | None = None) -> Harness:
+        self.plc.unforce(address)
+        return self
+
+    def stimulus(self, table: Iterable[tuple[Duration, str, Value]], *,
+                 until: Duration | None = None) -> Harness:
+        """Play a time-ordered table of ``(time, address, value)`` rows.
+
+        Times count from now.  A row takes effect before the first scan that
+        starts at or after its time (scans are the only moments a PLC reads
+        its inputs).  After the last row the PLC runs on to ``until`` if it
+        is given.
+        """
+        rows = []
+        for i, row in enumerate(table):
+            try:
+                t, addr, value = row
+            except (TypeError, ValueError):
+                raise PlcConfigError(f"stimulus row {i + 1}: expected (time, address, value), "
+                                     f"got {row!r}") from None
+            rows.append((int(round(seconds(t) * 1e6)), i, str(addr), value))
+        rows.sort()
+        plc = self.plc
+        t0 = plc.now_us
+        for t_us, _, addr, value in rows:
+            while plc.now_us < t0 + t_us and plc.mode == "RUN":
+                plc.scan(1)
+            self.write(addr, value)
+        if until is not None:
+            end = t0 + int(round(seconds(until) * 1e6))
+            while plc.now_us < end and plc.mode == "RUN":
+                plc.scan(1)
+        return self
+
+    # -- state ------------------------------------------------------------
+    def snapshot(self) -> Plc:
+        """The whole PLC state now (memory, timers, devices, time)."""
+        return self.plc.snapshot()
+
+    def restore(self, snap: Plc) -> Harness:
+        """Go back to a :meth:`snapshot`."""
+        self.plc.restore(snap)
+        return self
+
+    def fork(self) -> Harness:
+        """An independent copy in the same state (e.g. after a long warm-up)."""
+        h = Harness(self.plc.fork(), watch=self.watched, history=self.history.maxlen or 20,
+                    name=self.name)
+        h.history.extend(self.history)
+        self.forks.append(h)
+        return h
+
+    # -- motion -----------------------------------------------------------
+    def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
+        """State of one EM253 axis (needs a plant)."""
+        e = self.plc.axis(slot, axis)
+        return AxisState(e["slot"], e["axis"], e["position"], e["mechanical"],
+                         e["speed"], str(e["status"]))
+
+    def wait_axis_moving(self, slot: int = 0, axis: int = 0, *,
+                         timeout: Duration = 1.0) -> float:
+        """Run until the axis moves; seconds it took."""
+        return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
+                              message=f"axis {slot}.{axis} did not start")
+
+    def wait_axis_stopped(self, slot: int = 0, axis: int = 0, *,
+                          timeout: Duration = 60.0) -> float:
+        """Run until the axis stands still; seconds it took."""
+        return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
+                              message=f"axis {slot}.{axis} did not stop")
+
+    def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
+        """Assert a move that is running (or about to start within a few
+        scans) ends within ``limit`` simulated seconds; returns its time."""
+        t0 = self.time
+        if not self.axis(slot, axis).moving:
+            self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))
+        self.run_until(lambda: not self.axis(slot, axis).moving, timeout=seconds(limit) -
+                       (self.time - t0), message=f"the move of axis {slot}.{axis} was not "
+                       f"done within {seconds(limit):g} s")
+        return self.time - t0
+
+    # -- results ----------------------------------------------------------
+    @property
+    def diagnostics(self) -> list[Any]:
+        """Compile-time and run-time diagnostics so far."""
+        return list(self.plc.diagnostics)
+
+    def warnings(self, contains: str = "") -> list[str]:
+        """Messages of the warnings so far (optionally containing a text)."""
+        return [d.message for d in self.plc.diagnostics
+                if d.severity == "warning" and contains in d.message]
+
+    @property
+    def coverage(self) -> Any:
+        """Network/output coverage (``instrument=True`` only, else None)."""
+        return self.plc.coverage
+
+
+class _Forced:
+    """The result of :meth:`Harness.force`: persistent, or a context manager."""
+
+    def __init__(self, h: Harness, addresses: list[str]) -> None:
+        self._h = h
+        self._addresses = addresses
+
+    def __enter__(self) -> Harness:
+        return self._h
+
+    def __exit__(self, *exc: Any) -> None:
+        for a in self._addresses:
+            if a.strip() in self._h.plc.forces:
+                self._h.plc.unforce(a)
+
+
+def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,
+                     cpu: str | None, instrument: bool) -> Plc:
+    """:func:`plcrt.load` for a program that is already parsed: the same
+    handling of the symbol table, data block and plant arguments."""
+    from ..engine.runtime import _text_or_path
+    from ..lang import parse_datablock, parse_symbols
+    if isinstance(plant, (str, Path, dict)):
+        from ..devices.plant import load_plant
+        plant = load_plant(plant)
+    if isinstance(symbols, (str, Path)):
+        symbols = parse_symbols(*_text_or_path(symbols))
+    if isinstance(data, (str, Path)):
+        data = parse_datablock(*_text_or_path(data))
+    return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
+               instrument=instrument)
+
+
+def _fmt(v: Value) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+__all__ = ["AxisState", "Harness", "PlcTimeout", "condition", "reader", "seconds"]

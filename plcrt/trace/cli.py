@@ -1,0 +1,139 @@
+"""The ``plcrt trace`` command: run a program and record signals per scan.
+
+::
+
+    plcrt trace PROGRAM... [--symbols F] [--data F] [--cpu NAME] [--plant F]
+        --signal SIG [--signal SIG]... [--scan-ms MS] (--seconds S | --scans N)
+        [--set ADDR=VALUE]... [--every N] [--csv F] [--plot F.png|F.svg] [--quiet]
+
+The run shows a progress bar on a terminal when it is long; then the CSV
+and the plot are written and the trend view (:func:`plcrt.trace.trend`) is
+printed on stdout.  With ``--quiet`` nothing but errors is printed.  After
+a run-time fault the samples recorded up to the fault are still written,
+and the exit status is 2.
+
+Presentation only: recording, formatting and plotting live in the other
+modules of :mod:`plcrt.trace`; options shared with ``plcrt run`` are parsed
+by the helpers of :mod:`plcrt.cli`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+from ..errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+
+
+def register(sub: Any) -> None:
+    """Add the ``trace`` subcommand to the ``plcrt`` parser."""
+    from ..cli import add_program_args
+
+    p = sub.add_parser(
+        "trace", help="run a program and record signals scan by scan (CSV, plot, sparklines)",
+        description="Run a program in simulated time, record the given signals after every "
+                    "scan (or every N-th), write them as CSV or a PNG/SVG plot and print a "
+                    "sparkline per signal.",
+        epilog="SIG is an address (I0.0, VW100, T37, T37:BIT, VD200:REAL), a symbol, or "
+               "axis<slot>.<axis>.<position|mechanical|speed> with --plant. "
+               "Each sample is taken at the end of a scan and stamped with the simulated "
+               "time then (the first 10 ms scan is at 0.01 s).")
+    add_program_args(p)
+    p.add_argument("--signal", action="append", required=True, metavar="SIG",
+                   help="a signal to record (repeat for more)")
+    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
+                   help="simulated scan time in ms (default 10)")
+    length = p.add_mutually_exclusive_group(required=True)
+    length.add_argument("--seconds", type=float, metavar="S", help="simulated seconds to run")
+    length.add_argument("--scans", type=int, metavar="N", help="number of scans to run")
+    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
+                   help="write before the first scan (inputs keep their value); "
+                        "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+    p.add_argument("--every", type=int, default=1, metavar="N",
+                   help="record after every N-th scan only (default 1: every scan)")
+    p.add_argument("--csv", metavar="F", help="write the samples to this CSV file")
+    p.add_argument("--plot", metavar="F",
+                   help="plot the signals to this file (.png or .svg; needs plcrt[plot])")
+    p.add_argument("--quiet", action="store_true",
+                   help="print nothing but errors (no progress bar, no trend, no warnings)")
+    p.set_defaults(func=cmd_trace)
+
+
+def cmd_trace(args: argparse.Namespace) -> int:
+    """``plcrt trace``: exit 0, 1 for bad input or options, 2 after a fault."""
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, _parse_set, _write,
+                       load_from_args, print_diagnostics)
+    from .plot import plot, plot_format, require_matplotlib
+    from .progress import run_with_progress
+    from .recorder import Trace
+    from .spark import trend
+
+    def report(diags: list[Diagnostic]) -> None:
+        print_diagnostics([d for d in diags if d.severity == "error"] if args.quiet
+                          else diags)
+
+    try:
+        if args.scans is not None and args.scans < 0:
+            raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
+        if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
+            raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+        if args.every < 1:
+            raise PlcConfigError(f"--every must be at least 1, got {args.every}")
+        if args.plot:
+            # before a long run: a wrong file name or a missing matplotlib
+            # should not cost the user the run
+            plot_format(args.plot)
+            require_matplotlib()
+        writes = [_parse_set(item) for item in args.set]
+        plc = load_from_args(args, args.scan_ms)
+        report(plc.diagnostics)
+        if "OB1" not in plc.unit.pous:
+            raise PlcConfigError("the program has no main program block (OB1), so there "
+                                 "is nothing to run; give the file with OB1 as well")
+        for addr, value, text in writes:
+            _write(plc, addr, value, text)
+        trace = Trace(plc, args.signal, every=args.every)
+    except PlcError as e:
+        print_diagnostics(e.diagnostics)
+        return EXIT_ERROR
+
+    fault: PlcError | None = None
+    loaded = len(plc.diagnostics)
+    try:
+        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=args.quiet)
+    except PlcRuntimeError as e:
+        fault = e
+    finally:
+        trace.detach()
+    report(plc.diagnostics[loaded:])
+
+    status = EXIT_OK
+    outputs = []
+    if args.csv:
+        outputs.append((args.csv, lambda: trace.to_csv(args.csv)))
+    if args.plot:
+        outputs.append((args.plot, lambda: plot(trace, args.plot,
+                                                title=", ".join(args.programs))))
+    for target, write in outputs:
+        try:
+            write()
+        except OSError as e:
+            print(f"plcrt: error: cannot write '{target}': {e.strerror or e}", file=sys.stderr)
+            status = EXIT_ERROR
+        except PlcError as e:   # a plot of an empty trace, say
+            print_diagnostics(e.diagnostics)
+            status = EXIT_ERROR
+
+    if not args.quiet:
+        print(f"{args.programs[0]}: {plc.scans} scan(s), {plc.time:g} s simulated, "
+              f"mode {plc.mode}")
+        print(trend(trace))
+    if fault is not None:
+        print_diagnostics(fault.diagnostics)
+        return EXIT_FAULT
+    return status
+
+
+__all__ = ["cmd_trace", "register"]

@@ -1,0 +1,324 @@
+"""Recording signals of a running program, one sample per scan.
+
+A :class:`Trace` is an observer of :class:`plcrt.Plc`: the engine calls it
+after every scan, once the outputs are written, and it appends the current
+value of each signal to a column.  The hot path only appends Python ints
+and floats to lists (or to bounded deques for ``limit=``); numpy arrays are
+built on first access and cached until the next sample.
+
+What a sample means: the state of memory and of the simulated axes at the
+*end* of a scan, stamped with the simulated time at that moment, which is
+``plc.time`` after the scan (scan 1 of a 10 ms program is stamped 0.01 s).
+A scan that faults is not recorded (the engine raises before observers run)
+and nothing is recorded in STOP mode (no scan runs).
+
+This module is not a plotter or a formatter (see :mod:`plcrt.trace.plot`
+and :mod:`plcrt.trace.spark`) and never changes the PLC's memory.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+import struct
+from collections import deque
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any, Callable, Sequence
+
+import numpy as np
+
+from ..errors import PlcAddressError, PlcConfigError, PlcError
+
+#: axis quantities a trace can record, and whether they are floats
+AXIS_QUANTITIES = {"position": False, "mechanical": False, "speed": True}
+
+_AXIS_RE = re.compile(r"axis(\d+)\.(\d+)\.(\w+)", re.IGNORECASE)
+_AXIS_PREFIX_RE = re.compile(r"axis\d*\.", re.IGNORECASE)
+_KINDS = ("REAL", "BIT")
+
+# perf: pre-built big-endian decoders, as the generated code uses
+_WORD = struct.Struct(">h").unpack_from
+_DWORD = struct.Struct(">i").unpack_from
+_REAL = struct.Struct(">f").unpack_from
+
+
+@dataclass(frozen=True)
+class Signal:
+    """One recorded signal: its name as given, its kind and its reader.
+
+    ``kind`` is ``"bit"`` (0/1), ``"int"`` (bytes unsigned, words and double
+    words signed, timer/counter values, axis positions) or ``"real"`` (REAL
+    double words, axis speed).
+    """
+
+    name: str
+    kind: str
+    read: Callable[[], int | float]
+
+    @property
+    def dtype(self) -> type:
+        return np.float64 if self.kind == "real" else np.int64
+
+
+def parse_signal(plc: Any, text: str) -> Signal:
+    """Validate one signal string against ``plc`` and build its reader.
+
+    Raises:
+        PlcConfigError: a malformed signal (unknown ``:suffix`` or axis quantity).
+        PlcAddressError: an address, symbol or axis that does not exist.
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise PlcConfigError(f"trace signal {text!r}: give an address, a symbol or "
+                             f"axis<slot>.<axis>.<quantity>")
+    name = text.strip()
+    if _AXIS_PREFIX_RE.match(name):
+        return _axis_signal(plc, name)
+    addr_text, kind = name, None
+    head, sep, tail = name.rpartition(":")
+    if sep:
+        if tail.strip().upper() not in _KINDS:
+            raise PlcConfigError(f"trace signal {name!r}: unknown suffix ':{tail}' "
+                                 f"(use ':REAL' for a float or ':BIT' for a timer or "
+                                 f"counter bit)")
+        addr_text, kind = head.strip(), tail.strip().upper()
+    try:
+        a = plc._addr(addr_text)
+    except PlcError as e:
+        raise PlcAddressError(f"trace signal {name!r}: {e.message}") from None
+    if kind == "BIT":
+        if a.area not in ("T", "C"):
+            raise PlcAddressError(f"trace signal {name!r}: ':BIT' is for timers and "
+                                  f"counters (T37:BIT, C5:BIT); a bit address needs no suffix")
+        a = type(a)(a.area, a.offset, 0, 0, a.text)
+    buf, off, width, bit = plc._locate(a)
+    if kind == "REAL":
+        if width != 4 or a.area in ("T", "C"):
+            raise PlcAddressError(f"trace signal {name!r}: a REAL needs a double word "
+                                  f"(VD, MD, ...)")
+        return Signal(name, "real", lambda: _REAL(buf, off)[0])
+    # perf: each reader is a closure over the buffer and offset found once
+    # here, so recording costs one call and one struct decode per signal.
+    if width == 0:
+        return Signal(name, "bit", lambda: buf[off] >> bit & 1)
+    if width == 1:
+        return Signal(name, "int", lambda: buf[off])
+    if width == 2:
+        return Signal(name, "int", lambda: _WORD(buf, off)[0])
+    return Signal(name, "int", lambda: _DWORD(buf, off)[0])
+
+
+def _axis_signal(plc: Any, name: str) -> Signal:
+    m = _AXIS_RE.fullmatch(name)
+    if m is None or m.group(3).lower() not in AXIS_QUANTITIES:
+        raise PlcConfigError(f"trace signal {name!r}: an axis signal is "
+                             f"axis<slot>.<axis>.<quantity> with quantity "
+                             f"{'|'.join(AXIS_QUANTITIES)}, e.g. axis0.0.speed")
+    slot, axis, quantity = int(m.group(1)), int(m.group(2)), m.group(3).lower()
+    if not plc.modules:
+        raise PlcAddressError(f"trace signal {name!r}: no plant is loaded, so there "
+                              f"are no axes (load the program with plant=... or --plant)")
+    try:
+        plc.axis(slot, axis)
+    except PlcError as e:
+        raise PlcAddressError(f"trace signal {name!r}: {e.message}") from None
+    kind = "real" if AXIS_QUANTITIES[quantity] else "int"
+    axes = getattr(plc.module(slot), "axes", None)
+    method = getattr(axes[axis], quantity, None) if isinstance(axes, list) else None
+    if callable(method):
+        # perf: ask the axis object directly for the value at the end of the
+        # scan instead of building the snapshot dictionaries of plc.axis().
+        return Signal(name, kind, lambda: method(plc._t_us))
+    return Signal(name, kind, lambda: plc.axis(slot, axis)[quantity])
+
+
+class Trace:
+    """Record signals of ``plc`` after every scan (or every ``every``-th).
+
+    Args:
+        plc: the running program.
+        signals: addresses (``I0.0``, ``VW100``, ``VD200:REAL``, ``T37``,
+            ``T37:BIT``, symbols) or axis quantities (``axis0.0.speed``).
+        every: record only after scans whose number (``plc.scans``, counted
+            from power-up) is a multiple of ``every``.
+        limit: keep only the last ``limit`` samples (a ring buffer).
+
+    The trace attaches itself to ``plc.observers``; :meth:`detach` (or
+    leaving a ``with`` block) stops the recording and keeps the samples.
+
+    Raises:
+        PlcConfigError, PlcAddressError: for a bad signal or option, before
+            anything is attached.
+    """
+
+    def __init__(self, plc: Any, signals: Sequence[str], *, every: int = 1,
+                 limit: int | None = None) -> None:
+        if isinstance(signals, str):
+            signals = [signals]
+        if not signals:
+            raise PlcConfigError("a trace needs at least one signal")
+        if not isinstance(every, int) or isinstance(every, bool) or every < 1:
+            raise PlcConfigError(f"every must be a whole number of scans >= 1, got {every!r}")
+        if limit is not None and (not isinstance(limit, int) or isinstance(limit, bool)
+                                  or limit < 1):
+            raise PlcConfigError(f"limit must be a number of samples >= 1, got {limit!r}")
+        parsed = [parse_signal(plc, s) for s in signals]
+        seen: set[str] = set()
+        for sig in parsed:
+            if sig.name in seen:
+                raise PlcConfigError(f"trace signal {sig.name!r} is given twice")
+            seen.add(sig.name)
+        self.plc = plc
+        self.every = every
+        self.limit = limit
+        self._signals = parsed
+        self._index = {s.name: i for i, s in enumerate(parsed)}
+
+        def column() -> Any:
+            return deque(maxlen=limit) if limit is not None else []
+
+        self._t_us = column()            # sample times, integer µs
+        self._cols = [column() for _ in parsed]
+        # perf: bound appends and readers, zipped once for the hot path
+        self._hot = tuple((c.append, s.read) for c, s in zip(self._cols, parsed))
+        self._t_append = self._t_us.append
+        self._recorded = 0               # samples ever taken (cache key)
+        self._cache: dict[Any, tuple[int, np.ndarray]] = {}
+        self.attached = False
+        self.attach()
+
+    # -- recording ---------------------------------------------------------
+    def _record(self, plc: Any) -> None:
+        if self.every != 1 and plc.scans % self.every:
+            return
+        self._t_append(plc._t_us)
+        for append, read in self._hot:
+            append(read())
+        self._recorded += 1
+
+    def attach(self) -> None:
+        """(Re)start recording; called by the constructor."""
+        if not self.attached:
+            self.plc.observers.append(self._record)
+            self.attached = True
+
+    def detach(self) -> None:
+        """Stop recording (the samples stay); calling it twice is harmless."""
+        if self.attached:
+            obs = self.plc.observers
+            for i, fn in enumerate(obs):
+                if fn == self._record:
+                    del obs[i]
+                    break
+            self.attached = False
+
+    def __enter__(self) -> Trace:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.detach()
+
+    # -- access --------------------------------------------------------------
+    @property
+    def names(self) -> list[str]:
+        """The signal names, in the order given."""
+        return [s.name for s in self._signals]
+
+    def kind(self, name: str) -> str:
+        """``"bit"``, ``"int"`` or ``"real"`` (see :class:`Signal`)."""
+        return self._signals[self._lookup(name)].kind
+
+    def __len__(self) -> int:
+        return len(self._t_us)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._index
+
+    def _lookup(self, name: str) -> int:
+        try:
+            return self._index[name.strip() if isinstance(name, str) else name]
+        except KeyError:
+            raise KeyError(f"no signal {name!r} in this trace "
+                           f"(signals: {', '.join(self.names)})") from None
+
+    def _cached(self, key: Any, build: Callable[[], np.ndarray]) -> np.ndarray:
+        hit = self._cache.get(key)
+        if hit is not None and hit[0] == self._recorded:
+            return hit[1]
+        arr = build()
+        arr.flags.writeable = False   # shared by later calls: keep it intact
+        self._cache[key] = (self._recorded, arr)
+        return arr
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times in simulated seconds (float64), one per sample."""
+        return self._cached("time", lambda: np.array(self._t_us, dtype=np.int64) / 1e6)
+
+    def array(self, name: str) -> np.ndarray:
+        """The samples of one signal: int64, or float64 for REAL and speed."""
+        i = self._lookup(name)
+        sig = self._signals[i]
+        return self._cached(i, lambda: np.array(self._cols[i], dtype=sig.dtype))
+
+    __getitem__ = array
+
+    def last(self, n: int = 1) -> list[tuple[int | float, ...]]:
+        """The last ``n`` samples as rows ``(time_s, value, ...)``."""
+        return self._rows(max(0, len(self) - n), len(self))
+
+    def _rows(self, start: int, stop: int) -> list[tuple[int | float, ...]]:
+        cols = [self.time] + [self.array(s.name) for s in self._signals]
+        return [tuple(c[k].item() for c in cols) for k in range(start, stop)]
+
+    def changes(self, name: str) -> np.ndarray:
+        """Times of the samples whose value differs from the sample before."""
+        v = self.array(name)
+        differ = v[1:] != v[:-1]
+        if v.dtype.kind == "f":
+            differ &= ~(np.isnan(v[1:]) & np.isnan(v[:-1]))   # NaN stays NaN
+        return self.time[1:][differ]
+
+    def table(self, n: int = 10) -> list[list[str]]:
+        """The last ``n`` samples as text: a header row, then one row each."""
+        rows = [["time_s", *self.names]]
+        for row in self.last(n):
+            rows.append([repr(row[0])] + [format_value(v) for v in row[1:]])
+        return rows
+
+    def to_csv(self, path_or_file: str | Path | IO[str]) -> None:
+        """Write ``time_s,<names>`` and one row per sample.
+
+        Bits are 0/1, integers in decimal, floats (REAL, speed, time) with
+        ``repr`` precision, so reading the file back gives the same numbers.
+        """
+        if isinstance(path_or_file, (str, Path)):
+            with open(path_or_file, "w", encoding="utf-8", newline="") as f:
+                self._write_csv(f)
+        else:
+            self._write_csv(path_or_file)
+
+    def _write_csv(self, f: IO[str]) -> None:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["time_s", *self.names])
+        fmt = [repr if s.kind == "real" else str for s in self._signals]
+        cols = [[float(v) if s.kind == "real" else v for v in c]
+                for s, c in zip(self._signals, self._cols)]
+        for k, t in enumerate(self._t_us):
+            w.writerow([repr(t / 1e6)] + [f(c[k]) for f, c in zip(fmt, cols)])
+
+    def __repr__(self) -> str:
+        state = "recording" if self.attached else "detached"
+        return f"<Trace {', '.join(self.names)}: {len(self)} sample(s), {state}>"
+
+
+def format_value(value: int | float) -> str:
+    """A value for people: integers as they are, floats with 7 significant
+    digits (what a REAL holds)."""
+    if isinstance(value, float):
+        return f"{value:.7g}" if math.isfinite(value) else str(value)
+    return str(value)
+
+
+__all__ = ["AXIS_QUANTITIES", "Signal", "Trace", "format_value", "parse_signal"]

@@ -61,7 +61,8 @@ class Shape(NamedTuple):
 
     kind: str            #: contact, modifier, stack, coil, box, rail
     inputs: int = 0      #: power-flow inputs taken from the logic stack
-    op: str = ""         #: contacts: load, and, or
+    op: str = ""         #: contacts: load, and, or; stack: and, or, push, read,
+    #:                       pop, copy (LDS), eno (AENO)
     negated: bool = False
     immediate: bool = False
     compare: str = ""    #: compare contacts: "B=", "W<>", "R>=", ...
@@ -69,7 +70,9 @@ class Shape(NamedTuple):
     pins: str = ""       #: where the operands are drawn (see module docstring)
 
 
-_STACK = {"ALD", "OLD", "LPS", "LRD", "LPP", "LDS", "AENO"}
+#: stack instructions and what they do to the rung (the ``op`` of their shape)
+_STACK = {"ALD": "and", "OLD": "or", "LPS": "push", "LRD": "read", "LPP": "pop",
+          "LDS": "copy", "AENO": "eno"}
 _MODIFIERS = {"NOT", "EU", "ED"}
 _COILS = {"=", "=I", "S", "R", "SI", "RI", "JMP", "SCRT", "CSCRE", "CRET",
           "STOP", "WDR", "END"}
@@ -175,7 +178,7 @@ def shape(mnemonic: str) -> Shape:
     m = mnemonic.upper()
     lad, pins = _LAD.get(m, ("", ""))
     if m in _STACK:
-        return Shape("stack")
+        return Shape("stack", op=_STACK[m])
     if m in _MODIFIERS:
         return Shape("modifier", 1, lad=lad)
     if m in _COILS:

@@ -1,0 +1,160 @@
+"""``plcrt debug PROGRAM...``: the debugger on a terminal, a script or a pipe.
+
+This module only connects a :class:`~plcrt.debug.session.Session` to the
+outside world: it loads the program with instrumentation, applies
+``--break`` and ``--watch``, and chooses how commands arrive:
+
+* stdin is a terminal (and no ``--script``): a ``(plcrt)`` prompt with
+  readline editing and history when Python has readline, colours in the
+  ladder view, Ctrl-C stops a run between two scans;
+* ``--script FILE`` or a pipe: no prompt, each command is echoed as
+  ``(plcrt) <command>`` before its output so the transcript reads well,
+  plain text only.
+
+Exit status: 0 every command succeeded, 1 a command reported an error (or
+the program or options are bad), 2 the PLC faulted.  What the commands do
+is the session's business, not this module's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from ..cli import EXIT_ERROR, PROG, add_program_args, print_diagnostics
+from ..errors import PlcConfigError, PlcError
+
+#: readline history of interactive sessions (kept between sessions)
+HISTORY_FILE = "~/.plcrt_debug_history"
+
+
+def register(sub: Any) -> None:
+    """Add the ``debug`` subcommand to the ``plcrt`` parser."""
+    p = sub.add_parser(
+        "debug", help="interactive debugger: breakpoints inside a scan, watch, force",
+        description="Debug a program in simulated time: stop before a network inside a "
+                    "scan, step network by network, watch, set and force addresses, draw "
+                    "networks with live values, look at EM253 axes.  Commands come from "
+                    "the terminal, from --script FILE or from a pipe (type 'help' for "
+                    "the list; docs/debugger.md describes them).",
+        epilog="Exit status: 0 ok, 1 a command or the input had an error, "
+               "2 run-time fault of the PLC program.")
+    add_program_args(p)
+    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
+                   help="simulated scan time in ms (default 10)")
+    p.add_argument("--script", metavar="FILE",
+                   help="read the commands from FILE instead of stdin")
+    p.add_argument("--break", dest="breaks", action="append", default=[], metavar="NET",
+                   help="breakpoint before network NET (OB1/3, SBR0/1, or 3 for OB1/3)")
+    p.add_argument("--watch", action="append", default=[], metavar="ADDR",
+                   help="watch this address from the start; ADDR:REAL reads a float")
+    p.set_defaults(func=cmd_debug)
+
+
+def cmd_debug(args: argparse.Namespace) -> int:
+    """Load, set up, run the session; returns the exit status."""
+    from ..engine.runtime import load
+    from .session import CommandError, Session
+
+    script: list[str] | None = None
+    if args.script is not None:
+        try:
+            script = Path(args.script).read_text(encoding="utf-8").splitlines()
+        except (OSError, UnicodeDecodeError) as e:
+            reason = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
+            print(f"{PROG}: error: cannot read the script {args.script}: {reason}",
+                  file=sys.stderr)
+            return EXIT_ERROR
+    try:
+        data, plant = getattr(args, "data", None), getattr(args, "plant", None)
+        # Path objects make load() read files, never take the argument as text;
+        # instrument=True compiles the network probes breakpoints use.
+        plc = load([Path(p) for p in args.programs],
+                   symbols=Path(args.symbols) if args.symbols else None,
+                   data=Path(data) if data else None,
+                   plant=Path(plant) if plant else None,
+                   scan_ms=args.scan_ms, cpu=args.cpu, instrument=True)
+        print_diagnostics(plc.diagnostics)  # warnings
+        if "OB1" not in plc.unit.pous:
+            raise PlcConfigError("the program has no main program block (OB1), so there "
+                                 "is nothing to run; give the file with OB1 as well")
+    except PlcError as e:
+        print_diagnostics(e.diagnostics)
+        return EXIT_ERROR
+
+    interactive = script is None and _isatty(sys.stdin)
+    session = Session(plc, sys.stdout, echo=not interactive,
+                      color=interactive and _isatty(sys.stdout),
+                      handle_interrupt=interactive)
+    for option, values, apply in (("--break", args.breaks, session.add_breakpoint),
+                                  ("--watch", args.watch, session.add_watch)):
+        for value in values:
+            try:
+                apply(value)
+            except CommandError as e:
+                print(f"{PROG}: error: {option} {value}: {e}", file=sys.stderr)
+                return EXIT_ERROR
+            except PlcError as e:
+                print(f"{PROG}: error: {option} {value}: {e.message}", file=sys.stderr)
+                return EXIT_ERROR
+
+    if script is not None:
+        return session.run(script)
+    if not interactive:
+        return session.run(sys.stdin)
+    print(session.banner())
+    with _history():
+        return session.run(readline=_ask)
+
+
+def _ask(prompt: str) -> str | None:
+    """One line from the terminal; None at Ctrl-D."""
+    try:
+        return input(prompt)
+    except EOFError:
+        print()
+        return None
+    except KeyboardInterrupt:
+        # Ctrl-C at the prompt drops the line being typed, as in a shell.
+        print("^C")
+        return ""
+
+
+def _isatty(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):
+        return False
+
+
+class _history:
+    """readline editing and a history kept between sessions, when Python
+    has readline; nothing otherwise (the session works without it)."""
+
+    def __enter__(self) -> None:
+        try:
+            import readline
+        except ImportError:
+            self._readline: Any = None
+            return
+        self._readline = readline
+        self._path = os.path.expanduser(HISTORY_FILE)
+        try:
+            readline.read_history_file(self._path)
+        except OSError:
+            pass  # no history yet
+        readline.set_history_length(1000)
+
+    def __exit__(self, *exc: object) -> None:
+        if self._readline is None:
+            return
+        try:
+            self._readline.write_history_file(self._path)
+        except OSError:
+            pass  # a read-only home: the history is lost, the session was not
+
+
+__all__ = ["cmd_debug", "register"]

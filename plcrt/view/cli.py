@@ -1,0 +1,150 @@
+"""The ``plcrt show`` subcommand: networks drawn as ladder (LAD), with live
+status after a run (``--status``).
+
+Registered by :mod:`plcrt.cli` through :func:`register`.  Only argument
+handling and printing live here; the drawing is :mod:`plcrt.view.render`.
+rich and the renderer are imported when the command runs, so building the
+parser for other commands stays cheap.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+_NET_RE = re.compile(r"(?:([^/]+)/)?(\d+)$")
+
+
+def register(sub: Any) -> None:
+    """Add ``show`` to the subparsers of the ``plcrt`` command."""
+    from ..cli import add_program_args
+
+    p = sub.add_parser(
+        "show", help="draw networks as ladder (LAD), optionally with live status",
+        description="Draw a program's networks as ladder diagrams (LAD) in the terminal, "
+                    "as Micro/WIN shows them; networks without a LAD form are shown as STL. "
+                    "With --status the program runs first and the drawing shows power flow "
+                    "and values at the end of the last scan.")
+    add_program_args(p)
+    p.add_argument("--network", action="append", default=[], metavar="ID",
+                   help="only this network: OB1/3, SBR0/1 or a number (of OB1); repeatable")
+    p.add_argument("--stl", action="store_true", help="show the STL text instead of LAD")
+    p.add_argument("--status", action="store_true",
+                   help="run the program, then draw with power flow and values")
+    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
+                   help="simulated scan time in ms (default 10)")
+    length = p.add_mutually_exclusive_group()
+    length.add_argument("--seconds", type=float, metavar="S",
+                        help="with --status: simulated seconds to run")
+    length.add_argument("--scans", type=int, metavar="N",
+                        help="with --status: number of scans to run (default 1)")
+    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
+                   help="with --status: write before the first scan (inputs keep their value)")
+    p.set_defaults(func=cmd_show)
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    """``plcrt show``: 0 ok, 1 an input or option error, 2 a PLC fault while
+    running for --status (the drawing then shows the state at the fault)."""
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, _parse_set, _write, load_from_args,
+                       print_diagnostics)
+    from ..engine.runtime import parse_sources
+    from ..errors import PlcConfigError, PlcError, PlcRuntimeError
+
+    fault: PlcError | None = None
+    try:
+        _check_options(args, PlcConfigError)
+        if args.status:
+            writes = [_parse_set(item) for item in args.set]
+            plc = load_from_args(args, args.scan_ms)
+            print_diagnostics(plc.diagnostics)
+            if "OB1" not in plc.unit.pous:
+                raise PlcConfigError("--status needs the main program block (OB1) to run; "
+                                     "give the file with OB1 as well")
+            for addr, value, text in writes:
+                _write(plc, addr, value, text)
+            program = plc.program
+        else:
+            program = parse_sources([Path(p) for p in args.programs])
+        selected = _select(program, args.network, PlcConfigError)
+    except PlcError as e:
+        print_diagnostics(e.diagnostics)
+        return EXIT_ERROR
+
+    status = None
+    if args.status:
+        from .status import PlcStatus
+        loaded = len(plc.diagnostics)
+        try:
+            if args.seconds is not None:
+                plc.run(seconds=args.seconds)
+            else:
+                plc.run(scans=1 if args.scans is None else args.scans)
+        except PlcRuntimeError as e:
+            fault = e
+        print_diagnostics(plc.diagnostics[loaded:])
+        status = PlcStatus(plc)
+
+    from rich.console import Console
+
+    from .render import render_program
+
+    # soft_wrap: a wide rung stays one line per row when piped, instead of
+    # being folded at 80 columns; highlight off: no guessed colours.
+    console = Console(highlight=False, soft_wrap=True)
+    if status is not None:
+        console.print(f"status after {plc.scans} scan(s), {plc.time:g} s simulated, "
+                      f"mode {plc.mode}", markup=False)
+    texts = render_program(program, status=status, networks=selected,
+                           styled=console.is_terminal, stl=args.stl)
+    for i, text in enumerate(texts):
+        console.print(text)
+        if i + 1 < len(texts):
+            console.print()  # a blank line between networks, as Micro/WIN spaces them
+    if fault is not None:
+        print_diagnostics(fault.diagnostics)
+        return EXIT_FAULT
+    return EXIT_OK
+
+
+def _check_options(args: argparse.Namespace, error: type) -> None:
+    if not args.status:
+        given = [name for name, on in (("--set", args.set),
+                                       ("--seconds", args.seconds is not None),
+                                       ("--scans", args.scans is not None)) if on]
+        if given:
+            raise error(f"{', '.join(given)} only make(s) sense with --status")
+    if args.scans is not None and args.scans < 0:
+        raise error(f"--scans must not be negative, got {args.scans}")
+    if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
+        raise error(f"--seconds must be a non-negative number, got {args.seconds}")
+
+
+def _select(program: Any, specs: list[str], error: type) -> list[tuple[str, int]] | None:
+    """``--network`` values as (block id, number) pairs; None = all."""
+    if not specs:
+        return None
+    out = []
+    for spec in specs:
+        m = _NET_RE.match(spec.strip())
+        if m is None:
+            raise error(f"--network {spec}: use BLOCK/N (OB1/3, SBR0/1) or a number")
+        block, number = (m.group(1) or "OB1").strip(), int(m.group(2))
+        pou = next((p for p in program.pous
+                    if block.upper() in (p.ident.upper(), p.name.upper())), None)
+        if pou is None:
+            names = ", ".join(p.ident for p in program.pous) or "none"
+            raise error(f"--network {spec}: no block {block} (blocks: {names})")
+        numbers = [n.number for n in pou.networks]
+        if number not in numbers:
+            have = f"{min(numbers)}..{max(numbers)}" if numbers else "none"
+            raise error(f"--network {spec}: {pou.ident} has no network {number} "
+                        f"(networks {have})")
+        out.append((pou.ident, number))
+    return out
+
+
+__all__ = ["cmd_show", "register"]

@@ -190,6 +190,10 @@ class Harness:
                    scan_ms=scan_ms, cpu=cpu, instrument=instrument)
         return cls(plc, watch=watch, history=history)
 
+    def __repr__(self) -> str:
+        return (f"<Harness {Path(self.name).name} t={self.time:.3f} s "
+                f"scan {self.scans} {self.plc.mode}>")
+
     # -- watching ---------------------------------------------------------
     def watch(self, *addresses: str) -> Harness:
         """Add addresses to the per-scan history (``VD4:REAL`` reads a float)."""
@@ -261,6 +265,7 @@ class Harness:
         """Scan until ``cond`` holds after a scan; return the simulated seconds
         that took.  Fails with :class:`PlcTimeout` when ``timeout`` (simulated)
         passes first, or the CPU goes to STOP."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         t0 = self.plc.now_us
         limit = self._scans_for(timeout)
@@ -277,12 +282,14 @@ class Harness:
 
     def run_while(self, cond: Condition, *, timeout: Duration = 10.0, message: str = "") -> float:
         """Scan while ``cond`` holds (the opposite of :meth:`run_until`)."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         return self.run_until(lambda: not pred(), timeout=timeout,
                               message=message or f"{what!r} stayed true")
 
     def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
         """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         plc = self.plc
         for _ in range(self._scans_for(duration)):
@@ -293,6 +300,7 @@ class Harness:
         return self
 
     def _timeout(self, text: str, message: str, exc: type[AssertionError] = PlcTimeout) -> None:
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         parts = [message, text] if message else [text]
         parts.append(f"at t = {self.time:.3f} s, scan {self.scans}")
         raise exc("; ".join(parts))
@@ -418,18 +426,21 @@ class Harness:
     def wait_axis_moving(self, slot: int = 0, axis: int = 0, *,
                          timeout: Duration = 1.0) -> float:
         """Run until the axis moves; seconds it took."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not start")
 
     def wait_axis_stopped(self, slot: int = 0, axis: int = 0, *,
                           timeout: Duration = 60.0) -> float:
         """Run until the axis stands still; seconds it took."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not stop")
 
     def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
         """Assert a move that is running (or about to start within a few
         scans) ends within ``limit`` simulated seconds; returns its time."""
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
         t0 = self.time
         if not self.axis(slot, axis).moving:
             self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))

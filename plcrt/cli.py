@@ -1,4 +1,12 @@
-"""The ``plcrt`` command line: ``check``, ``run`` and ``dump``.
+"""The ``plcrt`` command line: ``check``, ``run`` and ``dump``, and the
+options and steps the commands that run a program share.
+
+``show``, ``debug`` and ``trace`` are defined beside what they present
+(:mod:`plcrt.view.cli`, :mod:`plcrt.debug.cli`, :mod:`plcrt.trace.cli`) and
+registered here; they declare ``--scan-ms``, ``--seconds``/``--scans`` and
+``--set`` and load the program with the public helpers of this module
+(:func:`add_run_length_args`, :func:`add_set_args`, :func:`load_for_run`,
+...), so the options read and behave the same in every command.
 
 This module is the presentation layer only.  It turns command-line
 arguments into calls of the public API (:func:`plcrt.load`, :class:`plcrt.Plc`)
@@ -29,9 +37,9 @@ import math
 import os
 import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn, TextIO
+from typing import Any, NamedTuple, NoReturn, TextIO
 
 from . import __version__
 from .engine.runtime import Plc, load
@@ -148,14 +156,9 @@ def _build_parser() -> _Parser:
     p = sub.add_parser("run", help="run a program for a simulated time or number of scans",
                        description="Run a program in simulated time and print watched values.")
     common(p)
-    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
-                   help="simulated scan time in ms (default 10)")
-    length = p.add_mutually_exclusive_group(required=True)
-    length.add_argument("--seconds", type=float, metavar="S", help="simulated seconds to run")
-    length.add_argument("--scans", type=int, metavar="N", help="number of scans to run")
-    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
-                   help="write before the first scan (inputs keep their value); "
-                        "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+    add_scan_ms_arg(p)
+    add_run_length_args(p)
+    add_set_args(p)
     p.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="print this address at the end; ADDR:REAL reads a float")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
@@ -186,8 +189,10 @@ def _build_parser() -> _Parser:
 # Commands
 # ---------------------------------------------------------------------------
 
-def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
-    """Load the program named on the command line (raises PlcError)."""
+def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
+                   instrument: bool = False) -> Plc:
+    """Load the program named on the command line (raises PlcError);
+    ``instrument`` compiles the network probes breakpoints use."""
     data = getattr(args, "data", None)
     plant = getattr(args, "plant", None)
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
@@ -196,7 +201,7 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0) -> Plc:
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
-                plant=Path(plant) if plant else None)
+                plant=Path(plant) if plant else None, instrument=instrument)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -231,19 +236,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         print_diagnostics([d for d in diags if d.severity == "error"] if quiet else diags)
 
     try:
-        if args.scans is not None and args.scans < 0:
-            raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
-        if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
-            raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
-        writes = [_parse_set(item) for item in args.set]
+        check_run_length(args)
+        writes = parse_sets(args.set)
         watches = [_parse_watch(item) for item in args.watch]
-        plc = load_from_args(args, args.scan_ms)
-        report(plc.diagnostics)  # warnings
-        if "OB1" not in plc.unit.pous:
-            raise PlcConfigError("the program has no main program block (OB1), so there "
-                                 "is nothing to run; give the file with OB1 as well")
-        for addr, value, text in writes:
-            _write(plc, addr, value, text)
+        plc = load_for_run(args, writes, report=report)
         for spec, addr, kind in watches:
             plc.read(addr, kind)  # reject a bad address before running
     except PlcError as e:
@@ -374,8 +370,118 @@ def _stl_line(texts: dict[str, list[str]], file: str | None, lineno: int) -> str
 
 
 # ---------------------------------------------------------------------------
-# run: --set / --watch
+# What the commands that run a program share (run, trace, show, debug)
 # ---------------------------------------------------------------------------
+
+#: help of ``--set`` (``show`` says when it applies first)
+SET_HELP = ("write before the first scan (inputs keep their value); "
+            "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+
+#: why a program without OB1 cannot run
+NO_OB1 = ("the program has no main program block (OB1), so there is nothing to run; "
+          "give the file with OB1 as well")
+
+
+def add_scan_ms_arg(p: argparse.ArgumentParser) -> None:
+    """``--scan-ms MS``, the simulated scan time (``args.scan_ms``, default 10)."""
+    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
+                   help="simulated scan time in ms (default 10)")
+
+
+def add_run_length_args(p: argparse.ArgumentParser, *, required: bool = True,
+                        seconds_help: str = "simulated seconds to run",
+                        scans_help: str = "number of scans to run") -> None:
+    """``--seconds S`` or ``--scans N`` (one of them; both None when neither
+    is given and not ``required``).  :func:`check_run_length` checks them."""
+    length = p.add_mutually_exclusive_group(required=required)
+    length.add_argument("--seconds", type=float, metavar="S", help=seconds_help)
+    length.add_argument("--scans", type=int, metavar="N", help=scans_help)
+
+
+def add_set_args(p: argparse.ArgumentParser, *, help: str = SET_HELP) -> None:
+    """``--set ADDR=VALUE``, repeatable (``args.set``, a list of strings for
+    :func:`parse_sets`)."""
+    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help=help)
+
+
+def check_run_length(args: argparse.Namespace) -> None:
+    """Reject a negative ``--scans`` and a negative or infinite ``--seconds``.
+
+    Raises:
+        PlcConfigError: naming the option.
+    """
+    if args.scans is not None and args.scans < 0:
+        raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
+    if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
+        raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+
+
+class SetItem(NamedTuple):
+    """One ``--set ADDR=VALUE``, parsed."""
+
+    addr: str
+    value: int | float
+    #: the argument as given, for messages
+    item: str
+
+
+def parse_sets(items: Sequence[str]) -> list[SetItem]:
+    """Parse ``--set`` arguments (before loading, so a typo is reported
+    without waiting for the program).
+
+    Raises:
+        PlcConfigError: for an item that is not ADDR=VALUE or a bad value.
+    """
+    out = []
+    for item in items:
+        addr, sep, value = item.partition("=")
+        if not sep or not addr.strip() or not value.strip():
+            raise PlcConfigError(f"--set needs ADDR=VALUE, got '{item}'")
+        out.append(SetItem(addr.strip(), parse_value(value), item))
+    return out
+
+
+def apply_sets(plc: Plc, sets: Sequence[SetItem]) -> None:
+    """Write parsed ``--set`` values in order, refusing silent truncation
+    of a real.
+
+    Raises:
+        PlcConfigError: a bad address, or a real for anything but a double word.
+    """
+    for addr, value, item in sets:
+        if isinstance(value, float):
+            plc.read(addr)  # a bad address is reported as such first
+            try:
+                is_dword = isinstance(plc.read(addr, "REAL"), float)
+            except PlcError:
+                is_dword = False
+            if not is_dword:
+                raise PlcConfigError(f"--set {item}: a real value needs a double word "
+                                     f"address (VD, MD, ...)")
+        try:
+            plc.write(addr, value)
+        except PlcError as e:
+            raise PlcConfigError(f"--set {item}: {e.message}") from None
+
+
+def load_for_run(args: argparse.Namespace, sets: Sequence[SetItem] = (), *,
+                 report: Callable[[Sequence[Diagnostic]], None] | None = None,
+                 instrument: bool = False, no_ob1: str = NO_OB1) -> Plc:
+    """Load the program of a command that runs it (``--scan-ms`` and the
+    program options), report the load-time warnings (``report``, default
+    :func:`print_diagnostics`), require OB1 (else ``no_ob1``) and write the
+    ``--set`` values.
+
+    Raises:
+        PlcError: the program does not load, has no OB1, or a write fails.
+    """
+    plc = load_from_args(args, args.scan_ms, instrument=instrument)
+    (report or print_diagnostics)(plc.diagnostics)  # warnings
+    if "OB1" not in plc.unit.pous:
+        raise PlcConfigError(no_ob1)
+    apply_sets(plc, sets)
+    return plc
+
 
 def parse_value(text: str) -> int | float:
     """Parse a --set value: decimal, ``16#hex``, ``2#binary`` or a real.
@@ -398,12 +504,9 @@ def parse_value(text: str) -> int | float:
                          f"2#binary or a real (1.5, 2e3)")
 
 
-def _parse_set(item: str) -> tuple[str, int | float, str]:
-    addr, sep, value = item.partition("=")
-    if not sep or not addr.strip() or not value.strip():
-        raise PlcConfigError(f"--set needs ADDR=VALUE, got '{item}'")
-    return addr.strip(), parse_value(value), item
-
+# ---------------------------------------------------------------------------
+# run: --watch and the output
+# ---------------------------------------------------------------------------
 
 def _parse_watch(item: str) -> tuple[str, str, str | None]:
     """(key for the output, address, read kind) of one --watch argument."""
@@ -418,23 +521,6 @@ def _parse_watch(item: str) -> tuple[str, str, str | None]:
     if not spec:
         raise PlcConfigError("--watch needs an address")
     return spec, spec, None
-
-
-def _write(plc: Plc, addr: str, value: int | float, item: str) -> None:
-    """Write one --set value, refusing silent truncation of a real."""
-    if isinstance(value, float):
-        plc.read(addr)  # a bad address is reported as such first
-        try:
-            is_dword = isinstance(plc.read(addr, "REAL"), float)
-        except PlcError:
-            is_dword = False
-        if not is_dword:
-            raise PlcConfigError(f"--set {item}: a real value needs a double word "
-                                 f"address (VD, MD, ...)")
-    try:
-        plc.write(addr, value)
-    except PlcError as e:
-        raise PlcConfigError(f"--set {item}: {e.message}") from None
 
 
 def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int | float],
@@ -587,4 +673,7 @@ def _silence_stdout() -> None:
         pass
 
 
-__all__ = ["main", "parse_value", "render_dump"]
+__all__ = ["NO_OB1", "SET_HELP", "SetItem", "add_program_args", "add_run_length_args",
+           "add_scan_ms_arg", "add_set_args", "apply_sets", "check_run_length",
+           "load_for_run", "load_from_args", "main", "parse_sets", "parse_value",
+           "print_diagnostics", "render_dump"]

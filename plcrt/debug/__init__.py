@@ -1,9 +1,12 @@
 """``plcrt debug``: an interactive, scriptable debugger for a loaded PLC.
 
-:mod:`plcrt.debug.session` is the command interpreter (breakpoints on
-networks, stepping inside a scan, watch, set, force, the ladder view with
-live values, the EM253 axes); :mod:`plcrt.debug.cli` is the ``plcrt debug``
-subcommand that wires it to a terminal, a script file or a pipe.
+:mod:`plcrt.debug.session` is the command interpreter (the input loop,
+breakpoints on networks and the paused mode inside a scan);
+:mod:`plcrt.debug.commands` holds its commands (scan, run, break, watch,
+set, force, show, axes, ...) and :mod:`plcrt.debug.panels` the tables and
+the ladder view with live values they print; :mod:`plcrt.debug.cli` is the
+``plcrt debug`` subcommand that wires a session to a terminal, a script file
+or a pipe.
 
 This package does not run PLC code itself: every scan is
 :meth:`plcrt.Plc.scan`, and breakpoints are the probes an instrumented

@@ -24,8 +24,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..cli import EXIT_ERROR, PROG, add_program_args, print_diagnostics
-from ..errors import PlcConfigError, PlcError
+from ..cli import (EXIT_ERROR, PROG, add_program_args, add_scan_ms_arg, load_for_run,
+                   print_diagnostics)
+from ..errors import PlcError
 
 #: readline history of interactive sessions (kept between sessions)
 HISTORY_FILE = "~/.plcrt_debug_history"
@@ -43,8 +44,7 @@ def register(sub: Any) -> None:
         epilog="Exit status: 0 ok, 1 a command or the input had an error, "
                "2 run-time fault of the PLC program.")
     add_program_args(p)
-    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
-                   help="simulated scan time in ms (default 10)")
+    add_scan_ms_arg(p)
     p.add_argument("--script", metavar="FILE",
                    help="read the commands from FILE instead of stdin")
     p.add_argument("--break", dest="breaks", action="append", default=[], metavar="NET",
@@ -56,7 +56,6 @@ def register(sub: Any) -> None:
 
 def cmd_debug(args: argparse.Namespace) -> int:
     """Load, set up, run the session; returns the exit status."""
-    from ..engine.runtime import load
     from .session import CommandError, Session
 
     script: list[str] | None = None
@@ -69,18 +68,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return EXIT_ERROR
     try:
-        data, plant = getattr(args, "data", None), getattr(args, "plant", None)
-        # Path objects make load() read files, never take the argument as text;
-        # instrument=True compiles the network probes breakpoints use.
-        plc = load([Path(p) for p in args.programs],
-                   symbols=Path(args.symbols) if args.symbols else None,
-                   data=Path(data) if data else None,
-                   plant=Path(plant) if plant else None,
-                   scan_ms=args.scan_ms, cpu=args.cpu, instrument=True)
-        print_diagnostics(plc.diagnostics)  # warnings
-        if "OB1" not in plc.unit.pous:
-            raise PlcConfigError("the program has no main program block (OB1), so there "
-                                 "is nothing to run; give the file with OB1 as well")
+        # instrument=True compiles the network probes breakpoints use
+        plc = load_for_run(args, instrument=True)
     except PlcError as e:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR

@@ -20,8 +20,8 @@ by the helpers of :mod:`plcrt.cli`.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
+from collections.abc import Sequence
 from typing import Any
 
 from ..errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
@@ -29,7 +29,7 @@ from ..errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
 
 def register(sub: Any) -> None:
     """Add the ``trace`` subcommand to the ``plcrt`` parser."""
-    from ..cli import add_program_args
+    from ..cli import add_program_args, add_run_length_args, add_scan_ms_arg, add_set_args
 
     p = sub.add_parser(
         "trace", help="run a program and record signals scan by scan (CSV, plot, sparklines)",
@@ -43,14 +43,9 @@ def register(sub: Any) -> None:
     add_program_args(p)
     p.add_argument("--signal", action="append", required=True, metavar="SIG",
                    help="a signal to record (repeat for more)")
-    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
-                   help="simulated scan time in ms (default 10)")
-    length = p.add_mutually_exclusive_group(required=True)
-    length.add_argument("--seconds", type=float, metavar="S", help="simulated seconds to run")
-    length.add_argument("--scans", type=int, metavar="N", help="number of scans to run")
-    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
-                   help="write before the first scan (inputs keep their value); "
-                        "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+    add_scan_ms_arg(p)
+    add_run_length_args(p)
+    add_set_args(p)
     p.add_argument("--every", type=int, default=1, metavar="N",
                    help="record after every N-th scan only (default 1: every scan)")
     p.add_argument("--csv", metavar="F", help="write the samples to this CSV file")
@@ -63,22 +58,19 @@ def register(sub: Any) -> None:
 
 def cmd_trace(args: argparse.Namespace) -> int:
     """``plcrt trace``: exit 0, 1 for bad input or options, 2 after a fault."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, _parse_set, _write,
-                       load_from_args, print_diagnostics)
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, check_run_length, load_for_run,
+                       parse_sets, print_diagnostics)
     from .plot import plot, plot_format, require_matplotlib
     from .progress import run_with_progress
     from .recorder import Trace
     from .spark import trend
 
-    def report(diags: list[Diagnostic]) -> None:
+    def report(diags: Sequence[Diagnostic]) -> None:
         print_diagnostics([d for d in diags if d.severity == "error"] if args.quiet
                           else diags)
 
     try:
-        if args.scans is not None and args.scans < 0:
-            raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
-        if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
-            raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+        check_run_length(args)
         if args.every < 1:
             raise PlcConfigError(f"--every must be at least 1, got {args.every}")
         if args.plot:
@@ -86,14 +78,8 @@ def cmd_trace(args: argparse.Namespace) -> int:
             # should not cost the user the run
             plot_format(args.plot)
             require_matplotlib()
-        writes = [_parse_set(item) for item in args.set]
-        plc = load_from_args(args, args.scan_ms)
-        report(plc.diagnostics)
-        if "OB1" not in plc.unit.pous:
-            raise PlcConfigError("the program has no main program block (OB1), so there "
-                                 "is nothing to run; give the file with OB1 as well")
-        for addr, value, text in writes:
-            _write(plc, addr, value, text)
+        writes = parse_sets(args.set)
+        plc = load_for_run(args, writes, report=report)
         trace = Trace(plc, args.signal, every=args.every)
     except PlcError as e:
         print_diagnostics(e.diagnostics)

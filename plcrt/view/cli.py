@@ -10,7 +10,6 @@ parser for other commands stays cheap.
 from __future__ import annotations
 
 import argparse
-import math
 import re
 from pathlib import Path
 from typing import Any
@@ -20,7 +19,7 @@ _NET_RE = re.compile(r"(?:([^/]+)/)?(\d+)$")
 
 def register(sub: Any) -> None:
     """Add ``show`` to the subparsers of the ``plcrt`` command."""
-    from ..cli import add_program_args
+    from ..cli import add_program_args, add_run_length_args, add_scan_ms_arg, add_set_args
 
     p = sub.add_parser(
         "show", help="draw networks as ladder (LAD), optionally with live status",
@@ -34,38 +33,31 @@ def register(sub: Any) -> None:
     p.add_argument("--stl", action="store_true", help="show the STL text instead of LAD")
     p.add_argument("--status", action="store_true",
                    help="run the program, then draw with power flow and values")
-    p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
-                   help="simulated scan time in ms (default 10)")
-    length = p.add_mutually_exclusive_group()
-    length.add_argument("--seconds", type=float, metavar="S",
-                        help="with --status: simulated seconds to run")
-    length.add_argument("--scans", type=int, metavar="N",
-                        help="with --status: number of scans to run (default 1)")
-    p.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
-                   help="with --status: write before the first scan (inputs keep their value)")
+    add_scan_ms_arg(p)
+    add_run_length_args(p, required=False,
+                        seconds_help="with --status: simulated seconds to run",
+                        scans_help="with --status: number of scans to run (default 1)")
+    add_set_args(p, help="with --status: write before the first scan (inputs keep their value)")
     p.set_defaults(func=cmd_show)
 
 
 def cmd_show(args: argparse.Namespace) -> int:
     """``plcrt show``: 0 ok, 1 an input or option error, 2 a PLC fault while
     running for --status (the drawing then shows the state at the fault)."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, _parse_set, _write, load_from_args,
-                       print_diagnostics)
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, check_run_length, load_for_run,
+                       parse_sets, print_diagnostics)
     from ..engine.runtime import parse_sources
     from ..errors import PlcConfigError, PlcError, PlcRuntimeError
 
     fault: PlcError | None = None
     try:
         _check_options(args, PlcConfigError)
+        check_run_length(args)
         if args.status:
-            writes = [_parse_set(item) for item in args.set]
-            plc = load_from_args(args, args.scan_ms)
-            print_diagnostics(plc.diagnostics)
-            if "OB1" not in plc.unit.pous:
-                raise PlcConfigError("--status needs the main program block (OB1) to run; "
-                                     "give the file with OB1 as well")
-            for addr, value, text in writes:
-                _write(plc, addr, value, text)
+            writes = parse_sets(args.set)
+            plc = load_for_run(args, writes,
+                               no_ob1="--status needs the main program block (OB1) to run; "
+                                      "give the file with OB1 as well")
             program = plc.program
         else:
             program = parse_sources([Path(p) for p in args.programs])
@@ -111,16 +103,13 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 
 def _check_options(args: argparse.Namespace, error: type) -> None:
+    """The run options without --status are a mistake, not ignored."""
     if not args.status:
         given = [name for name, on in (("--set", args.set),
                                        ("--seconds", args.seconds is not None),
                                        ("--scans", args.scans is not None)) if on]
         if given:
             raise error(f"{', '.join(given)} only make(s) sense with --status")
-    if args.scans is not None and args.scans < 0:
-        raise error(f"--scans must not be negative, got {args.scans}")
-    if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
-        raise error(f"--seconds must be a non-negative number, got {args.seconds}")
 
 
 def _select(program: Any, specs: list[str], error: type) -> list[tuple[str, int]] | None:

@@ -17,6 +17,7 @@ setup: $(BIN)/.installed
 
 demo: setup
 	$(BIN)/plcrt check programs/subroutine.awl
+	$(BIN)/plcrt show programs/seal_in.awl --status --scans 3 --set I0.0=1
 	$(BIN)/plcrt run programs/seal_in.awl --scans 3 --set I0.0=1 --watch I0.0 --watch Q0.0
 	$(BIN)/plcrt run programs/timers.awl --seconds 2.5 --set I0.0=1 --watch T37 --watch Q0.0
 	$(BIN)/plcrt run programs/subroutine.awl --scans 1 --set AIW0=25600 --watch VW10 --watch Q0.0 --json

@@ -44,6 +44,7 @@ from typing import Any, NamedTuple, NoReturn, TextIO
 from . import __version__
 from .engine.runtime import Plc, load
 from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+from .safetext import printable
 
 EXIT_OK = 0
 EXIT_ERROR = 1
@@ -83,6 +84,7 @@ class _Parser(argparse.ArgumentParser):
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (never raises)."""
+    _tolerate_narrow_output()
     try:
         return _main(sys.argv[1:] if argv is None else argv)
     except KeyboardInterrupt:
@@ -310,21 +312,24 @@ def render_dump(plc: Plc) -> str:
         if piece:
             block, net = _piece_origin(lines, i, locs) or (piece.group(1), int(piece.group(2)))
             title = titles.get((block, net), "")
-            out.append(f"# ==== {block} network {net}" + (f": {title}" if title else "") + " ====")
+            out.append(printable(f"# ==== {block} network {net}" + (f": {title}" if title else "")
+                                 + " ===="))
             last_runner = None
         runner = _RUNNER_RE.match(line)
         if runner and runner.group(1) != last_runner:
             last_runner = runner.group(1)
             name = names.get(last_runner, "")
             label = f" ({name})" if name and name != last_runner else ""
-            out.append(f"# ==== {last_runner}{label}: runs its networks in order ====")
+            out.append(printable(f"# ==== {last_runner}{label}: runs its networks in order ===="))
         m = _INSN_COMMENT_RE.match(line)
         if m:
             insn_id = int(m.group(2))
             loc = locs[insn_id] if insn_id < len(locs) else None
             lineno = loc.line if loc else int(m.group(3))
             stl = _stl_line(texts, loc.file if loc else None, lineno)
-            line = f"{m.group(1)}# [{insn_id}] line {lineno}: {stl}"
+            # program text goes into a comment only, with control characters
+            # escaped (a CR or an escape sequence must not reach the output)
+            line = f"{m.group(1)}# [{insn_id}] line {lineno}: {printable(stl)}"
         out.append(line)
     return "\n".join(out).rstrip("\n") + "\n"
 
@@ -550,29 +555,32 @@ def _print_values(program: str, plc: Plc, values: dict[str, int | float]) -> Non
     summary = f"{program}: {plc.scans} scan(s), {plc.time:g} s simulated, mode {plc.mode}"
     if values and sys.stdout.isatty() and _print_rich_table(summary, values):
         return
-    print(summary)
+    print(printable(summary))
     if values:
-        width = max(len("address"), *(len(k) for k in values))
+        keys = {k: printable(k) for k in values}
+        width = max(len("address"), *(len(k) for k in keys.values()))
         print(f"{'address':<{width}}  value")
         for key, value in values.items():
-            print(f"{key:<{width}}  {_fmt(value)}")
+            print(f"{keys[key]:<{width}}  {_fmt(value)}")
 
 
 def _print_rich_table(summary: str, values: dict[str, int | float]) -> bool:
     try:
         from rich.console import Console
         from rich.table import Table
+        from rich.text import Text
     except ImportError:  # rich is a dependency, but the plain form is fine too
         return False
     console = Console()
     # The summary stays one line above the table: as a table title it would
-    # wrap to the (narrow) table width.
-    console.print(summary, highlight=False, markup=False)
+    # wrap to the (narrow) table width.  Text objects, never markup strings:
+    # a symbol name such as "[bold]x[/]" or ":smile:" is shown as written.
+    console.print(Text(printable(summary)), highlight=False)
     table = Table()
     table.add_column("address")
     table.add_column("value", justify="right")
     for key, value in values.items():
-        table.add_row(key, _fmt(value))
+        table.add_row(Text(printable(key)), Text(_fmt(value)))
     console.print(table)
     return True
 
@@ -619,13 +627,14 @@ def _print_rich_axes(rows: list[list[str]]) -> bool:
     try:
         from rich.console import Console
         from rich.table import Table
+        from rich.text import Text
     except ImportError:
         return False
     table = Table()
     for i, col in enumerate(_AXIS_COLUMNS):
         table.add_column(col, justify="left" if i == len(_AXIS_COLUMNS) - 1 else "right")
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(Text(cell) for cell in row))   # plain text, never markup
     Console().print(table)
     return True
 
@@ -663,6 +672,18 @@ def _internal_error(exc: BaseException) -> None:
         print(f"{PROG}: this is a bug in plcrt; please report it together with the "
               f"program and the command (set PLCRT_TRACEBACK=1 to see the traceback)",
               file=sys.stderr)
+
+
+def _tolerate_narrow_output() -> None:
+    """On an output that cannot encode everything (``PYTHONIOENCODING=ascii``,
+    a legacy code page) write what it cannot encode as escapes (the ladder's
+    box drawing, program text in any script) instead of failing."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None and stream.errors == "strict":
+                stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass   # not a text stream we can reconfigure: leave it
 
 
 def _silence_stdout() -> None:

@@ -15,6 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Literal
 
+from .safetext import printable
+
 Severity = Literal["error", "warning", "note"]
 
 
@@ -54,9 +56,11 @@ class Diagnostic:
     code: str = ""  #: short machine-readable tag, e.g. "unimplemented"
 
     def __str__(self) -> str:
+        # One line, whatever the message quotes from the program (operand
+        # text, symbol names): control characters are shown as escapes.
         if self.loc is None:
-            return f"{self.severity}: {self.message}"
-        return f"{self.loc}: {self.severity}: {self.message}{self.loc.context()}"
+            return printable(f"{self.severity}: {self.message}")
+        return printable(f"{self.loc}: {self.severity}: {self.message}{self.loc.context()}")
 
 
 class PlcError(Exception):

@@ -27,6 +27,7 @@ from typing import Any
 from ..cli import (EXIT_ERROR, PROG, add_program_args, add_scan_ms_arg, load_for_run,
                    print_diagnostics)
 from ..errors import PlcError
+from ..safetext import printable
 
 #: readline history of interactive sessions (kept between sessions)
 HISTORY_FILE = "~/.plcrt_debug_history"
@@ -75,6 +76,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     interactive = script is None and _isatty(sys.stdin)
+    if script is None:
+        _tolerate_bad_bytes(sys.stdin)
     session = Session(plc, sys.stdout, echo=not interactive,
                       color=interactive and _isatty(sys.stdout),
                       handle_interrupt=interactive)
@@ -84,10 +87,11 @@ def cmd_debug(args: argparse.Namespace) -> int:
             try:
                 apply(value)
             except CommandError as e:
-                print(f"{PROG}: error: {option} {value}: {e}", file=sys.stderr)
+                print(printable(f"{PROG}: error: {option} {value}: {e}"), file=sys.stderr)
                 return EXIT_ERROR
             except PlcError as e:
-                print(f"{PROG}: error: {option} {value}: {e.message}", file=sys.stderr)
+                print(printable(f"{PROG}: error: {option} {value}: {e.message}"),
+                      file=sys.stderr)
                 return EXIT_ERROR
 
     if script is not None:
@@ -110,6 +114,16 @@ def _ask(prompt: str) -> str | None:
         # Ctrl-C at the prompt drops the line being typed, as in a shell.
         print("^C")
         return ""
+
+
+def _tolerate_bad_bytes(stream: Any) -> None:
+    """Bytes of stdin that are not valid in its encoding become U+FFFD, so
+    that such a line fails as a command (``error: ...``) instead of ending
+    the session at the first read; the commands before it have run."""
+    try:
+        stream.reconfigure(errors="replace")
+    except (AttributeError, ValueError, OSError):
+        pass   # not a text file (a test's StringIO), or already read from
 
 
 def _isatty(stream: Any) -> bool:

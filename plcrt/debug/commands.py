@@ -241,8 +241,8 @@ def _cmd_unforce(s: Session, args: list[str]) -> None:
                  f"changes them")
         return
     for addr in args:
-        key = next((k for k in s.plc.forces if k.upper() == addr.strip().upper()), addr)
-        s.plc.unforce(key)
+        # a force belongs to its location: 'unforce Start' releases 'force I0.0 1'
+        key = s.plc.unforce(addr) or addr
         if s._location(key)[0] is s.plc.mem.areas["I"]:
             # the input image is read from the terminals at every scan start
             s._print(f"released {key} (from the next scan on it reads its input "

@@ -18,6 +18,7 @@ from typing import Any, TextIO
 
 from ..engine.runtime import Plc
 from ..lang import ir
+from ..safetext import printable
 
 
 def fmt(value: int | float) -> str:
@@ -127,12 +128,14 @@ def draw_network(out: TextIO, plc: Plc, pou: ir.Pou, network: ir.Network, *,
                 out.write(text.rstrip("\n") + "\n")
             return
         except Exception as e:  # noqa: BLE001 - a drawing problem must not end the session
-            out.write(f"(the ladder view failed: {type(e).__name__}: {e}; showing STL)\n")
-    out.write(f"Network {network.number}" + (f"  {network.title}" if network.title else "")
-              + "\n")
+            out.write(printable(f"(the ladder view failed: {type(e).__name__}: {e}; "
+                                f"showing STL)") + "\n")
+    # program text: control characters are written as escapes
+    out.write(printable(f"Network {network.number}" + (f"  {network.title}" if network.title
+                                                       else "")) + "\n")
     for insn in network.insns:
         ops = ", ".join(o.text for o in insn.operands)
-        out.write(f"{insn.mnemonic:<7}{ops}".rstrip() + "\n")
+        out.write(printable(f"{insn.mnemonic:<7}{ops}".rstrip()) + "\n")
 
 
 __all__ = ["axes_table", "block_heading", "draw_network", "fmt", "key_values", "load_view",

@@ -47,6 +47,7 @@ from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError, PlcRuntimeError
 from ..lang import ir
+from ..safetext import printable
 from ..testing.harness import Harness, reader
 from .commands import COMMANDS, Command, CommandError, lookup, strip_comment
 from .panels import draw_network, fmt, load_view, ms, sim_time, status_line, watch_table
@@ -201,8 +202,8 @@ class Session:
         nets = plc.program.network_count()
         axes = len(plc.axes())
         extra = f", {axes} axes" if axes else ""
-        return (f"plcrt debug: {files} ({nets} network(s), scan {ms(plc.scan_us)} ms{extra}); "
-                f"type 'help' for the commands")
+        return printable(f"plcrt debug: {files} ({nets} network(s), scan {ms(plc.scan_us)} ms"
+                         f"{extra}); type 'help' for the commands")
 
     # -- the same operations for the CLI's --break / --watch options --------
     def add_breakpoint(self, text: str) -> NetworkRef:
@@ -223,7 +224,9 @@ class Session:
     # Output helpers
     # ------------------------------------------------------------------
     def _print(self, text: str = "") -> None:
-        self.out.write(text + "\n")
+        # Titles, operands and echoed commands come from untrusted files:
+        # control characters are written as escapes, never raw.
+        self.out.write("\n".join(printable(line) for line in text.split("\n")) + "\n")
 
     def _error(self, message: str) -> None:
         self.errors += 1

@@ -19,6 +19,8 @@ wall-clock pace (for demos); it never changes results.
 from __future__ import annotations
 
 import copy
+import numbers
+import struct
 import time as _time
 import types
 from pathlib import Path
@@ -339,30 +341,54 @@ class Plc:
         program has run (before the outputs are written), so the program
         cannot change what the terminals and the next scan see.  A program
         write in between is visible to the rest of that scan, as on the CPU.
+
+        A force belongs to the memory location, not to its spelling: with
+        the symbol ``Start`` for ``I0.0``, ``force("Start", 1)`` and then
+        ``force("i0.0", 0)`` leave one force (I0.0 = 0, listed in
+        :attr:`forces` under the name used last), and ``unforce`` by either
+        name releases it.  Overlapping locations of different sizes
+        (``QB0`` and ``Q0.0``) are separate forces, applied in the order
+        they were made.
         """
         a = self._addr(address)
-        buf, off, width, bit = self._locate(a)
+        loc = self._locate(a)
+        buf, off, width, bit = loc
         value = _check_value(address, width, value)
-        key = address.strip()
-        self.forces[key] = value
-        self._force_slots = [s for s in self._force_slots
-                             if (s[0], s[1], s[2], s[3]) != (buf, off, width, bit)]
+        old = self._forced_key(loc)
+        if old is not None:
+            del self.forces[old]
+        self.forces[address.strip()] = value
+        self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
         self._force_slots.append((buf, off, width, bit, value))
         _store(buf, off, width, bit, value)
 
-    def unforce(self, address: str | None = None) -> None:
-        """Release one forced address, or all of them (the value stays)."""
+    def unforce(self, address: str | None = None) -> str | None:
+        """Release the force of one address, named by the symbol or the
+        address it was forced by, or release all (``None``); the value stays
+        until the program changes it.  Returns the name the force was
+        listed under in :attr:`forces` (None when all were released).
+
+        Raises:
+            PlcAddressError: a bad address, or one that is not forced.
+        """
         if address is None:
             self.forces.clear()
             self._force_slots = []
-            return
-        key = address.strip()
-        if key not in self.forces:
-            raise PlcAddressError(f"{address} is not forced")
-        buf, off, width, bit = self._locate(self._addr(address))
+            return None
+        loc = self._locate(self._addr(address))
+        key = self._forced_key(loc)
+        if key is None:
+            raise PlcAddressError(f"{address.strip()} is not forced")
         del self.forces[key]
-        self._force_slots = [s for s in self._force_slots
-                             if (s[0], s[1], s[2], s[3]) != (buf, off, width, bit)]
+        self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
+        return key
+
+    def _forced_key(self, loc: tuple[bytearray, int, int, int]) -> str | None:
+        """The key of :attr:`forces` that forces location ``loc``, if any."""
+        for key in self.forces:
+            if _same_loc(self._locate(self._addr(key)), loc):
+                return key
+        return None
 
     def _apply_forces(self) -> None:
         for buf, off, width, bit, value in self._force_slots:
@@ -382,9 +408,25 @@ class Plc:
         return self.fork()
 
     def restore(self, snapshot: Plc) -> None:
-        """Go back to a state taken with :meth:`snapshot` of this PLC."""
+        """Go back to a state taken with :meth:`snapshot` of this PLC or of
+        a fork of it (the same program object, compiled the same way).
+
+        Raises:
+            PlcConfigError: ``snapshot`` is not a snapshot, or it was taken
+                from a different program, or from the same parsed program
+                compiled with other options (symbols, CPU, plant, probes).
+        """
+        if not isinstance(snapshot, Plc):
+            raise PlcConfigError(f"restore() needs a snapshot made by snapshot(), got "
+                                 f"{type(snapshot).__name__}")
         if snapshot.program is not self.program:
             raise PlcConfigError("this snapshot was taken from a different program")
+        if (snapshot.source != self.source or snapshot.model != self.model
+                or len(snapshot.devices) != len(self.devices)
+                or (snapshot.coverage is None) != (self.coverage is None)):
+            raise PlcConfigError("this snapshot was taken from the same program compiled "
+                                 "with other options (symbols, CPU, plant or instrumentation); "
+                                 "restore it into a PLC loaded the same way")
         snapshot._copy_state(self)
 
     def _copy_state(self, dst: Plc) -> None:
@@ -451,10 +493,32 @@ class Plc:
 
 
 def _check_value(address: str, width: int, value: int | float | bool) -> int | float:
-    """Validate a value for a location of ``width`` bytes (0 = a bit)."""
+    """Validate a value for a location of ``width`` bytes (0 = a bit).
+
+    A bit takes 0, 1, False or True; a double word takes a float as a REAL
+    if single precision can hold it (infinities included, as on the CPU).
+    """
+    if not isinstance(value, (int, float)):
+        # numpy scalars, Decimal, Fraction ...: as the Python number they are
+        if isinstance(value, numbers.Integral):
+            value = int(value)
+        elif isinstance(value, numbers.Real):
+            value = float(value)
+        elif hasattr(value, "item") and isinstance(getattr(value, "shape", None), tuple) \
+                and value.shape == ():
+            value = value.item()          # numpy.bool_
+        if not isinstance(value, (int, float)):
+            raise PlcAddressError(f"{address}: {value!r} is not a number")
     if width == 0:
+        if value not in (0, 1):
+            raise PlcAddressError(f"{address}: a bit takes 0 or 1, got {value!r}")
         return 1 if value else 0
     if isinstance(value, float) and width == 4:
+        try:
+            _F32.pack(value)
+        except OverflowError:
+            raise PlcAddressError(f"{address}: {value!r} is out of the range of a REAL "
+                                  f"(about -3.4e38 to 3.4e38)") from None
         return value
     if isinstance(value, float) and not value.is_integer():
         raise PlcAddressError(f"{address}: a real value needs a double word")
@@ -463,6 +527,16 @@ def _check_value(address: str, width: int, value: int | float | bool) -> int | f
     if not lo <= v <= hi:
         raise PlcAddressError(f"{address}: value {v} does not fit in {width} byte(s)")
     return v
+
+
+_F32 = struct.Struct(">f")
+
+
+def _same_loc(a: Sequence[Any], b: Sequence[Any]) -> bool:
+    """Whether two (buffer, offset, width, bit) locations are the same: the
+    buffers must be the same object (``==`` on bytearrays compares their
+    contents, and the I and Q images are equal while both are all zeros)."""
+    return a[0] is b[0] and a[1] == b[1] and a[2] == b[2] and a[3] == b[3]
 
 
 def _store(b: bytearray, off: int, width: int, bit: int, value: int | float) -> None:

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Union
 
-from ..engine.runtime import Plc, load
-from ..errors import PlcAddressError, PlcConfigError
+from ..engine.runtime import Plc, _check_value, load
+from ..errors import PlcAddressError, PlcConfigError, PlcError
 
 Value = Union[int, float, bool]
 Duration = Union[int, float, str]
@@ -85,8 +85,8 @@ def reader(plc: Plc, spec: str) -> Callable[[], Value]:
     return lambda: int.from_bytes(buf[off:end], "big", signed=True)
 
 
-_COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*(?:(==|!=|<>|<=|>=|<|>|=)\s*(\S+))?\s*$",
-                      re.IGNORECASE)
+_COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"
+                      r"(?:(==|!=|<>|<=|>=|<|>|=)\s*([^\s<>=!]\S*))?\s*$", re.IGNORECASE)
 _OPS: dict[str, Callable[[Any, Any], bool]] = {
     "==": lambda a, b: a == b, "=": lambda a, b: a == b, "!=": lambda a, b: a != b,
     "<>": lambda a, b: a != b, "<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
@@ -108,7 +108,10 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
         if takes_arg:
             return (lambda: bool(cond(h))), name   # type: ignore[call-arg]
         return (lambda: bool(cond())), name        # type: ignore[call-arg]
-    m = _COND_RE.match(str(cond))
+    if not isinstance(cond, str):
+        raise PlcConfigError(f"a condition is a string such as 'Q0.0' or 'VW100 >= 25', or a "
+                             f"function; got {type(cond).__name__} {cond!r}")
+    m = _COND_RE.match(cond)
     if m is None:
         raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
                              f"or 'ADDR <op> value' with op one of == != < <= > >=")
@@ -274,7 +277,7 @@ class Harness:
             plc.scan(1)
             if plc.mode != "RUN":
                 self._timeout(f"the CPU went to STOP before {what!r} became true", message)
-            if pred():
+            if self._check(pred, what):
                 return (plc.now_us - t0) / 1e6
         self._timeout(f"{what!r} did not become true within {seconds(timeout):g} s of "
                       f"simulated time ({limit} scans)", message)
@@ -294,10 +297,26 @@ class Harness:
         plc = self.plc
         for _ in range(self._scans_for(duration)):
             plc.scan(1)
-            if not pred():
+            if plc.mode != "RUN":
+                # time stands still in STOP: the duration would never pass
+                self._timeout(f"the CPU went to STOP before {seconds(duration):g} s had "
+                              f"passed, so {what!r} was not seen to stay true", message,
+                              exc=AssertionError)
+            if not self._check(pred, what):
                 self._timeout(f"{what!r} became false at t = {plc.time:.3f} s", message,
                               exc=AssertionError)
         return self
+
+    def _check(self, pred: Callable[[], bool], what: str) -> bool:
+        """``pred()``; an exception of a condition function propagates with
+        a note saying when it was checked (the scans before it have run)."""
+        try:
+            return pred()
+        except Exception as e:
+            if hasattr(e, "add_note"):
+                e.add_note(f"while checking the condition {what!r} after scan {self.scans} "
+                           f"(t = {self.time:.3f} s)")
+            raise
 
     def _timeout(self, text: str, message: str, exc: type[AssertionError] = PlcTimeout) -> None:
         __tracebackhide__ = True  # pytest: report the test's line, not ours
@@ -360,11 +379,11 @@ class Harness:
         try:
             yield self
         finally:
-            for a in values:
-                if a.strip() in self.plc.forces:
-                    self.plc.unforce(a)
+            _release(self.plc, values)
 
     def unforce(self, address: str | None = None) -> Harness:
+        """Release one force (by the symbol or the address: a force belongs
+        to the memory location), or all of them."""
         self.plc.unforce(address)
         return self
 
@@ -384,7 +403,16 @@ class Harness:
             except (TypeError, ValueError):
                 raise PlcConfigError(f"stimulus row {i + 1}: expected (time, address, value), "
                                      f"got {row!r}") from None
-            rows.append((int(round(seconds(t) * 1e6)), i, str(addr), value))
+            try:
+                t_s = seconds(t)
+            except PlcConfigError as e:
+                raise PlcConfigError(f"stimulus row {i + 1} {row!r}: {e.message}") from None
+            try:   # every row is checked before the first scan runs
+                _, _, width, _ = self.plc._locate(self.plc._addr(str(addr)))
+                _check_value(str(addr), width, value)
+            except PlcError as e:
+                raise type(e)(f"stimulus row {i + 1} {row!r}: {e.message}") from None
+            rows.append((int(round(t_s * 1e6)), i, str(addr), value))
         rows.sort()
         plc = self.plc
         t0 = plc.now_us
@@ -477,9 +505,17 @@ class _Forced:
         return self._h
 
     def __exit__(self, *exc: Any) -> None:
-        for a in self._addresses:
-            if a.strip() in self._h.plc.forces:
-                self._h.plc.unforce(a)
+        _release(self._h.plc, self._addresses)
+
+
+def _release(plc: Plc, addresses: Iterable[str]) -> None:
+    """Release the forces of ``addresses`` that are still forced (by the
+    same location: a force re-made under another name counts too)."""
+    for a in addresses:
+        try:
+            plc.unforce(a)
+        except PlcAddressError:
+            pass   # released inside the block already
 
 
 def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,

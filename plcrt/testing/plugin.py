@@ -269,14 +269,25 @@ def _parsed(sess: _Session, files: tuple[Path, ...]) -> Any:
 
 
 def _build(sess: _Session, spec: _Spec) -> Harness:
-    """A harness for ``spec``; plcrt's own errors propagate (PlcError)."""
+    """A harness for ``spec``; plcrt's own errors propagate (PlcError), a
+    program without OB1 or a bad ``watch`` address is a PlcUsageError."""
+    from ..errors import PlcError
     from .harness import Harness
     program = spec.program if isinstance(spec.program, str) else _parsed(sess, spec.program)
     h = Harness.load(program, symbols=spec.symbols, data=spec.data, plant=spec.plant,
                      scan_ms=spec.scan_ms if spec.scan_ms is not None else sess.scan_ms,
-                     cpu=spec.cpu, watch=spec.watch,
+                     cpu=spec.cpu,
                      history=spec.history if spec.history is not None else sess.history,
                      instrument=sess.coverage)
+    if "OB1" not in h.plc.unit.pous:
+        # scans would do nothing, and every assertion on "nothing changes" pass
+        raise PlcUsageError(f"{spec.label} has no main program block (OB1), so there is "
+                            f"nothing to run; name the file with OB1 as well")
+    for address in spec.watch:
+        try:
+            h.watch(address)
+        except PlcError as e:
+            raise PlcUsageError(f"watch {address!r}: {e.message}") from None
     h.name = spec.label
     return h
 
@@ -311,6 +322,8 @@ def plc(request: pytest.FixtureRequest) -> Harness:
     else:
         try:
             h = _build(sess, spec)
+        except PlcUsageError as e:
+            problem = str(e)
         except PlcError as e:
             problem = f"cannot load {spec.label}:\n{e}"
     if problem:

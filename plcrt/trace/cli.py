@@ -25,6 +25,10 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+from ..safetext import printable
+
+#: exit status after Ctrl-C, as ``plcrt`` uses elsewhere (128 + SIGINT)
+EXIT_INTERRUPTED = 130
 
 
 def register(sub: Any) -> None:
@@ -78,6 +82,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
             # should not cost the user the run
             plot_format(args.plot)
             require_matplotlib()
+        for option, target in (("--csv", args.csv), ("--plot", args.plot)):
+            if target:
+                _check_writable(option, target)
         writes = parse_sets(args.set)
         plc = load_for_run(args, writes, report=report)
         trace = Trace(plc, args.signal, every=args.every)
@@ -86,11 +93,18 @@ def cmd_trace(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     fault: PlcError | None = None
+    interrupted = False
     loaded = len(plc.diagnostics)
     try:
         run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=args.quiet)
     except PlcRuntimeError as e:
         fault = e
+    except KeyboardInterrupt:
+        # Ctrl-C ends the run between two scans; the samples so far are kept
+        interrupted = True
+        trace._even_out()
+        print(f"plcrt: interrupted after {plc.scans} scan(s); writing the "
+              f"{len(trace)} sample(s) recorded so far", file=sys.stderr)
     finally:
         trace.detach()
     report(plc.diagnostics[loaded:])
@@ -106,20 +120,46 @@ def cmd_trace(args: argparse.Namespace) -> int:
         try:
             write()
         except OSError as e:
-            print(f"plcrt: error: cannot write '{target}': {e.strerror or e}", file=sys.stderr)
+            print(printable(f"plcrt: error: cannot write '{target}': {e.strerror or e}"),
+                  file=sys.stderr)
             status = EXIT_ERROR
         except PlcError as e:   # a plot of an empty trace, say
             print_diagnostics(e.diagnostics)
             status = EXIT_ERROR
 
     if not args.quiet:
-        print(f"{args.programs[0]}: {plc.scans} scan(s), {plc.time:g} s simulated, "
-              f"mode {plc.mode}")
-        print(trend(trace))
+        # names come from the command line and the symbol table: no raw
+        # control characters on the terminal
+        print(printable(f"{args.programs[0]}: {plc.scans} scan(s), {plc.time:g} s simulated, "
+                        f"mode {plc.mode}"))
+        print("\n".join(printable(line) for line in trend(trace).split("\n")))
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if interrupted:
+        return EXIT_INTERRUPTED
     return status
+
+
+def _check_writable(option: str, target: str) -> None:
+    """Refuse an output file that cannot be written, before the run: its
+    folder does not exist, or it names a folder.  (Other failures, such as
+    a full disk, are reported when the file is written.)
+
+    Raises:
+        PlcConfigError: naming the option and the file.
+    """
+    import os
+    from pathlib import Path
+
+    path = Path(target)
+    if target.endswith(("/", os.sep)) or path.is_dir():
+        raise PlcConfigError(f"{option} {target}: this is a folder, not a file")
+    folder = path.parent
+    if not folder.is_dir():
+        raise PlcConfigError(f"{option} {target}: the folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise PlcConfigError(f"{option} {target}: no permission to write this file")
 
 
 __all__ = ["cmd_trace", "register"]

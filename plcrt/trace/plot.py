@@ -106,14 +106,15 @@ def plot(trace: Any, path: str | Path, *, signals: Sequence[str] | None = None,
                               color=f"C{i % 10}")
             # a stable id per signal, so the SVG can be inspected by signal
             line.set_gid(f"signal-{i}")
-            ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            # names and titles are shown as written: no mathtext ("$...$")
+            ax.set_ylabel(name, rotation=0, ha="right", va="center", parse_math=False)
             ax.grid(True, axis="x", linewidth=0.4, alpha=0.5)
             if kind == "bit":
                 ax.set_yticks([0, 1])
                 ax.set_ylim(-0.2, 1.2)
         axes[-1].set_xlabel("time (s)")
         if title:
-            fig.suptitle(title)
+            fig.suptitle(title, parse_math=False)
         metadata: dict[str, Any] = {"Software": None} if fmt == "png" else \
             {"Date": None, "Creator": "plcrt"}
         fig.savefig(path, format=fmt, metadata=metadata)

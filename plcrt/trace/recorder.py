@@ -197,6 +197,15 @@ class Trace:
             append(read())
         self._recorded += 1
 
+    def _even_out(self) -> None:
+        """Drop a sample that an interruption (Ctrl-C) cut in half: every
+        column as long as the shortest one."""
+        n = min([len(self._t_us)] + [len(c) for c in self._cols])
+        for col in [self._t_us, *self._cols]:
+            while len(col) > n:
+                col.pop()
+        self._cache.clear()
+
     def attach(self) -> None:
         """(Re)start recording; called by the constructor."""
         if not self.attached:

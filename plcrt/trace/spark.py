@@ -88,7 +88,9 @@ def trend(trace: Any, width: int = 60) -> str:
     ranges = []
     for name in names:
         a = trace.array(name)
-        finite = a[np.isfinite(a)] if a.dtype.kind == "f" else a
+        # the range of the values that are numbers: a REAL that is +-inf
+        # all along shows as inf..inf, only NaNs as nan
+        finite = a[~np.isnan(a)] if a.dtype.kind == "f" else a
         if len(finite) == 0:
             ranges.append("nan")
         else:

@@ -14,7 +14,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-_NET_RE = re.compile(r"(?:([^/]+)/)?(\d+)$")
+#: as the debugger's ``break``: OB1/3, SBR0 / 1, SCALE/2 or 3 (of OB1)
+_NET_RE = re.compile(r"(?:([^/\s]+)\s*/\s*)?(\d+)")
 
 
 def register(sub: Any) -> None:
@@ -61,6 +62,9 @@ def cmd_show(args: argparse.Namespace) -> int:
             program = plc.program
         else:
             program = parse_sources([Path(p) for p in args.programs])
+        if not program.pous:
+            raise PlcConfigError(f"nothing to show: {', '.join(args.programs)} holds no block "
+                                 f"(an empty file, or only comments)")
         selected = _select(program, args.network, PlcConfigError)
     except PlcError as e:
         print_diagnostics(e.diagnostics)
@@ -118,7 +122,7 @@ def _select(program: Any, specs: list[str], error: type) -> list[tuple[str, int]
         return None
     out = []
     for spec in specs:
-        m = _NET_RE.match(spec.strip())
+        m = _NET_RE.fullmatch(spec.strip())
         if m is None:
             raise error(f"--network {spec}: use BLOCK/N (OB1/3, SBR0/1) or a number")
         block, number = (m.group(1) or "OB1").strip(), int(m.group(2))

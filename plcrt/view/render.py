@@ -29,6 +29,7 @@ from rich.text import Text
 
 from ..isa.shape import shape
 from ..lang import ir
+from ..safetext import printable
 from .ladder import Box, Coil, Contact, Logic, Node, Parallel, Series, to_ladder
 from .status import Power, Status, and3, contact_state, eno_power, modifier_power, or3
 
@@ -57,8 +58,9 @@ class Block:
         self.rows: list[list[Cell]] = [[(" ", None)] * width for _ in range(height)]
 
     def put(self, r: int, c: int, text: str, tag: str | None = None) -> int:
-        """Write ``text`` at (r, c); wide characters take two cells."""
-        for ch in text:
+        """Write ``text`` at (r, c); wide characters take two cells, control
+        characters from the program are written as escapes (``\\x1b``)."""
+        for ch in printable(text):
             n = cell_len(ch)
             if n == 0:
                 continue
@@ -171,8 +173,13 @@ def _text_put(b: Block, r: int, c: int, pair: tuple[str, str]) -> None:
     b.put(r, c, pair[1], "val")
 
 
+def _cells(text: str) -> int:
+    """Columns ``text`` takes once :meth:`Block.put` wrote it."""
+    return cell_len(printable(text))
+
+
 def _width(pair: tuple[str, str]) -> int:
-    return cell_len(pair[0]) + cell_len(pair[1])
+    return _cells(pair[0]) + _cells(pair[1])
 
 
 # ---------------------------------------------------------------------------
@@ -259,7 +266,7 @@ def _box(box: Box, powers: list[Power], ctx: _Ctx,
     pin_rows = max(len(lefts), len(rights))
     lname = max([cell_len(p.name) for p in lefts] + [cell_len(n) for n in power_names] + [0])
     rname = max([cell_len(p.name) for p in rights] + [3 if box.eno else 0])
-    inner = max(cell_len(box.title) + 2, lname + rname + 2, cell_len(box.note) + 2, 6)
+    inner = max(_cells(box.title) + 2, lname + rname + 2, cell_len(box.note) + 2, 6)
     # a blank between an operand and the next element's (chained boxes)
     lm = max([_width(v) + 2 for v in lvals] + [3])
     rm = max([_width(v) + 2 for v in rvals] + [0])
@@ -286,7 +293,7 @@ def _box(box: Box, powers: list[Power], ctx: _Ctx,
         b.put(r, L, "│", "box")
         b.put(r, R, "│", "box")
     title_row = top + 1
-    b.put(title_row, L + 1 + (inner - cell_len(box.title)) // 2, box.title, "title")
+    b.put(title_row, L + 1 + (inner - _cells(box.title)) // 2, box.title, "title")
     if not power_names:  # on the rail: the rail feeds the title row
         b.put(title_row, 0, "─" * L, _w(en))
         b.put(title_row, L, "┤", "box")
@@ -383,7 +390,7 @@ def _stl_lines(network: ir.Network, ctx: _Ctx) -> Block:
         vals = [ctx.label(o.text, "BIT" if bit and i == 0 else kind)
                 for i, o in enumerate(insn.operands)]
         lines.append((stl, [v for v in vals if v[1]]))
-    width = max([cell_len(stl) for stl, _ in lines] + [0])
+    width = max([_cells(stl) for stl, _ in lines] + [0])
     extra = max([sum(_width(v) + 2 for v in vals) for _, vals in lines] + [0])
     b = Block(width + extra, len(lines))
     for r, (stl, vals) in enumerate(lines):
@@ -451,7 +458,8 @@ def render_network(pou: ir.Pou, network: ir.Network, *, status: Status | None = 
     out = Text()
     out.append(f"Network {network.number}", style("hdr"))
     if network.title:
-        out.append(f"  {network.title}", style("hdr"))
+        # program text: appended as plain Text (never markup), escaped
+        out.append(f"  {printable(network.title)}", style("hdr"))
     if reason and not stl:
         out.append(f"\n(STL: not LAD-representable: {reason})", style("why"))
     if block.h:
@@ -472,7 +480,7 @@ def render_program(program: ir.Program, *, status: Status | None = None,
         if not nets:
             continue
         head = pou.ident + (f" ({pou.name})" if pou.name and pou.name != pou.ident else "")
-        out.append(Text(head + (f"  {pou.title}" if pou.title else ""),
+        out.append(Text(printable(head + (f"  {pou.title}" if pou.title else "")),
                         _STYLES["pou"] if styled else ""))
         for n in nets:
             out.append(render_network(pou, n, status=status, styled=styled,

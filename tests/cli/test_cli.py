@@ -269,6 +269,10 @@ def test_run_compile_error_json(tmp_path: Path, capsys: pytest.CaptureFixture[st
     (["--watch", "VW0:BCD"], "unknown format ':BCD'"),
     (["--scan-ms", "0"], "scan time"),
     (["--scans", "-1"], "must not be negative"),
+    # used to set the bit to 1 silently
+    (["--set", "I0.0=5"], "--set I0.0=5: I0.0: a bit takes 0 or 1, got 5"),
+    # used to end in "internal error: OverflowError"
+    (["--set", "VD0=-1e39"], "--set VD0=-1e39: VD0: -1e+39 is out of the range of a REAL"),
 ])
 def test_run_bad_options(args: list[str], message: str,
                          capsys: pytest.CaptureFixture[str]) -> None:
@@ -444,3 +448,54 @@ def test_run_realtime_keeps_results(capsys) -> None:
                              "--realtime", "--set", "I0.0=1", "--watch", "Q0.0", "--json")
     assert code == 0
     assert json.loads(out)["values"] == {"Q0.0": 1}
+
+
+# ---------------------------------------------------------------------------
+# Untrusted text and narrow terminals
+# ---------------------------------------------------------------------------
+
+def test_diagnostics_escape_control_characters_of_the_program(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # an operand may hold any character but blanks, commas, semicolons and
+    # quotes; the diagnostic quoting it must not write it raw
+    prog = write(tmp_path, "esc.awl", ob1("LD \x1b[2Jx\n= Q0.0", "LD I0.0\nCALL \x1b]0pwn\x07"))
+    code, out, err = run_cli(capsys, "check", prog)
+    assert code == 1 and out == ""
+    assert "\x1b" not in err and "\x07" not in err
+    assert "unknown symbol '\\x1b[2Jx'" in err
+    assert "no subroutine named '\\x1b]0pwn\\x07'" in err
+
+
+def test_dump_escapes_control_characters_in_comments(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = write(tmp_path, "t.awl", "ORGANIZATION_BLOCK OB1\nBEGIN\n"
+                 "Network 1 // clear\x1b[2J\nLD I0.0\n= Q0.0 // \x1b[31mred\n"
+                 "END_ORGANIZATION_BLOCK\n")
+    code, out, _ = run_cli(capsys, "dump", prog)
+    assert code == 0 and "\x1b" not in out
+    assert "# ==== OB1 network 1: clear\\x1b[2J ====" in out
+    assert "line 5: = Q0.0 // \\x1b[31mred" in out
+
+
+def test_run_table_shows_symbol_names_as_written(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """On a terminal the values are a rich table; a symbol name with rich
+    markup was rendered as markup ("[bold red]x[/]" became a red "x")."""
+    symbols = write(tmp_path, "s.sym", "[bold red]x[/]\tQ0.0\tc\n[reverse]y\tQ0.1\tc\n")
+    monkeypatch.setattr(sys.stdout, "isatty", lambda: True)
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--symbols", symbols, "--scans", "1",
+                             "--watch", "[bold red]x[/]", "--watch", "[reverse]y")
+    assert (code, err) == (0, "")
+    assert "│ [bold red]x[/] │" in out and "│ [reverse]y     │" in out
+
+
+def test_output_that_cannot_encode_box_drawing(tmp_path: Path) -> None:
+    # PYTHONIOENCODING=ascii (a legacy terminal) ended in an internal error
+    env = {**__import__("os").environ, "PYTHONIOENCODING": "ascii"}
+    result = subprocess.run([sys.executable, "-m", "plcrt", "show", SEAL_IN, "--network", "2"],
+                            capture_output=True, text=True, timeout=60, check=False, env=env)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    assert "Network 2  Running lamp" in result.stdout
+    assert "\\u2503" in result.stdout         # the rail, escaped, not lost

@@ -190,3 +190,126 @@ def test_uninstrumented_code_has_no_probes() -> None:
     plc = plcrt.load(COUNTING)
     assert plc.coverage is None
     assert "_NC" not in plc.source and "_OC" not in plc.source
+
+
+# ---------------------------------------------------------------------------
+# A force belongs to its memory location, not to the name it was made with
+# ---------------------------------------------------------------------------
+
+SYMBOLS = "Start\tI0.0\tstart button\nLamp\tQ0.0\tlamp\n"
+
+
+def test_force_by_symbol_unforce_by_address_and_the_reverse() -> None:
+    plc = plcrt.load(COUNTING, symbols=SYMBOLS)
+    plc.force("Start", 1)
+    assert plc.unforce(" i0.0 ") == "Start"          # any spelling of the location
+    assert plc.forces == {} and plc._force_slots == []
+    plc.force("I0.0", 1)
+    assert plc.unforce("Start") == "I0.0"
+    assert plc.forces == {}
+    with pytest.raises(PlcAddressError, match="Start is not forced"):
+        plc.unforce("Start")
+
+
+def test_forcing_a_location_again_replaces_its_force_under_the_new_name() -> None:
+    plc = plcrt.load(COUNTING, symbols=SYMBOLS)
+    plc.force("Start", 1)
+    plc.force("I0.0", 0)
+    assert plc.forces == {"I0.0": 0}                  # one force, not two that disagree
+    plc.scan(1)
+    assert plc["I0.0"] == 0
+    plc.unforce("Start")
+    assert plc.forces == {}
+
+
+def test_forces_of_equal_looking_images_stay_apart() -> None:
+    """I0.0 and Q0.0 have the same offset in two images that are equal while
+    both are all zeros; forcing one must not drop the other (bytearrays
+    compare by content)."""
+    plc = plcrt.load(COUNTING)
+    plc.force("I0.0", 0)
+    plc.force("Q0.0", 0)
+    assert plc.forces == {"I0.0": 0, "Q0.0": 0}
+    assert len(plc._force_slots) == 2
+    plc.mem.areas["PI"][0] = 1          # the terminal says 1, the force says 0
+    plc.scan(1)
+    assert plc["I0.0"] == 0
+    plc.unforce("Q0.0")
+    assert plc.forces == {"I0.0": 0}
+    plc.scan(1)
+    assert plc["I0.0"] == 0
+
+
+def test_fork_keeps_one_force_per_location() -> None:
+    plc = plcrt.load(COUNTING, symbols=SYMBOLS)
+    plc.force("Lamp", 1)
+    plc.force("VW2", 7)
+    twin = plc.fork()
+    assert twin.forces == {"Lamp": 1, "VW2": 7}
+    assert twin.unforce("Q0.0") == "Lamp" and twin.forces == {"VW2": 7}
+    assert plc.forces == {"Lamp": 1, "VW2": 7}
+
+
+# ---------------------------------------------------------------------------
+# Values the memory cannot hold are errors, never silently changed
+# ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("address, value, message", [
+    ("I0.0", 5, "I0.0: a bit takes 0 or 1, got 5"),
+    ("Q0.0", -1, "Q0.0: a bit takes 0 or 1, got -1"),
+    ("VD0", 1e39, "VD0: 1e+39 is out of the range of a REAL"),
+    ("VD0", -1e39, "VD0: -1e+39 is out of the range of a REAL"),
+    ("VW0", "12", "VW0: '12' is not a number"),
+    ("I0.0", None, "I0.0: None is not a number"),
+])
+def test_write_and_force_refuse_values_that_do_not_fit(address: str, value: object,
+                                                       message: str) -> None:
+    plc = plcrt.load(COUNTING)
+    for action in (plc.write, plc.force):
+        with pytest.raises(PlcAddressError, match=message.replace("+", r"\+")):
+            action(address, value)  # type: ignore[operator]
+    assert plc.forces == {}
+    assert plc["VD0"] == 0
+
+
+def test_write_accepts_bools_numpy_numbers_and_infinite_reals() -> None:
+    np = pytest.importorskip("numpy")
+    plc = plcrt.load(COUNTING)
+    plc.write("I0.0", True)
+    plc.write("Q0.0", np.int64(1))
+    plc.write("VW2", np.int16(-5))
+    plc.write("VD4", float("inf"))
+    plc.write("VD8", np.float32(1.5))
+    assert (plc["I0.0"], plc["Q0.0"], plc["VW2"]) == (1, 1, -5)
+    assert plc.read("VD4", "REAL") == float("inf") and plc.read("VD8", "REAL") == 1.5
+
+
+# ---------------------------------------------------------------------------
+# restore
+# ---------------------------------------------------------------------------
+
+def test_restore_of_a_fork_snapshot_and_of_things_that_are_not_snapshots() -> None:
+    plc = plcrt.load(COUNTING)
+    plc.write("I0.1", 1)
+    twin = plc.fork()
+    twin.scan(7)
+    plc.restore(twin.snapshot())        # a fork shares the program: allowed
+    assert plc.scans == 7 and plc["VW0"] == 7
+    with pytest.raises(PlcConfigError, match="needs a snapshot made by snapshot"):
+        plc.restore(42)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("options", [{"cpu": "CPU222"}, {"instrument": True}])
+def test_restore_refuses_the_same_program_compiled_differently(options: dict) -> None:
+    """The pytest plugin parses a file once and compiles it per test, so two
+    PLCs can share the program object yet differ; restoring across them
+    resized V memory (CPU222 has less) or failed with an internal error."""
+    from plcrt.engine.runtime import Plc, parse_sources
+
+    program = parse_sources(COUNTING)
+    plc, other = Plc(program), Plc(program, **options)
+    other.scan(3)
+    v_size = len(plc.mem.areas["V"])
+    with pytest.raises(PlcConfigError, match="compiled with other options"):
+        plc.restore(other.snapshot())
+    assert len(plc.mem.areas["V"]) == v_size and plc.scans == 0

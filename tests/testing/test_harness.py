@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import plcrt
 from plcrt import PlcConfigError
 from plcrt.testing import Harness, PlcTimeout, seconds
 from stl_helpers import ob1_text
@@ -279,3 +280,99 @@ def test_fork_mid_way_gives_the_same_history(table, mid_scans) -> None:
         x.stimulus(rest, until=end - mid)
     assert f.history_rows() == h.history_rows() == straight.history_rows()
     assert f.scans == h.scans == straight.scans == 65
+
+
+# -- edge cases --------------------------------------------------------------------
+STOPS = ob1_text("LD SM0.0\nINCW VW100", "LD I0.2\nSTOP")
+
+
+def test_run_until_with_a_condition_that_raises_says_when() -> None:
+    h = Harness.load(COUNTER)
+
+    def broken() -> bool:
+        raise ZeroDivisionError("oops")
+
+    with pytest.raises(ZeroDivisionError) as info:
+        h.run_until(broken)
+    # the test's own exception, with a note on the scan it was checked after
+    assert info.value.__notes__ == [
+        "while checking the condition 'broken' after scan 1 (t = 0.010 s)"]
+    assert h.scans == 1
+
+
+@pytest.mark.parametrize("cond", [None, 5, ["Q0.0"]])
+def test_a_condition_of_the_wrong_type_is_named(cond) -> None:
+    with pytest.raises(PlcConfigError, match="a condition is a string such as"):
+        Harness.load(COUNTER).run_until(cond)
+
+
+@pytest.mark.parametrize("cond", ["VW100 >=", "VW100 >= =3", "VW100 == == 3"])
+def test_an_incomplete_comparison_is_not_read_as_a_value(cond: str) -> None:
+    # "VW100 >=" used to be read as "VW100 > '='" ("'=' is not a number")
+    with pytest.raises(PlcConfigError, match="cannot read the condition"):
+        Harness.load(COUNTER).run_until(cond)
+
+
+def test_stays_fails_when_the_cpu_is_in_stop() -> None:
+    # In STOP no scan runs and time stands still: "stays off for 1 s" would
+    # pass without a single scan.
+    h = Harness.load(STOPS)
+    h["I0.2"] = 1
+    with pytest.raises(AssertionError, match="the CPU went to STOP before 1 s had passed"):
+        h.stays("not Q0.0", "1s")
+    with pytest.raises(AssertionError, match="went to STOP"):
+        h.stays("not Q0.0", "1s")   # already in STOP
+    assert h.scans == 1
+
+
+def test_stimulus_checks_every_row_before_the_first_scan() -> None:
+    h = Harness.load(COUNTER)
+    for table, error in (
+            ([(0, "VW10", 1), ("1s", "XX9.9", 1)], "stimulus row 2 .*'XX9.9' is not an address"),
+            ([(0, "VW10", 1), (-1, "VW10", 2)], "stimulus row 2 .*must be a non-negative"),
+            ([(0, "I0.0", 3)], "stimulus row 1 .*a bit takes 0 or 1"),
+            ([(0.1, "VB0", 300)], "stimulus row 1 .*does not fit")):
+        with pytest.raises(plcrt.PlcError, match=error):
+            h.stimulus(table)
+        assert h.scans == 0 and h["VW10"] == 0      # nothing ran, nothing written
+
+
+def test_stimulus_keeps_the_order_of_rows_with_equal_times() -> None:
+    h = Harness.load(COUNTER)
+    h.stimulus([("20ms", "VW10", 5), (0, "VW10", 1), ("20ms", "VW10", 3), ("10ms", "VW10", 7),
+                ("20ms", "VW10", 2)])
+    assert h["VW10"] == 2 and h.scans == 2
+
+
+def test_force_and_unforce_by_symbol_or_address(tmp_path: Path) -> None:
+    symbols = tmp_path / "s.sym"
+    symbols.write_text("Start\tI0.0\tstart\nStop\tI0.1\tstop\n", encoding="utf-8")
+    h = Harness.load(SEAL_IN, symbols=symbols)
+    h.force("I0.0", 1)
+    h.unforce("Start")
+    assert h.plc.forces == {}
+    with h.force("Start", 1):
+        h.force("I0.0", 0)          # the same location, forced again by address
+    assert h.plc.forces == {}        # released at the end of the block all the same
+    with h.forced({"Stop": 1}):
+        h.unforce("I0.1")            # released inside the block: no error at its end
+    assert h.plc.forces == {}
+
+
+def test_fork_and_snapshot_of_a_faulted_plc() -> None:
+    fault = ob1_text("LD SM0.0\nINCW VW0", "LD I0.1\nBMB VB0, VB10200, VB500")
+    h = Harness.load(fault, watch=["VW0"])
+    h.run(scans=2)
+    h["VB500"] = 100
+    h["I0.1"] = 1
+    with pytest.raises(plcrt.PlcRuntimeError, match="block move runs past the end"):
+        h.scan()
+    twin = h.fork()
+    assert (twin.plc.mode, twin.scans, twin["VW0"]) == ("STOP", 2, 3)
+    assert str(twin.plc.fault) == str(h.plc.fault)
+    twin.scan(5)                        # STOP: nothing runs, nothing raises
+    assert twin.scans == 2
+    with pytest.raises(PlcTimeout, match="the CPU went to STOP"):
+        twin.run_until("VW0 > 10")
+    h.restore(twin.snapshot())
+    assert h.plc.mode == "STOP"

@@ -402,3 +402,76 @@ def test_report_merges_and_lists() -> None:
         "  OB1/2 line 9: = Q0.1 never reached",
     ]
     assert report_lines({}) == ["no PLC program was run with coverage"]
+
+
+def test_watch_and_ob1_problems_fail_setup_with_what_to_fix(pytester: pytest.Pytester) -> None:
+    """A watched address that does not exist is a problem of the marker, not
+    of loading the program; a file without OB1 (an empty one, say) would
+    make every scan do nothing and "stays off" assertions pass."""
+    pytester.makefile(".awl", seal=SEAL, bad=BAD, empty="// nothing here\n",
+                      sbr="SUBROUTINE_BLOCK SBR0\nBEGIN\nNetwork 1\nLD I0.0\n= Q0.0\n"
+                          "END_SUBROUTINE_BLOCK\n")
+    pytester.makepyfile(test_setup="""\
+import pytest
+import plcrt
+
+
+@pytest.mark.plc("seal.awl", watch=["Q0.0", "XX9.9"])
+def test_watch_unknown_address(plc):
+    pass
+
+
+@pytest.mark.plc("seal.awl", watch=["Q0.0:FOO"])
+def test_watch_unknown_kind(plc):
+    pass
+
+
+@pytest.mark.plc("empty.awl")
+def test_empty_program(plc):
+    plc.stays("not Q0.0", "1s")
+
+
+@pytest.mark.plc("sbr.awl")
+def test_no_ob1(plc):
+    pass
+
+
+@pytest.mark.plc("bad.awl")
+def test_compile_error(plc):
+    pass
+
+
+def test_factory_watch(plc_factory):
+    with pytest.raises(plcrt.PlcConfigError, match="plc_factory: watch 'XX': 'XX' is not an address"):
+        plc_factory("seal.awl", watch=["XX"])
+""")
+    result = _run(pytester)
+    result.assert_outcomes(errors=5, passed=1)
+    result.stdout.fnmatch_lines([
+        "test_setup.py::test_watch_unknown_address: @pytest.mark.plc: watch 'XX9.9': "
+        "'XX9.9' is not an address",
+        "test_setup.py::test_watch_unknown_kind: @pytest.mark.plc: watch 'Q0.0:FOO': *"
+        "unknown kind 'FOO'*",
+        "test_setup.py::test_empty_program: @pytest.mark.plc: empty.awl has no main program "
+        "block (OB1), so there is nothing to run; name the file with OB1 as well",
+        "test_setup.py::test_no_ob1: @pytest.mark.plc: sbr.awl has no main program block*",
+        "test_setup.py::test_compile_error: @pytest.mark.plc: cannot load bad.awl:",
+        "*/bad.awl:5:1: error: unknown instruction 'FOO' [[]OB1 network 1]",
+    ])
+    out = result.stdout.str()
+    assert "cannot load seal.awl" not in out
+    assert "Traceback" not in out and "plcrt/" not in out.replace("\\", "/")
+
+
+def test_p_no_plcrt_switches_the_plugin_off(pytester: pytest.Pytester) -> None:
+    pytester.makefile(".awl", seal=SEAL)
+    pytester.makepyfile(test_plain="""\
+def test_plain():
+    assert True
+""")
+    result = _run(pytester, "-p", "no:plcrt", "-W", "error::pytest.PytestConfigWarning")
+    result.assert_outcomes(passed=1)
+    assert "plcrt coverage" not in result.stdout.str()
+    result = _run(pytester, "-p", "no:plcrt", "--plc-coverage")
+    assert result.ret == pytest.ExitCode.USAGE_ERROR   # its options are gone with it
+    result.stderr.fnmatch_lines(["*unrecognized arguments: --plc-coverage*"])

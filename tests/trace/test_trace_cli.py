@@ -115,13 +115,43 @@ def test_trace_fault_exits_2_and_keeps_samples(tmp_path: Path,
     assert csv.read_text(encoding="utf-8") == "time_s,VW0\n0.01,1\n0.02,2\n"
 
 
-def test_trace_unwritable_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    target = tmp_path / "missing" / "t.csv"
+def test_trace_unwritable_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                              monkeypatch: pytest.MonkeyPatch) -> None:
+    # A folder that does not exist, or a folder as the file, is refused
+    # before the run (which may be long), like a wrong --plot extension.
+    for target, why in ((tmp_path / "missing" / "t.csv", "does not exist"),
+                        (tmp_path, "this is a folder, not a file")):
+        code, out, err = run_cli(capsys, "trace", TIMERS, "--signal", "T37", "--scans", "2",
+                                 "--csv", target)
+        assert (code, out) == (1, "")
+        assert err.startswith(f"plcrt: error: --csv {target}: ") and why in err
+    # A failure only writing can show comes after the run: the trend is still shown.
+    from plcrt.trace.recorder import Trace
+
+    def full(self: Trace, path: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Trace, "to_csv", full)
+    target = tmp_path / "t.csv"
     code, out, err = run_cli(capsys, "trace", TIMERS, "--signal", "T37", "--scans", "2",
                              "--csv", target)
     assert code == 1
-    assert f"cannot write '{target}'" in err
-    assert "2 samples" in out   # the trend is still shown
+    assert f"cannot write '{target}': No space left on device" in err
+    assert "2 samples" in out
+
+
+def test_trace_plot_names_are_not_mathtext(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    # A '$' pair in a program name (the plot's title) or a signal made
+    # matplotlib parse mathtext and fail after the run.
+    pytest.importorskip("matplotlib")
+    prog = tmp_path / "x$\\foo$.awl"
+    prog.write_text(Path(TIMERS).read_text(encoding="utf-8"), encoding="utf-8")
+    svg = tmp_path / "t.svg"
+    code, out, err = run_cli(capsys, "trace", prog, "--signal", "Q0.0", "--scans", "3",
+                             "--plot", svg, "--quiet")
+    assert (code, out, err) == (0, "", "")
+    assert "x$\\foo$.awl" in svg.read_text(encoding="utf-8")
 
 
 def test_run_quiet(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -154,3 +184,28 @@ def test_run_output_unchanged_without_quiet(capsys: pytest.CaptureFixture[str]) 
     assert (code, err) == (0, "")   # 2500 scans, but not a terminal: no bar
     assert out.splitlines() == [f"{TIMERS}: 2500 scan(s), 25 s simulated, mode RUN",
                                 "address  value", "Q0.0     1"]
+
+
+def test_trace_ctrl_c_keeps_the_samples(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """Ctrl-C during a long run used to end plcrt with "interrupted" and no
+    CSV: every sample was lost.  Now the samples so far are written, and a
+    sample cut in half by the interruption is dropped."""
+    import plcrt.trace.progress as progress
+
+    def interrupted(plc, **kw) -> None:
+        plc.scan(5)
+        trace = plc.observers[0].__self__
+        trace._t_us.append(plc._t_us)       # Ctrl-C in the middle of recording
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(progress, "run_with_progress", interrupted)
+    csv = tmp_path / "t.csv"
+    code, out, err = run_cli(capsys, "trace", TIMERS, "--signal", "T37", "--signal", "Q0.0",
+                             "--seconds", "1e6", "--csv", csv)
+    assert code == 130
+    assert err == ("plcrt: interrupted after 5 scan(s); writing the 5 sample(s) recorded "
+                   "so far\n")
+    assert csv.read_text(encoding="utf-8").splitlines() == [
+        "time_s,T37,Q0.0", "0.01,0,0", "0.02,0,0", "0.03,0,0", "0.04,0,0", "0.05,0,0"]
+    assert "5 samples, t = 0.01..0.05 s" in out

@@ -72,3 +72,15 @@ def test_trend_empty_and_negative() -> None:
     assert trend(tr) == "0 samples"
     plc.scan(1)
     assert trend(tr, width=4) == "1 sample, t = 0.01..0.01 s\nVW0  -1000..-1000  ▁▁▁▁  last=-1000"
+
+
+def test_trend_range_of_infinite_and_nan_reals() -> None:
+    # A REAL that is +inf all along used to show the range "nan".
+    plc = plcrt.load(ob1_text("LD SM0.0\nMOVR VD0, VD4"))
+    tr = Trace(plc, ["VD4:REAL", "VD8:REAL"])
+    plc.write("VD0", float("inf"))
+    plc.write("VD8", float("nan"))
+    plc.scan(2)
+    lines = trend(tr, width=4).splitlines()
+    assert lines[1] == "VD4:REAL  inf..inf        last=inf"
+    assert lines[2] == "VD8:REAL  nan             last=nan"

@@ -493,6 +493,14 @@ class Harness:
         """Network/output coverage (``instrument=True`` only, else None)."""
         return self.plc.coverage
 
+    def trace(self, *signals: str, every: int = 1, limit: int | None = None) -> Any:
+        """Start recording ``signals`` (addresses, ``VD4:REAL``, ``T37:BIT``,
+        ``axis0.0.speed``) once per scan from now on; returns the
+        :class:`plcrt.trace.Trace`, whose arrays are numpy (``tr["Q0.0"]``,
+        ``tr.time``).  ``tr.detach()`` stops it."""
+        from ..trace import Trace
+        return Trace(self.plc, list(signals), every=every, limit=limit)
+
 
 class _Forced:
     """The result of :meth:`Harness.force`: persistent, or a context manager."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -376,3 +377,23 @@ def test_fork_and_snapshot_of_a_faulted_plc() -> None:
         twin.run_until("VW0 > 10")
     h.restore(twin.snapshot())
     assert h.plc.mode == "STOP"
+
+
+def test_trace_records_numpy_arrays_from_now_on() -> None:
+    """Harness.trace records once per scan from the moment it is started:
+    a TON T37 (PT 20 x 100 ms) with 10 ms scans counts 0, 0, ..., 1 ... and
+    its output comes on in the scan at 2.01 s."""
+    h = Harness.load(ROOT / "programs" / "timers.awl")
+    h["I0.0"] = 1
+    tr = h.trace("T37", "Q0.0")
+    h.run("2.5s")
+    assert len(tr) == 250
+    assert tr.time[0] == pytest.approx(0.01)
+    q = tr["Q0.0"]
+    first_on = int(np.argmax(q == 1))
+    assert tr.time[first_on] == pytest.approx(2.01)
+    assert tr["T37"][first_on] == 20
+    assert list(np.unique(np.diff(tr["T37"]))) == [0, 1]
+    tr.detach()
+    h.scan(3)
+    assert len(tr) == 250

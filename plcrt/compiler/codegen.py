@@ -29,6 +29,9 @@ from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 MAX_NESTING = 8
 MAX_FOR_NESTING = 8
 
+#: depth of the S7-200 logic stack (System Manual, "Logic stack")
+MAX_STACK_LEVELS = 9
+
 # Flow kinds that start a new piece at the instruction / after it.
 _CUT_BEFORE = {"label"}
 _CUT_AFTER = {"for", "next", "scre"}
@@ -332,6 +335,43 @@ def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: Source
     gen.line(f"{oc}[{j}] |= 2 if {gen.level(shp.inputs - 1)} else 1")
 
 
+#: A and O contacts are emitted as their load form plus ALD / OLD when
+#: probed, so that the contact's own value is on the stack to record
+_COMBINE = {"and": "ALD", "or": "OLD"}
+
+
+def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[Any],
+                   loc: SourceLoc) -> bool:
+    """Emit a contact so that whether it was open or closed is recorded.
+
+    ``A x`` is ``LD x`` + ``ALD`` and ``O x`` is ``LD x`` + ``OLD`` (System
+    Manual, logic stack), so the probe can read the contact alone from the
+    top of the stack.  That needs one free stack level: with nine in use the
+    contact is emitted as written and not probed.  Returns False when the
+    instruction is not a contact (nothing emitted).
+    """
+    shp = shape(insn.mnemonic)
+    if shp.kind != "contact" or gen.depth >= MAX_STACK_LEVELS:
+        return False
+    m = insn.mnemonic
+    load = m if shp.op == "load" else "LD" + m[1:]
+    load_spec = lookup(load)
+    if load_spec is None or (shp.op != "load" and gen.depth < 1):
+        return False
+    net = piece.network
+    k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
+                                net.loc.within(piece.pou.ident, net.number))
+    j = unit.probes.add_contact(k, m, insn.operands[0].text if insn.operands else "", loc)
+    cc = gen.bind(unit.probes.closed, "CC")
+    load_spec.emit(gen, *ops)
+    gen.line(f"{cc}[{j}] |= 2 if {gen.top} else 1")
+    if shp.op != "load":
+        combine = lookup(_COMBINE[shp.op])
+        assert combine is not None
+        combine.emit(gen)
+    return True
+
+
 def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
     if not info.flow:
         lines = [f"def {info.fname}(L):"]
@@ -396,7 +436,10 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             _output_probe(unit, gen, piece, insn, loc)
         saved = (list(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
-            if spec.variadic:
+            if unit.probes is not None and not broken and \
+                    _contact_probe(unit, gen, piece, insn, ops, loc):
+                pass
+            elif spec.variadic:
                 spec.emit(gen, insn, resolver, *ops)
             else:
                 spec.emit(gen, *ops)

@@ -10,7 +10,10 @@ two kinds of probes (and nothing else changes in what the program does):
   :mod:`plcrt.isa.shape`) ``_OC[j] |= 2 if <power> else 1``: bit 0 = the
   output was reached without power flow, bit 1 = with power flow.  An output
   that saw both has had each of its rung's outcomes exercised: the ladder
-  equivalent of branch coverage.
+  equivalent of branch (decision) coverage;
+* at every contact ``_CC[j] |= 2 if <closed> else 1``: bit 0 = evaluated
+  open, bit 1 = closed.  A parallel branch whose contact was never closed
+  never conducted: the ladder form of condition coverage.
 
 The first piece of every network also checks ``_BP[k]`` and calls the
 break handler, which the debugger uses for breakpoints on networks.
@@ -43,7 +46,8 @@ class NetworkRef:
 
 @dataclass(frozen=True)
 class OutputRef:
-    """One coil or box of a rung (an outcome of the network's logic)."""
+    """One coil or box of a rung (an outcome of the network's logic), or
+    one contact."""
 
     index: int
     network: int        #: index into the network list
@@ -60,6 +64,8 @@ class CoverageMap:
         self.outputs: list[OutputRef] = []
         self.hits = bytearray()          #: per network: 1 = ran (since reset)
         self.power = bytearray()         #: per output: bit0 unpowered, bit1 powered
+        self.contacts: list[OutputRef] = []
+        self.closed = bytearray()        #: per contact: bit0 seen open, bit1 closed
         self.breakpoints = bytearray()   #: per network: 1 = break before it
         self.on_break: Callable[[NetworkRef], None] | None = None
         #: perf: one bound method for every probe to share
@@ -84,6 +90,12 @@ class CoverageMap:
         self.power.append(0)
         return j
 
+    def add_contact(self, network: int, mnemonic: str, operand: str, loc: SourceLoc) -> int:
+        j = len(self.contacts)
+        self.contacts.append(OutputRef(j, network, mnemonic, operand, loc))
+        self.closed.append(0)
+        return j
+
     # -- run time ---------------------------------------------------------
     def hit(self, k: int) -> None:
         """Called by generated code before network ``k`` when it has a breakpoint."""
@@ -98,6 +110,7 @@ class CoverageMap:
         """Forget what ran (breakpoints stay)."""
         self.hits[:] = bytes(len(self.hits))
         self.power[:] = bytes(len(self.power))
+        self.closed[:] = bytes(len(self.closed))
 
     # -- results ----------------------------------------------------------
     def data(self) -> dict[str, Any]:
@@ -105,6 +118,7 @@ class CoverageMap:
         return {
             "networks": {n.name: int(self.hits[n.index]) for n in self.networks},
             "outputs": {self.output_key(o): int(self.power[o.index]) for o in self.outputs},
+            "contacts": {self.output_key(c): int(self.closed[c.index]) for c in self.contacts},
         }
 
     def output_key(self, o: OutputRef) -> str:
@@ -112,15 +126,18 @@ class CoverageMap:
         return f"{net.name}:{o.loc.line}:{o.loc.column}:{o.mnemonic}"
 
 
+#: the kinds of probes in :meth:`CoverageMap.data`
+PARTS = ("networks", "outputs", "contacts")
+
+
 def merge_data(a: dict[str, Any], b: dict[str, Any]) -> dict[str, Any]:
     """Union of two :meth:`CoverageMap.data` results of the same program."""
-    out: dict[str, Any] = {"networks": dict(a.get("networks", {})),
-                           "outputs": dict(a.get("outputs", {}))}
-    for key, v in b.get("networks", {}).items():
-        out["networks"][key] = out["networks"].get(key, 0) | v
-    for key, v in b.get("outputs", {}).items():
-        out["outputs"][key] = out["outputs"].get(key, 0) | v
+    out: dict[str, Any] = {}
+    for part in PARTS:
+        out[part] = dict(a.get(part, {}))
+        for key, v in b.get(part, {}).items():
+            out[part][key] = out[part].get(key, 0) | v
     return out
 
 
-__all__ = ["CoverageMap", "NetworkRef", "OutputRef", "merge_data"]
+__all__ = ["PARTS", "CoverageMap", "NetworkRef", "OutputRef", "merge_data"]

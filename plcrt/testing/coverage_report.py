@@ -1,4 +1,4 @@
-"""Network and rung-output coverage across a test session: merge and report.
+"""Network, rung-output and contact coverage across a test session.
 
 The pytest plugin (:mod:`plcrt.testing.plugin`) turns the
 :class:`~plcrt.engine.coverage.CoverageMap` of every instrumented harness
@@ -11,8 +11,10 @@ An entry::
 
     {"networks": {"OB1/1": 0|1, ...},              # as CoverageMap.data()
      "outputs": {"OB1/1:12:1:=": bits, ...},        # bit 0 unpowered, bit 1 powered
+     "contacts": {"OB1/1:10:1:LD": bits, ...},      # bit 0 seen open, bit 1 closed
      "meta": {"networks": {"OB1/1": [title, line]},
-              "outputs": {"OB1/1:12:1:=": [network, mnemonic, operand, line]}}}
+              "outputs": {"OB1/1:12:1:=": [network, mnemonic, operand, line]},
+              "contacts": {"OB1/1:10:1:LD": [network, mnemonic, operand, line]}}}
 
 This module does not run programs and does not import the engine or pytest.
 """
@@ -26,35 +28,37 @@ Store = dict[str, Entry]   #: program key (resolved path or paths) -> entry
 
 #: output bits, as the probes of plcrt.engine.coverage set them
 UNPOWERED, POWERED = 1, 2
+#: contact bits
+OPEN, CLOSED = 1, 2
+#: the probe kinds (as plcrt.engine.coverage.PARTS, without importing it)
+PARTS = ("networks", "outputs", "contacts")
 
 
 def entry_from_map(cov: Any) -> Entry:
     """An entry from a live ``CoverageMap`` (what ran, and the names to show)."""
     data = cov.data()
     nets = {n.name: [n.title or "", _line(n.loc)] for n in cov.networks}
-    outs = {cov.output_key(o): [cov.networks[o.network].name, o.mnemonic, o.operand,
-                                _line(o.loc)]
-            for o in cov.outputs}
+    def names(refs: Any) -> dict[str, list[Any]]:
+        return {cov.output_key(o): [cov.networks[o.network].name, o.mnemonic, o.operand,
+                                    _line(o.loc)] for o in refs}
     return {"networks": data["networks"], "outputs": data["outputs"],
-            "meta": {"networks": nets, "outputs": outs}}
+            "contacts": data["contacts"],
+            "meta": {"networks": nets, "outputs": names(cov.outputs),
+                     "contacts": names(cov.contacts)}}
 
 
 def merge_entry(store: Store, key: str, entry: Entry) -> None:
     """Union ``entry`` into ``store[key]`` (bits are OR-ed, names kept)."""
     old = store.get(key)
     if old is None:
-        store[key] = {"networks": dict(entry.get("networks", {})),
-                      "outputs": dict(entry.get("outputs", {})),
-                      "meta": {"networks": dict(entry.get("meta", {}).get("networks", {})),
-                               "outputs": dict(entry.get("meta", {}).get("outputs", {}))}}
-        return
+        old = store[key] = {part: {} for part in PARTS}
+        old["meta"] = {part: {} for part in PARTS}
     # the same arithmetic as plcrt.engine.coverage.merge_data, kept here so
     # that merging on the xdist controller does not import the engine
-    for part in ("networks", "outputs"):
+    for part in PARTS:
         into = old[part]
         for k, v in entry.get(part, {}).items():
             into[k] = into.get(k, 0) | int(v)
-    for part in ("networks", "outputs"):
         for k, v in entry.get("meta", {}).get(part, {}).items():
             old["meta"][part].setdefault(k, v)
 
@@ -88,8 +92,21 @@ def summarize(entry: Entry) -> dict[str, Any]:
             continue
         findings.append({"network": network, "line": line, "mnemonic": mnemonic,
                          "operand": operand, "missing": what})
+    conditions = 0
+    contacts = entry.get("contacts", {})
+    meta_c = entry["meta"].get("contacts", {})
+    for key, bits in contacts.items():
+        conditions += (bits & OPEN) + (bits >> 1 & 1)
+        network, mnemonic, operand, line = meta_c.get(key, [key.split(":")[0], "?", "", 0])
+        if not nets.get(network, 0) or bits == OPEN | CLOSED:
+            continue
+        what = {0: "never evaluated", OPEN: "never closed", CLOSED: "never open"}[bits]
+        findings.append({"network": network, "line": line, "mnemonic": mnemonic,
+                         "operand": operand, "missing": what})
+    findings.sort(key=lambda f: (f["network"], f["line"]))
     run = len(nets) - len(not_run)
     return {
+        "contacts_covered": conditions, "contacts_total": 2 * len(contacts),
         "networks_run": run, "networks_total": len(nets),
         "branches_covered": branches, "branches_total": 2 * len(entry["outputs"]),
         "networks_not_run": [{"network": n, "title": meta_n.get(n, ["", 0])[0],
@@ -104,15 +121,18 @@ def report_lines(store: Store) -> list[str]:
     if not store:
         return ["no PLC program was run with coverage"]
     lines: list[str] = []
-    tot = [0, 0, 0, 0]
+    tot = [0, 0, 0, 0, 0, 0]
     for key in sorted(store):
         s = summarize(store[key])
         tot[0] += s["networks_run"]
         tot[1] += s["networks_total"]
         tot[2] += s["branches_covered"]
         tot[3] += s["branches_total"]
+        tot[4] += s["contacts_covered"]
+        tot[5] += s["contacts_total"]
         lines.append(f"{key}: networks {_ratio(s['networks_run'], s['networks_total'])}, "
-                     f"branches {_ratio(s['branches_covered'], s['branches_total'])}")
+                     f"branches {_ratio(s['branches_covered'], s['branches_total'])}, "
+                     f"contacts {_ratio(s['contacts_covered'], s['contacts_total'])}")
         for n in s["networks_not_run"]:
             title = f' "{n["title"]}"' if n["title"] else ""
             lines.append(f"  not run: {n['network']}{title} (line {n['line']})")
@@ -121,7 +141,7 @@ def report_lines(store: Store) -> list[str]:
             lines.append(f"  {o['network']} line {o['line']}: {what} {o['missing']}")
     if len(store) > 1:
         lines.append(f"TOTAL: networks {_ratio(tot[0], tot[1])}, "
-                     f"branches {_ratio(tot[2], tot[3])}")
+                     f"branches {_ratio(tot[2], tot[3])}, contacts {_ratio(tot[4], tot[5])}")
     return lines
 
 
@@ -133,7 +153,7 @@ def to_json(store: Store) -> dict[str, Any]:
     for key in sorted(store):
         e = store[key]
         programs[key] = {
-            "data": {"networks": e["networks"], "outputs": e["outputs"]},
+            "data": {part: e.get(part, {}) for part in PARTS},
             "names": e["meta"],
             "summary": summarize(e),
         }

@@ -285,9 +285,9 @@ def _describe_difference(area: str, got: bytes, want: bytes) -> str:
     return shown + (" ..." if len(offsets) > 6 else "")
 
 
-def run_side_by_side(case: Case) -> None:
+def run_side_by_side(case: Case, instrument: bool = False) -> None:
     """Run both sides over the case; assert identical memory after each scan."""
-    engine = plcrt.load(case.program, scan_ms=case.scan_ms)
+    engine = plcrt.load(case.program, scan_ms=case.scan_ms, instrument=instrument)
     reference = ReferencePlc(case.program, scan_ms=case.scan_ms)
     for mem in (engine.mem.areas, reference.mem):
         mem["V"][:V_BYTES] = case.initial_v
@@ -404,6 +404,17 @@ S V0.0, 12
               scan_ms=60000))
 def test_compiled_engine_matches_reference(case: Case) -> None:
     run_side_by_side(case)
+
+
+@settings(max_examples=150, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(case=cases())
+@example(Case(STACK_OVERFLOW, ((0, 0, 2),)))
+@example(Case(STACK_LPS_OVERFLOW, ((1, 0, 2), (3, 0, 2), (0, 0, 1))))
+def test_probed_engine_matches_reference(case: Case) -> None:
+    """The coverage probes (contacts split into load + ALD/OLD, output and
+    network marks) never change what a program does, stack overflows included."""
+    run_side_by_side(case, instrument=True)
 
 
 # Regression: an early version of the contact-run folding (Gen.combine) turned

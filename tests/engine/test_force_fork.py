@@ -168,8 +168,29 @@ def test_coverage_probes_record_networks_and_power_flow() -> None:
     data = cov.data()
     assert data["outputs"][q00] == 3          # both outcomes seen
     assert data["networks"]["OB1/3"] == 1
+    contacts = data["contacts"]
+    i00 = next(k for k in contacts if k.startswith("OB1/1:"))
+    assert contacts[i00] == 3                 # I0.0 seen open, then closed
+    sm = next(k for k in contacts if k.startswith("OB1/3:"))
+    assert contacts[sm] == 2                  # SM0.0: only ever closed
     cov.reset()
     assert set(cov.data()["networks"].values()) == {0}
+    assert set(cov.data()["contacts"].values()) == {0}
+
+
+def test_contact_probes_keep_a_full_stack_intact() -> None:
+    """With nine levels in use a contact is not split into LD + OLD (that
+    would push a tenth level and lose the bottom one); it runs unprobed."""
+    loads = "\n".join(f"LD I0.{i}" for i in range(8)) + "\nLD I1.0"
+    text = ob1_text(loads + "\nO I1.1\n" + "\n".join(["ALD"] * 8) + "\n= Q0.0")
+    plain, probed = plcrt.load(text), plcrt.load(text, instrument=True)
+    for p in (plain, probed):
+        p.write("IB0", 255)
+        p.write("I1.1", 1)
+        p.scan(1)
+    assert plain["Q0.0"] == probed["Q0.0"] == 1
+    names = [c.mnemonic for c in probed.coverage.contacts]
+    assert names.count("LD") == 9 and "O" not in names
 
 
 def test_breakpoint_handler_runs_inside_the_scan() -> None:

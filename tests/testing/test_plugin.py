@@ -337,20 +337,26 @@ def test_fork_counts_too(plc):
     result.assert_outcomes(passed=2)
     result.stdout.fnmatch_lines([
         "*= plcrt coverage =*",
-        "cov.awl: networks 5/7 (71.4 %), branches 5/12 (41.7 %)",
+        "cov.awl: networks 5/7 (71.4 %), branches 5/12 (41.7 %), contacts 9/16 (56.2 %)",
         '  not run: OB1/3 "Horn" (line 11)',
         '  not run: SBR0/1 "Count service calls" (line 25)',
+        "  OB1/2 line 9: LDN I0.7 never open",
         "  OB1/2 line 10: JMP 1 never false",
+        "  OB1/5 line 17: LD I0.6 never closed",
         "  OB1/5 line 18: CALL SERVICE never true",
+        "  OB1/6 line 20: LD M0.0 never closed",
         "  OB1/6 line 21: = Q0.1 never true",
         "coverage JSON written to *cov.json",
     ])
     assert "Q0.0 never" not in result.stdout.str()   # seal-in seen both ways
+    assert "I0.1 never" not in result.stdout.str()   # the stop button was pressed
     report = json.loads((pytester.path / "out" / "cov.json").read_text())
     prog = report["programs"]["cov.awl"]
     assert prog["summary"]["networks_run"] == 5 and prog["summary"]["networks_total"] == 7
     assert prog["data"]["networks"]["OB1/3"] == 0
     assert prog["data"]["outputs"]["OB1/1:7:1:="] == 3
+    assert prog["data"]["contacts"]["OB1/1:6:1:AN"] == 3        # open and closed
+    assert prog["data"]["contacts"]["OB1/5:17:1:LD"] == 1       # only ever open
     assert [n["network"] for n in prog["summary"]["networks_not_run"]] == ["OB1/3", "SBR0/1"]
 
 
@@ -378,27 +384,35 @@ def test_it(plc):
     assert workers == {"gw0", "gw1"}
     out = result.stdout.str()
     assert out.count("plcrt coverage") == 1
-    result.stdout.fnmatch_lines(["seal.awl: networks 2/2 (100.0 %), branches 4/4 (100.0 %)"])
+    result.stdout.fnmatch_lines([
+        "seal.awl: networks 2/2 (100.0 %), branches 4/4 (100.0 %), contacts 6/8 (75.0 %)",
+        "  OB1/1 line 6: O Q0.0 never closed",
+        "  OB1/1 line 7: AN I0.1 never open",
+    ])
 
 
 def test_report_merges_and_lists() -> None:
     meta = {"networks": {"OB1/1": ["Start", 3], "OB1/2": ["", 8]},
             "outputs": {"OB1/1:5:1:=": ["OB1/1", "=", "Q0.0", 5],
-                        "OB1/2:9:1:=": ["OB1/2", "=", "Q0.1", 9]}}
+                        "OB1/2:9:1:=": ["OB1/2", "=", "Q0.1", 9]},
+            "contacts": {"OB1/1:4:1:LD": ["OB1/1", "LD", "I0.0", 4]}}
     store: dict = {}
     merge_store(store, {"p.awl": {"networks": {"OB1/1": 1, "OB1/2": 0},
                                   "outputs": {"OB1/1:5:1:=": 1, "OB1/2:9:1:=": 0},
+                                  "contacts": {"OB1/1:4:1:LD": 1},
                                   "meta": meta}})
     assert report_lines(store) == [
-        "p.awl: networks 1/2 (50.0 %), branches 1/4 (25.0 %)",
+        "p.awl: networks 1/2 (50.0 %), branches 1/4 (25.0 %), contacts 1/2 (50.0 %)",
         "  not run: OB1/2 (line 8)",
+        "  OB1/1 line 4: LD I0.0 never closed",
         "  OB1/1 line 5: = Q0.0 never true",
     ]
     merge_store(store, {"p.awl": {"networks": {"OB1/1": 1, "OB1/2": 1},
                                   "outputs": {"OB1/1:5:1:=": 2, "OB1/2:9:1:=": 0},
+                                  "contacts": {"OB1/1:4:1:LD": 2},
                                   "meta": meta}})
     assert report_lines(store) == [
-        "p.awl: networks 2/2 (100.0 %), branches 2/4 (50.0 %)",
+        "p.awl: networks 2/2 (100.0 %), branches 2/4 (50.0 %), contacts 2/2 (100.0 %)",
         "  OB1/2 line 9: = Q0.1 never reached",
     ]
     assert report_lines({}) == ["no PLC program was run with coverage"]

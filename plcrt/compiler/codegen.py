@@ -332,7 +332,7 @@ def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: Source
                                insn.operands[0].text if insn.operands else "", loc)
     oc = gen.bind(unit.probes.power, "OC")
     # the first power input (EN; CU of a counter) is the deepest of them
-    gen.line(f"{oc}[{j}] |= 2 if {gen.level(shp.inputs - 1)} else 1")
+    gen.line(f"{oc}[{j}] |= {gen.level(shp.inputs - 1)} + 1")  # perf: 0/1 -> bit 0/1
 
 
 #: A and O contacts are emitted as their load form plus ALD / OLD when
@@ -364,7 +364,7 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     j = unit.probes.add_contact(k, m, insn.operands[0].text if insn.operands else "", loc)
     cc = gen.bind(unit.probes.closed, "CC")
     load_spec.emit(gen, *ops)
-    gen.line(f"{cc}[{j}] |= 2 if {gen.top} else 1")
+    gen.line(f"{cc}[{j}] |= {gen.top} + 1")  # perf: a stack value is 0 or 1
     if shp.op != "load":
         combine = lookup(_COMBINE[shp.op])
         assert combine is not None

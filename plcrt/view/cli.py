@@ -72,13 +72,15 @@ def cmd_show(args: argparse.Namespace) -> int:
 
     status = None
     if args.status:
+        from ..trace.progress import run_with_progress
         from .status import PlcStatus
         loaded = len(plc.diagnostics)
         try:
+            # a long run shows a progress bar on a terminal (stderr only)
             if args.seconds is not None:
-                plc.run(seconds=args.seconds)
+                run_with_progress(plc, seconds=args.seconds)
             else:
-                plc.run(scans=1 if args.scans is None else args.scans)
+                run_with_progress(plc, scans=1 if args.scans is None else args.scans)
         except PlcRuntimeError as e:
             fault = e
         print_diagnostics(plc.diagnostics[loaded:])

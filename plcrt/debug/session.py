@@ -280,12 +280,7 @@ class Session:
 
     # -- forced markers ---------------------------------------------------
     def _location(self, spec: str) -> tuple[bytearray, int, int, int]:
-        text, _, kind = spec.partition(":")
-        a = self.plc._addr(text)
-        if kind.strip().upper() == "BIT" and a.area in ("T", "C"):
-            from ..compiler.operands import Addr
-            a = Addr(a.area, a.offset, 0, 0, a.text)
-        return self.plc._locate(a)
+        return self.plc.locate(spec)[:4]
 
     def _is_forced(self, spec: str) -> bool:
         """Whether any forced address overlaps ``spec`` (forcing Q0.0 marks

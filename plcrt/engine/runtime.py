@@ -295,6 +295,49 @@ class Plc:
             raise PlcAddressError(f"{address!r} is not an address")
         return op
 
+    def locate(self, spec: str) -> tuple[bytearray, int, int, int, str]:
+        """Where an address spec lives: ``(buffer, byte offset, width, bit,
+        kind)``, width 0 for a bit, kind ``"bit"``, ``"int"`` or ``"real"``.
+
+        ``spec`` is an address or symbol with an optional suffix: ``:REAL``
+        reads a double word as a float, ``:BIT`` the bit of a timer or
+        counter (``T37:BIT``); ``T37`` alone is its current value.
+        """
+        text, sep, suffix = spec.strip().rpartition(":")
+        if not sep:
+            text, suffix = spec.strip(), ""
+        kind = suffix.strip().upper()
+        if kind not in ("", "REAL", "BIT"):
+            raise PlcAddressError(f"{spec!r}: unknown suffix ':{suffix.strip()}' (use :REAL "
+                                  f"for a float or :BIT for a timer or counter bit)")
+        a = self._addr(text)
+        if kind == "BIT":
+            if a.area not in ("T", "C"):
+                raise PlcAddressError(f"{spec!r}: ':BIT' is for timers and counters "
+                                      f"(T37:BIT, C5:BIT); a bit address needs no suffix")
+            a = Addr(a.area, a.offset, 0, 0, a.text)
+        buf, off, width, bit = self._locate(a)
+        if kind == "REAL" and (width != 4 or a.area in ("T", "C")):
+            raise PlcAddressError(f"{spec!r}: a REAL needs a double word (VD, MD, ...)")
+        return buf, off, width, bit, ("real" if kind == "REAL" else
+                                      "bit" if width == 0 else "int")
+
+    def reader(self, spec: str) -> tuple[str, Callable[[], int | float]]:
+        """``(kind, read)`` for a spec as in :meth:`locate`: ``read()``
+        returns the value now, resolved once (for per-scan use by traces,
+        watch lists and test conditions)."""
+        buf, off, width, bit, kind = self.locate(spec)
+        # perf: closures over the buffer and offset; nothing is parsed per read
+        if kind == "real":
+            unpack = CODECS["_rf"]
+            return kind, lambda: unpack(buf, off)[0]
+        if width == 0:
+            return kind, lambda: buf[off] >> bit & 1
+        if width == 1:
+            return kind, lambda: buf[off]
+        unpack = _SIGNED[width]
+        return kind, lambda: unpack(buf, off)[0]
+
     def __getitem__(self, address: str) -> int:
         return self.read(address)
 
@@ -490,6 +533,10 @@ class Plc:
         if a.area in ("AC", "HC"):
             return m[a.area], a.offset * 4, 4, 0
         return m[a.area], a.offset, a.width or 0, a.bit
+
+
+#: big-endian signed decoders of words and double words
+_SIGNED = {2: struct.Struct(">h").unpack_from, 4: struct.Struct(">i").unpack_from}
 
 
 def _check_value(address: str, width: int, value: int | float | bool) -> int | float:

@@ -13,7 +13,6 @@ every read and write goes through the PLC's memory image.
 from __future__ import annotations
 
 import re
-import struct
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -62,27 +61,8 @@ def seconds(d: Duration) -> float:
 
 def reader(plc: Plc, spec: str) -> Callable[[], Value]:
     """A function reading one address (``VW100``, ``VD4:REAL``, ``T37:BIT``,
-    symbol names) resolved once, for per-scan use."""
-    text, _, kind = spec.partition(":")
-    kind = kind.strip().upper()
-    if kind not in ("", "REAL", "BIT"):
-        raise PlcAddressError(f"{spec!r}: unknown kind {kind!r} (use :REAL or :BIT)")
-    plc.read(text, kind or None)  # validates, with the engine's messages
-    a = plc._addr(text)
-    if kind == "BIT":
-        from ..compiler.operands import Addr
-        a = Addr(a.area, a.offset, 0, 0, a.text)
-    buf, off, width, bit = plc._locate(a)
-    # perf: closures over the buffer and offset; no parsing per read
-    if width == 0:
-        return lambda: buf[off] >> bit & 1
-    if kind == "REAL":
-        unpack = struct.Struct(">f").unpack_from
-        return lambda: unpack(buf, off)[0]
-    if width == 1:
-        return lambda: buf[off]
-    end = off + width
-    return lambda: int.from_bytes(buf[off:end], "big", signed=True)
+    symbol names) resolved once, for per-scan use (see :meth:`Plc.reader`)."""
+    return plc.reader(spec)[1]
 
 
 _COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"
@@ -408,7 +388,7 @@ class Harness:
             except PlcConfigError as e:
                 raise PlcConfigError(f"stimulus row {i + 1} {row!r}: {e.message}") from None
             try:   # every row is checked before the first scan runs
-                _, _, width, _ = self.plc._locate(self.plc._addr(str(addr)))
+                _, _, width, _, _ = self.plc.locate(str(addr))
                 _check_value(str(addr), width, value)
             except PlcError as e:
                 raise type(e)(f"stimulus row {i + 1} {row!r}: {e.message}") from None

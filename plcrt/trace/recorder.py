@@ -21,7 +21,6 @@ from __future__ import annotations
 import csv
 import math
 import re
-import struct
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,12 +35,7 @@ AXIS_QUANTITIES = {"position": False, "mechanical": False, "speed": True}
 
 _AXIS_RE = re.compile(r"axis(\d+)\.(\d+)\.(\w+)", re.IGNORECASE)
 _AXIS_PREFIX_RE = re.compile(r"axis\d*\.", re.IGNORECASE)
-_KINDS = ("REAL", "BIT")
 
-# perf: pre-built big-endian decoders, as the generated code uses
-_WORD = struct.Struct(">h").unpack_from
-_DWORD = struct.Struct(">i").unpack_from
-_REAL = struct.Struct(">f").unpack_from
 
 
 @dataclass(frozen=True)
@@ -75,38 +69,11 @@ def parse_signal(plc: Any, text: str) -> Signal:
     name = text.strip()
     if _AXIS_PREFIX_RE.match(name):
         return _axis_signal(plc, name)
-    addr_text, kind = name, None
-    head, sep, tail = name.rpartition(":")
-    if sep:
-        if tail.strip().upper() not in _KINDS:
-            raise PlcConfigError(f"trace signal {name!r}: unknown suffix ':{tail}' "
-                                 f"(use ':REAL' for a float or ':BIT' for a timer or "
-                                 f"counter bit)")
-        addr_text, kind = head.strip(), tail.strip().upper()
     try:
-        a = plc._addr(addr_text)
+        kind, read = plc.reader(name)
     except PlcError as e:
         raise PlcAddressError(f"trace signal {name!r}: {e.message}") from None
-    if kind == "BIT":
-        if a.area not in ("T", "C"):
-            raise PlcAddressError(f"trace signal {name!r}: ':BIT' is for timers and "
-                                  f"counters (T37:BIT, C5:BIT); a bit address needs no suffix")
-        a = type(a)(a.area, a.offset, 0, 0, a.text)
-    buf, off, width, bit = plc._locate(a)
-    if kind == "REAL":
-        if width != 4 or a.area in ("T", "C"):
-            raise PlcAddressError(f"trace signal {name!r}: a REAL needs a double word "
-                                  f"(VD, MD, ...)")
-        return Signal(name, "real", lambda: _REAL(buf, off)[0])
-    # perf: each reader is a closure over the buffer and offset found once
-    # here, so recording costs one call and one struct decode per signal.
-    if width == 0:
-        return Signal(name, "bit", lambda: buf[off] >> bit & 1)
-    if width == 1:
-        return Signal(name, "int", lambda: buf[off])
-    if width == 2:
-        return Signal(name, "int", lambda: _WORD(buf, off)[0])
-    return Signal(name, "int", lambda: _DWORD(buf, off)[0])
+    return Signal(name, kind, read)
 
 
 def _axis_signal(plc: Any, name: str) -> Signal:

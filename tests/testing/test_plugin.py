@@ -465,7 +465,7 @@ def test_factory_watch(plc_factory):
         "test_setup.py::test_watch_unknown_address: @pytest.mark.plc: watch 'XX9.9': "
         "'XX9.9' is not an address",
         "test_setup.py::test_watch_unknown_kind: @pytest.mark.plc: watch 'Q0.0:FOO': *"
-        "unknown kind 'FOO'*",
+        "unknown suffix ':FOO'*",
         "test_setup.py::test_empty_program: @pytest.mark.plc: empty.awl has no main program "
         "block (OB1), so there is nothing to run; name the file with OB1 as well",
         "test_setup.py::test_no_ob1: @pytest.mark.plc: sbr.awl has no main program block*",

@@ -248,7 +248,7 @@ def test_empty_trace() -> None:
     ("VW100:REAL", PlcAddressError, "a REAL needs a double word"),
     ("T37:REAL", PlcAddressError, "a REAL needs a double word"),
     ("Q0.0:BIT", PlcAddressError, "':BIT' is for timers and counters"),
-    ("VD0:FLOAT", PlcConfigError, "unknown suffix ':FLOAT'"),
+    ("VD0:FLOAT", PlcAddressError, "unknown suffix ':FLOAT'"),
     ("", PlcConfigError, "give an address"),
     ("axis0.0.speed", PlcAddressError, "no plant is loaded"),
     ("axis0.0.torque", PlcConfigError, "quantity position|mechanical|speed"),

@@ -589,7 +589,8 @@ def _print_rich_table(summary: str, values: dict[str, int | float]) -> bool:
 _AXIS_COLUMNS = ("slot", "axis", "position", "mechanical", "speed", "status")
 
 
-def _axis_rows(axes: Sequence[dict[str, Any]]) -> list[list[str]]:
+def axis_rows(axes: Sequence[dict[str, Any]]) -> list[list[str]]:
+    """Table cells of :meth:`plcrt.Plc.axes` entries (columns ``_AXIS_COLUMNS``)."""
     rows = []
     for a in axes:
         row = [str(a[c]) for c in _AXIS_COLUMNS]
@@ -608,7 +609,7 @@ def _print_axes(axes: Sequence[dict[str, Any]]) -> None:
     if not axes:
         print("axes: none configured in the plant")
         return
-    rows = _axis_rows(axes)
+    rows = axis_rows(axes)
     if sys.stdout.isatty() and _print_rich_axes(rows):
         return
     widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(_AXIS_COLUMNS)]

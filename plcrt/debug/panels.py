@@ -70,16 +70,9 @@ def key_values(rows: Sequence[tuple[str, str]]) -> list[str]:
 def axes_table(axes: Sequence[dict[str, Any]]) -> list[str]:
     """The EM253 axes (entries of :meth:`plcrt.Plc.axes`, at least one):
     numbers right-aligned, the status left-aligned with its notes."""
+    from ..cli import axis_rows
     head = ("slot", "axis", "position", "mechanical", "speed Hz", "status")
-    rows = []
-    for a in axes:
-        status = str(a["status"])
-        # SevOn masking and the STF input explain an axis that does not move
-        notes = [n for n, on in (("SevOn", a.get("masked")), ("STF", a.get("stf"))) if on]
-        if notes:
-            status += f" ({', '.join(notes)})"
-        rows.append((str(a["slot"]), str(a["axis"]), str(a["position"]),
-                     str(a["mechanical"]), str(a["speed"]), status))
+    rows = [tuple(r) for r in axis_rows(axes)]
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
 
     def line(cells: tuple[str, ...]) -> str:

@@ -135,7 +135,7 @@ class Harness:
     """
 
     def __init__(self, plc: Plc, *, watch: Sequence[str] = (), history: int = 20,
-                 name: str = "") -> None:
+                 name: str = "", max_time: Duration | None = None) -> None:
         self.plc = plc
         self.name = name or str(plc.program.file)
         self.history: deque[tuple[int, float, tuple[Value, ...]]] = deque(maxlen=max(1, history))
@@ -144,18 +144,40 @@ class Harness:
         self._recording = False
         #: harnesses made by :meth:`fork` (the pytest plugin reports on them too)
         self.forks: list[Harness] = []
+        self.max_time: float | None = None
         self.watch(*watch)
+        if max_time is not None:
+            self.limit_time(max_time)
+
+    def limit_time(self, max_time: Duration) -> Harness:
+        """Fail (:class:`PlcTimeout`) as soon as the simulated time passes
+        ``max_time`` (counted from power-up), whatever runs the scans: a
+        per-test time limit, in simulated time, so a test that waits for
+        something that never comes ends quickly and the same way everywhere."""
+        limit_us = int(round(seconds(max_time) * 1e6))
+        if self.max_time is None:
+            self.plc.observers.append(self._check_time)
+        self.max_time = limit_us / 1e6
+        self._limit_us = limit_us
+        return self
+
+    def _check_time(self, plc: Plc) -> None:
+        if plc.now_us > self._limit_us:
+            raise PlcTimeout(f"the test ran past its limit of {self.max_time:g} s of "
+                             f"simulated time (max_time); at t = {plc.time:.3f} s, "
+                             f"scan {plc.scans}")
 
     @classmethod
     def load(cls, program: str | Path | Sequence[str | Path], *, symbols: Any = None,
              data: Any = None, plant: Any = None, scan_ms: float = 10.0,
              cpu: str | None = None, watch: Sequence[str] = (), history: int = 20,
-             instrument: bool = False) -> Harness:
+             instrument: bool = False, max_time: Duration | None = None) -> Harness:
         """Load a program (paths, STL text, or an already parsed
         :class:`plcrt.lang.ir.Program`) and wrap it.
 
         ``instrument=True`` compiles the network-coverage and breakpoint
-        probes in (slightly slower scans).
+        probes in (slightly slower scans).  ``max_time`` limits the simulated
+        time (see :meth:`limit_time`).
         """
         from ..lang import ir
         symbols = Path(symbols) if isinstance(symbols, str) and "\n" not in symbols else symbols
@@ -166,12 +188,12 @@ class Harness:
             # session and compiles it per test)
             plc = _plc_from_parsed(program, symbols=symbols, data=data, plant=plant,
                                    scan_ms=scan_ms, cpu=cpu, instrument=instrument)
-            return cls(plc, watch=watch, history=history)
+            return cls(plc, watch=watch, history=history, max_time=max_time)
         if isinstance(program, str) and "\n" not in program:
             program = Path(program)
         plc = load(program, symbols=symbols, data=data, plant=plant,
                    scan_ms=scan_ms, cpu=cpu, instrument=instrument)
-        return cls(plc, watch=watch, history=history)
+        return cls(plc, watch=watch, history=history, max_time=max_time)
 
     def __repr__(self) -> str:
         return (f"<Harness {Path(self.name).name} t={self.time:.3f} s "
@@ -419,7 +441,7 @@ class Harness:
     def fork(self) -> Harness:
         """An independent copy in the same state (e.g. after a long warm-up)."""
         h = Harness(self.plc.fork(), watch=self.watched, history=self.history.maxlen or 20,
-                    name=self.name)
+                    name=self.name, max_time=self.max_time)
         h.history.extend(self.history)
         self.forks.append(h)
         return h

@@ -38,7 +38,7 @@ if TYPE_CHECKING:
     from .harness import Harness
 
 #: keyword arguments of the marker and of ``plc_factory``
-OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history")
+OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "max_time")
 DEFAULT_SCAN_MS = 10.0
 DEFAULT_HISTORY = 20
 #: name of the JUnit XML property that carries the trace of a failing test
@@ -48,7 +48,7 @@ WORKEROUTPUT_KEY = "plcrt_coverage"
 
 MARKER_HELP = (
     "plc(program, *, symbols=None, data=None, plant=None, scan_ms=None, cpu=None, "
-    "watch=(), history=None): the S7-200 STL program (a .awl path or a list of them, "
+    "watch=(), history=None, max_time=None): the S7-200 STL program (a .awl path or a list of them, "
     "relative to the test file or the rootdir) that the `plc` fixture loads"
 )
 
@@ -64,6 +64,7 @@ class _Session:
     rootpath: Path
     scan_ms: float
     history: int
+    max_time: float | None
     coverage: bool
     coverage_report: Path | None
     #: parsed programs: ((path, mtime_ns, size), ...) -> ir.Program.  The IR
@@ -88,6 +89,7 @@ class _Spec:
     cpu: str | None = None
     watch: tuple[str, ...] = ()
     history: int | None = None
+    max_time: float | None = None
 
 
 _SESSION = pytest.StashKey[_Session]()
@@ -113,7 +115,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                     default=None,
                     help="also write the PLC coverage as JSON to PATH (implies --plc-coverage)")
     parser.addini("plc_scan_ms", "default PLC scan time in ms (plcrt)", default=None)
+    group.addoption("--plc-max-time", dest="plc_max_time", metavar="DURATION", default=None,
+                    help="fail a test whose PLC runs past this much simulated time, e.g. "
+                         "60s or 10min (default: ini plc_max_time, else no limit)")
     parser.addini("plc_history", "scans kept for the PLC trace (plcrt)", default=None)
+    parser.addini("plc_max_time", "simulated-time limit per PLC (plcrt)", default=None)
     parser.addini("plc_coverage", "report PLC network coverage (plcrt)", type="bool",
                   default=False)
     parser.addini("plc_coverage_report", "write PLC coverage JSON here (plcrt)", default=None)
@@ -145,13 +151,21 @@ def _session_from_config(config: pytest.Config) -> _Session:
                                 f"number of scans") from None
     if history < 1:
         raise pytest.UsageError(f"--plc-history / plc_history must be at least 1, got {history}")
+    max_time = _setting(config, "plc_max_time")
+    if max_time is not None:
+        from ..errors import PlcConfigError
+        from .harness import seconds   # only when the option is used
+        try:
+            max_time = seconds(max_time)
+        except PlcConfigError as e:
+            raise pytest.UsageError(f"--plc-max-time / plc_max_time: {e.message}") from None
     report = _setting(config, "plc_coverage_report")
     report_path = Path(report) if report is not None else None
     if report_path is not None and not report_path.is_absolute():
         report_path = Path(config.invocation_params.dir) / report_path
     coverage = bool(_setting(config, "plc_coverage")) or report_path is not None
     return _Session(rootpath=Path(config.rootpath), scan_ms=scan_ms, history=history,
-                    coverage=coverage, coverage_report=report_path)
+                    max_time=max_time, coverage=coverage, coverage_report=report_path)
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -249,6 +263,15 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
                                 or history < 1):
         raise PlcUsageError(f"history= must be a whole number of scans >= 1, got {history!r}")
     spec.history = history
+    max_time = kwargs.get("max_time")
+    if max_time is not None:
+        from ..errors import PlcConfigError
+        from .harness import seconds
+        try:
+            spec.max_time = seconds(max_time)
+        except PlcConfigError:
+            raise PlcUsageError(f"max_time= must be a duration such as 60, '90s' or '5min', "
+                                f"got {max_time!r}") from None
     return spec
 
 
@@ -278,7 +301,8 @@ def _build(sess: _Session, spec: _Spec) -> Harness:
                      scan_ms=spec.scan_ms if spec.scan_ms is not None else sess.scan_ms,
                      cpu=spec.cpu,
                      history=spec.history if spec.history is not None else sess.history,
-                     instrument=sess.coverage)
+                     instrument=sess.coverage,
+                     max_time=spec.max_time if spec.max_time is not None else sess.max_time)
     if "OB1" not in h.plc.unit.pous:
         # scans would do nothing, and every assertion on "nothing changes" pass
         raise PlcUsageError(f"{spec.label} has no main program block (OB1), so there is "

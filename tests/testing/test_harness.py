@@ -397,3 +397,20 @@ def test_trace_records_numpy_arrays_from_now_on() -> None:
     tr.detach()
     h.scan(3)
     assert len(tr) == 250
+
+
+def test_max_time_stops_any_run_and_carries_over_to_forks() -> None:
+    """max_time counts simulated time from power-up: plain runs, run_until
+    and forks all stop at the first scan past it."""
+    h = Harness.load(ROOT / "programs" / "seal_in.awl", max_time="0.5s")
+    h.run("0.4s")
+    f = h.fork()
+    with pytest.raises(PlcTimeout, match=r"limit of 0.5 s .* at t = 0.510 s, scan 51"):
+        h.run("1s")
+    with pytest.raises(PlcTimeout, match="limit of 0.5 s"):
+        f.run_until("Q0.0", timeout="10s")
+    g = Harness.load(ROOT / "programs" / "seal_in.awl")
+    g.run("2s").limit_time(3)
+    g.run("1s")
+    with pytest.raises(PlcTimeout, match="limit of 3 s"):
+        g.scan(1)

@@ -222,7 +222,7 @@ def test_no_marker(plc):
     result.stdout.fnmatch_lines([
         "test_errors.py::test_unknown_argument: @pytest.mark.plc: unknown argument(s) "
         "'watchh' (did you mean 'watch'?); the options are symbols, data, plant, scan_ms, "
-        "cpu, watch, history",
+        "cpu, watch, history, max_time",
         "test_errors.py::test_missing_program: @pytest.mark.plc: program file 'missing.awl' "
         "not found (looked for */missing.awl)",
         "test_errors.py::test_wrong_type: @pytest.mark.plc: watch= must be a list of "
@@ -489,3 +489,40 @@ def test_plain():
     result = _run(pytester, "-p", "no:plcrt", "--plc-coverage")
     assert result.ret == pytest.ExitCode.USAGE_ERROR   # its options are gone with it
     result.stderr.fnmatch_lines(["*unrecognized arguments: --plc-coverage*"])
+
+
+def test_max_time_limits_simulated_time_per_test(pytester: pytest.Pytester) -> None:
+    """A test whose PLC runs past max_time fails with a PlcTimeout naming
+    the limit, whether the marker or --plc-max-time sets it; a bad value
+    is a usage error."""
+    pytester.makefile(".awl", timer=TIMER)
+    pytester.makepyfile(test_limit="""\
+import pytest
+
+
+@pytest.mark.plc("timer.awl", max_time="2s")
+def test_waits_too_long(plc):
+    plc.run("5s")
+
+
+@pytest.mark.plc("timer.awl")
+def test_option_limit(plc):
+    plc.run("1min")
+
+
+@pytest.mark.plc("timer.awl", max_time="2s")
+def test_within_limit(plc):
+    plc["I0.0"] = 1
+    assert plc.run_until("Q0.0", timeout="1.5s") == pytest.approx(1.01)
+""")
+    result = _run(pytester, "--plc-max-time=30s")
+    result.assert_outcomes(passed=1, failed=2)
+    result.stdout.fnmatch_lines([
+        "*PlcTimeout: the test ran past its limit of 2 s of simulated time (max_time); "
+        "at t = 2.010 s, scan 201",
+        "*PlcTimeout: the test ran past its limit of 30 s of simulated time (max_time); "
+        "at t = 30.010 s, scan 3001",
+    ])
+    bad = _run(pytester, "--plc-max-time=soon")
+    assert bad.ret == pytest.ExitCode.USAGE_ERROR
+    bad.stderr.fnmatch_lines(["*--plc-max-time / plc_max_time: not a duration: 'soon'*"])

@@ -11,7 +11,9 @@ a fault, Ctrl-C and ``finish`` end them the same way.
 This module is not the session: reading input, the paused mode and the
 breakpoint probes live in :mod:`plcrt.debug.session`, whose internals the
 handlers use (they are one package).  The tables and the drawing are
-:mod:`plcrt.debug.panels`.  Nothing here holds PLC semantics: values are
+:mod:`plcrt.debug.panels`; the trace commands (``trace``, ``trend``,
+``csv``, ``plot``) are :mod:`plcrt.debug.trace_commands`, entered into the
+same table.  Nothing here holds PLC semantics: values are
 read and written through the PLC's own address access, durations and
 conditions are the test harness's.
 """
@@ -19,40 +21,19 @@ conditions are the test harness's.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import PlcConfigError, PlcError
 from ..testing.harness import PlcTimeout, condition, reader, seconds
+from .base import Command, CommandError
 from .panels import axes_table, block_heading, fmt, key_values, mode, ms, sim_time
+from .trace_commands import TRACE_COMMANDS, trace_summary
 
 if TYPE_CHECKING:
     from .session import Session
 
 #: ``run until`` gives up after this much simulated time unless told otherwise
 DEFAULT_UNTIL_TIMEOUT = "10s"
-
-
-class CommandError(Exception):
-    """A command that cannot be carried out as written: printed as
-    ``error: <message>`` and the session goes on."""
-
-
-@dataclass(frozen=True)
-class Command:
-    """One entry of the command table."""
-
-    name: str
-    handler: Callable[[Session, list[str]], None]
-    usage: str
-    summary: str
-    details: str = ""
-    aliases: tuple[str, ...] = ()
-    #: would start scans: refused while paused inside a scan
-    runs_scans: bool = False
-    #: only makes sense while paused (continue, next, finish)
-    paused_only: bool = False
 
 
 # ---------------------------------------------------------------------------
@@ -300,6 +281,8 @@ def _cmd_status(s: Session, args: list[str]) -> None:
     rows.append(("breakpoints", f"{len(names)}" + (f" ({', '.join(names)})" if names else "")))
     forces = [f"{k}={fmt(v)}" for k, v in plc.forces.items()]
     rows.append(("forces", f"{len(forces)}" + (f" ({', '.join(forces)})" if forces else "")))
+    if s._trace is not None:
+        rows.append(("trace", trace_summary(s._trace)))
     if plc.fault is not None:
         rows.append(("fault", plc.fault.message))
     for line in key_values(rows):
@@ -486,6 +469,7 @@ _TABLE = (
             aliases=("n",), paused_only=True),
     Command("finish", _cmd_finish, "finish",
             "paused: finish this scan and end the command there", paused_only=True),
+    *TRACE_COMMANDS,
     Command("help", _cmd_help, "help [CMD]", "list the commands, or explain one",
             aliases=("h", "?")),
     Command("quit", _cmd_quit, "quit",

@@ -23,7 +23,8 @@ This module is the machinery every command relies on: the input loop, the
 paused mode and the breakpoint probes, running scans (faults, Ctrl-C, the
 report after a scan command) and the output helpers.  It is not the command
 set: each command's handler and the table ``help`` lists are
-:mod:`plcrt.debug.commands` (re-exported here), and the tables and network
+:mod:`plcrt.debug.commands` (re-exported here) and, for traces,
+:mod:`plcrt.debug.trace_commands`, and the tables and network
 drawings are formatted by :mod:`plcrt.debug.panels`.  Nor is it a second
 engine: it holds no PLC semantics.  Scans are :meth:`plcrt.Plc.scan`,
 durations and conditions are the test harness's
@@ -41,7 +42,7 @@ import threading
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
@@ -51,6 +52,9 @@ from ..safetext import printable
 from ..testing.harness import Harness, reader
 from .commands import COMMANDS, Command, CommandError, lookup, strip_comment
 from .panels import draw_network, fmt, load_view, ms, sim_time, status_line, watch_table
+
+if TYPE_CHECKING:
+    from ..trace.recorder import Trace
 
 #: prompt of the top level; while paused the prompt names the network
 PROMPT = "(plcrt) "
@@ -119,6 +123,8 @@ class Session:
             self._blocks.setdefault(p.name.upper(), p.ident)
             self._blocks[p.ident.upper()] = p.ident
         self._view: Any = None   # (ladder_text, render_network, PlcStatus), False: no view
+        #: the trace of the trace commands (plcrt.debug.trace_commands), or None
+        self._trace: Trace | None = None
         self._apply_breaks()
 
     # ------------------------------------------------------------------

@@ -1,0 +1,111 @@
+"""``plcrt dump``: the generated Python of a program, annotated for reading.
+
+Each network's function gets a banner with its block, network and title,
+and each instruction marker of the generated code gets the STL line it
+came from.  This module only formats text for people; nothing here is
+executed or fed back to the compiler.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from typing import Any
+
+from .engine.runtime import Plc
+from .errors import PlcError
+from .safetext import printable
+
+# The comment codegen puts before each instruction's code.
+_INSN_COMMENT_RE = re.compile(r"^(\s*)# \[(\d+)\] line (\d+)\s*$")
+_PIECE_DEF_RE = re.compile(r"^def n_([A-Z]+\d+)_(\d+)")
+_RUNNER_RE = re.compile(r"^(?:def |_pieces_|_costs_)pou_([A-Z]+\d+)")
+
+
+
+def render_dump(plc: Plc) -> str:
+    """The generated source, annotated for reading.
+
+    Before each network's function a banner names the block, network and
+    title; each ``# [id] line n`` marker gains the STL text of line ``n``.
+    The result is meant for people: the STL text is inserted into comments
+    only, and nothing of it is executed.
+    """
+    texts = _source_lines(plc)
+    titles = {(p.ident, n.number): n.title for p in plc.program.pous for n in p.networks}
+    names = {p.ident: p.name for p in plc.program.pous}
+    locs = plc.unit.locs
+    lines = plc.source.splitlines()
+    files = sorted({str(f) for f in texts})
+    out = [f"# plcrt dump of {', '.join(files) or plc.program.file}",
+           "# Generated Python, for reading only: each '# [id] line n:' comment",
+           "# shows the STL instruction whose code follows it.", ""]
+    last_runner = None
+    for i, line in enumerate(lines):
+        piece = _PIECE_DEF_RE.match(line)
+        if piece:
+            block, net = _piece_origin(lines, i, locs) or (piece.group(1), int(piece.group(2)))
+            title = titles.get((block, net), "")
+            out.append(printable(f"# ==== {block} network {net}" + (f": {title}" if title else "")
+                                 + " ===="))
+            last_runner = None
+        runner = _RUNNER_RE.match(line)
+        if runner and runner.group(1) != last_runner:
+            last_runner = runner.group(1)
+            name = names.get(last_runner, "")
+            label = f" ({name})" if name and name != last_runner else ""
+            out.append(printable(f"# ==== {last_runner}{label}: runs its networks in order ===="))
+        m = _INSN_COMMENT_RE.match(line)
+        if m:
+            insn_id = int(m.group(2))
+            loc = locs[insn_id] if insn_id < len(locs) else None
+            lineno = loc.line if loc else int(m.group(3))
+            stl = _stl_line(texts, loc.file if loc else None, lineno)
+            # program text goes into a comment only, with control characters
+            # escaped (a CR or an escape sequence must not reach the output)
+            line = f"{m.group(1)}# [{insn_id}] line {lineno}: {printable(stl)}"
+        out.append(line)
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def _piece_origin(lines: list[str], start: int, locs: Sequence[Any]) -> tuple[str, int] | None:
+    """Block and network of the function starting at ``lines[start]``, from
+    its first instruction marker (exact even when names change)."""
+    for line in lines[start + 1:]:
+        if line and not line.startswith((" ", "\t")):
+            return None  # next top-level statement: a function without instructions
+        m = _INSN_COMMENT_RE.match(line)
+        if m:
+            insn_id = int(m.group(2))
+            if insn_id < len(locs) and locs[insn_id].block and locs[insn_id].network is not None:
+                return locs[insn_id].block, locs[insn_id].network
+            return None
+    return None
+
+
+def _source_lines(plc: Plc) -> dict[str, list[str]]:
+    """Program text per file, split into lines the way the parser counts them
+    (CRLF and a lone CR each end one line)."""
+    from .lang import read_source
+
+    files = {p.loc.file for p in plc.program.pous}
+    texts: dict[str, list[str]] = {}
+    for f in files:
+        try:
+            text = read_source(f)
+        except PlcError:
+            # A file that vanished since loading: fall back to the text kept
+            # in the program, which is right for the first file at least.
+            text = plc.program.source if f == plc.program.file else ""
+        texts[f] = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    return texts
+
+
+def _stl_line(texts: dict[str, list[str]], file: str | None, lineno: int) -> str:
+    lines = texts.get(file or "") or next(iter(texts.values()), [])
+    if 1 <= lineno <= len(lines):
+        return lines[lineno - 1].strip()
+    return "?"
+
+
+__all__ = ["render_dump"]

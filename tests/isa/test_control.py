@@ -11,15 +11,7 @@ import pytest
 
 import plcrt
 from plcrt.errors import PlcCompileError, PlcRuntimeError
-
-
-def _ob1(*networks: str) -> str:
-    lines = ["ORGANIZATION_BLOCK OB1", "BEGIN"]
-    for i, net in enumerate(networks, 1):
-        lines.append(f"Network {i}")
-        lines.extend(ln.strip() for ln in net.strip().splitlines())
-    lines.append("END_ORGANIZATION_BLOCK")
-    return "\n".join(lines) + "\n"
+from stl_helpers import ob1_text
 
 
 def _sbr(number: int, *networks: str, interface: str = "", name: str | None = None) -> str:
@@ -38,7 +30,7 @@ def _sbr(number: int, *networks: str, interface: str = "", name: str | None = No
 
 def _load(*networks: str, extra: str = "", scan_ms: float = 10.0) -> plcrt.Plc:
     """OB1 made of ``networks`` followed by the blocks in ``extra``."""
-    return plcrt.load(_ob1(*networks) + extra, scan_ms=scan_ms)
+    return plcrt.load(ob1_text(*networks) + extra, scan_ms=scan_ms)
 
 
 # -- JMP / LBL ------------------------------------------------------------------

@@ -16,12 +16,17 @@ An entry::
               "outputs": {"OB1/1:12:1:=": [network, mnemonic, operand, line]},
               "contacts": {"OB1/1:10:1:LD": [network, mnemonic, operand, line]}}}
 
-This module does not run programs and does not import the engine or pytest.
+This module does not run programs and imports neither the engine (only its
+light coverage tables) nor pytest.
 """
 
 from __future__ import annotations
 
 from typing import Any
+
+# only the probe tables and their merge, no engine: the xdist controller
+# merges its workers' results with this module
+from ..engine.coverage import PARTS, merge_data
 
 Entry = dict[str, Any]
 Store = dict[str, Entry]   #: program key (resolved path or paths) -> entry
@@ -30,14 +35,13 @@ Store = dict[str, Entry]   #: program key (resolved path or paths) -> entry
 UNPOWERED, POWERED = 1, 2
 #: contact bits
 OPEN, CLOSED = 1, 2
-#: the probe kinds (as plcrt.engine.coverage.PARTS, without importing it)
-PARTS = ("networks", "outputs", "contacts")
 
 
 def entry_from_map(cov: Any) -> Entry:
     """An entry from a live ``CoverageMap`` (what ran, and the names to show)."""
     data = cov.data()
     nets = {n.name: [n.title or "", _line(n.loc)] for n in cov.networks}
+
     def names(refs: Any) -> dict[str, list[Any]]:
         return {cov.output_key(o): [cov.networks[o.network].name, o.mnemonic, o.operand,
                                     _line(o.loc)] for o in refs}
@@ -49,18 +53,14 @@ def entry_from_map(cov: Any) -> Entry:
 
 def merge_entry(store: Store, key: str, entry: Entry) -> None:
     """Union ``entry`` into ``store[key]`` (bits are OR-ed, names kept)."""
-    old = store.get(key)
-    if old is None:
-        old = store[key] = {part: {} for part in PARTS}
-        old["meta"] = {part: {} for part in PARTS}
-    # the same arithmetic as plcrt.engine.coverage.merge_data, kept here so
-    # that merging on the xdist controller does not import the engine
+    old = store.get(key, {})
+    merged = merge_data(old, entry)
+    meta = {part: dict(old.get("meta", {}).get(part, {})) for part in PARTS}
     for part in PARTS:
-        into = old[part]
-        for k, v in entry.get(part, {}).items():
-            into[k] = into.get(k, 0) | int(v)
         for k, v in entry.get("meta", {}).get(part, {}).items():
-            old["meta"][part].setdefault(k, v)
+            meta[part].setdefault(k, v)
+    merged["meta"] = meta
+    store[key] = merged
 
 
 def merge_store(store: Store, other: Store) -> None:

@@ -49,6 +49,7 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
     reads: list[str] = []
     writes: list[tuple[Any, str]] = []   # (operand or None, type)
     for p, op_ir in zip(itf.params, args):
+        typ = p.type   #: the type the argument is read as
         try:
             op = resolver.parse(op_ir.text)
             if p.dir == "OUT" or p.address:
@@ -57,13 +58,13 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
                 op = check_role(op, _WRITE[p.type], op_ir.text, g.unit.model)
             else:
                 role = Role.D_PTR if p.pointer else _READ[p.type]
-                op = check_role(op, role, op_ir.text, g.unit.model)
+                op, typ = _check_in(g, itf, p, op, role, op_ir.text)
         except ResolveError as e:
             where = op_ir.loc if op_ir.loc.block is not None else op_ir.loc.within(
                 g.loc.block, g.loc.network)
             g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}", where)
         if p.dir == "IN":
-            reads.append(g.rbit(op) if p.type == "BOOL" else g.rd(op, _KIND[p.type]))
+            reads.append(g.rbit(op) if typ == "BOOL" else g.rd(op, _KIND[typ]))
         if p.dir == "OUT" or p.written:
             target = op if isinstance(op, (Addr, Indirect)) else None
             writes.append((target, p.type))
@@ -80,6 +81,31 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
             else:
                 g.wr(target, _KIND[typ], f"{r}[{i}]")
     return True
+
+
+def _check_in(g: Any, itf: Any, p: Any, op: Any, role: Role, text: str) -> tuple[Any, str]:
+    """Check an IN argument against its declared type, then against the
+    other types the interface allows (``also``); returns the operand and
+    the type it is read as.  A value of another type is converted the way
+    Micro/WIN converts a narrower actual parameter (a byte unsigned)."""
+    try:
+        return check_role(op, role, text, g.unit.model), p.type
+    except ResolveError:
+        for alt in p.also:
+            try:
+                op2 = check_role(op, _READ[alt], text, g.unit.model)
+            except ResolveError:
+                continue
+            if not isinstance(op, Const):
+                g.warn(f"{itf.name} argument {p.name} is a {alt} (as the manual's table types "
+                       f"it); it is read as an unsigned {alt} and cannot be negative or "
+                       f"larger than {(1 << (8 * _WIDTH[alt])) - 1}: use a {p.type} for "
+                       f"larger or negative values", f"also-{itf.name}-{p.name}")
+            return op2, alt
+        raise
+
+
+_WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4}
 
 
 def _load_implementations() -> None:

@@ -27,6 +27,7 @@ class Param:
     address: bool     #: argument must be a memory address
     written: bool     #: an IN the block writes back
     pointer: bool     #: a DWORD that may be given as &address
+    also: tuple[str, ...] = ()  #: other types an IN argument may have (read as that type)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,13 +80,15 @@ def _read(path: Path) -> list[BlockInterface]:
             params = tuple(
                 Param(str(p["name"]), str(p["dir"]).upper(), str(p["type"]).upper(),
                       bool(p.get("address", False)), bool(p.get("written", False)),
-                      bool(p.get("pointer", False)))
+                      bool(p.get("pointer", False)),
+                      tuple(str(t).upper() for t in p.get("also", ())))
                 for p in entry["params"])
             name = str(entry["name"])
         except (KeyError, TypeError) as e:
             raise PlcConfigError(f"{path}: instruction entry is missing {e}") from None
         for p in params:
-            if p.dir not in ("IN", "OUT") or p.type not in TYPES:
+            if p.dir not in ("IN", "OUT") or p.type not in TYPES \
+                    or any(t not in TYPES for t in p.also) or (p.also and p.dir != "IN"):
                 raise PlcConfigError(f"{path}: {name}.{p.name}: bad dir/type {p.dir}/{p.type}")
         result.append(BlockInterface(name, lib, str(entry.get("summary", "")), params))
     return result

@@ -245,6 +245,9 @@ def _sqrt_floor(sq: Fraction) -> Fraction:
                     _FINE)
 
 
+sqrt_floor = _sqrt_floor  #: public name: the look-ahead of envelopes bounds speeds with it
+
+
 def _sqrt_ceil(sq: Fraction) -> Fraction:
     """The smallest whole Hz at least ``sqrt(sq)``."""
     if sq <= 0:

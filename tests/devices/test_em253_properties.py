@@ -22,6 +22,11 @@ Properties (EM253 user manual, chapter 3.2):
   exact microsecond; a hard limit stops the axis exactly on it;
 * SevOn = 1 (3.2.1) masks pulse and direction: the counter counts, the
   mechanics stay put;
+* the module's terminals (2.2: STF, RPS, L+, L-, Z in; En, CLR, P, D out)
+  equal the axis state at the end of every scan, moving or stopped;
+* C_Step and C_Pos stay within the envelope (1..Step, 0..|PosSet| of that
+  step), and no stop (Run = 0, E_Stop, InnerState) ends beyond the
+  programmed end of a move;
 * the two axes are independent;
 * the results do not depend on the scan time;
 * the cost of simulating does not grow with the pulse frequency.
@@ -235,9 +240,60 @@ def simulate(cmds: list[Cmd], script: list[tuple[int, str, int]], scan_ms: int,
             assert te == now, f"command at {te} µs is not a scan start"
             plc[addr] = value
         plc.scan()
+        check_terminals(plc, mod)
         trace.outputs[now] = tuple(r() for r in readers)
+        for c in cmds:
+            check_envelope_outputs(c, plc)
     assert all(d.severity == "warning" for d in plc.diagnostics), plc.diagnostics
     return trace
+
+
+def check_terminals(plc: plcrt.Plc, mod: Any) -> None:
+    """The module's input byte (in PI, read by the next scan) and output byte
+    (in Q) equal the state of each axis at the end of the scan (manual 2.2),
+    whether the axis moves or stands."""
+    t = plc.now_us
+    pi, q = plc.mem.areas["PI"], plc.mem.areas["Q"]
+    for i, ax in enumerate(mod.axes):
+        p, m = ax.plant, ax.mechanical(t)
+        want_in = (int(ax.stf)
+                   | (2 if p.rps is not None and p.rps[0] <= m <= p.rps[1] else 0)
+                   | (4 if p.limit_pos is not None and m >= p.limit_pos else 0)
+                   | (8 if p.limit_neg is not None and m <= p.limit_neg else 0)
+                   | (16 if p.z_period and (m - p.z_offset) % p.z_period == 0 else 0))
+        moving_now = plc.axis(mod.slot, i)["status"] == "moving" if i in mod.configured \
+            else ax.moving
+        want_out = (int(ax.masked)
+                    | (4 if moving_now and not ax.masked else 0)
+                    | (8 if ax.direction > 0 and not ax.masked else 0))
+        assert pi[mod.di + i] == want_in, f"axis {i} inputs at {t} µs"
+        assert q[mod.do + i] & ~2 == want_out, f"axis {i} outputs at {t} µs"
+
+
+def check_envelope_outputs(cmd: Cmd, plc: plcrt.Plc) -> None:
+    """C_Step within 0..Step and C_Pos within 0..|PosSet| of that step
+    (POS_RUN, 3.2.6), C_Pos within 0..|PosSet| (POS_GOTO_R, 3.2.5), with
+    the parameters as they stand in memory (an Update may change them)."""
+    if cmd.kind == "spd":
+        return
+    b = cmd.base
+    v = plc.mem.areas["V"]
+
+    def dint(off: int) -> int:
+        return int.from_bytes(v[off:off + 4], "big", signed=True)
+
+    c_pos = dint(b + 24)
+    if cmd.kind == "goto":
+        assert 0 <= c_pos <= max(abs(cmd.pos), abs(dint(b + 12))), f"C_Pos {c_pos}"
+        return
+    step = v[b + 32]
+    assert 0 <= step <= len(cmd.table), f"C_Step {step}"
+    if step:
+        pos_set = max(abs(cmd.table[step - 1][3]),
+                      abs(dint(1000 + 400 * cmd.axis + 12 * (step - 1) + 8)))
+        assert 0 <= c_pos <= pos_set, f"C_Pos {c_pos} in step {step}"
+    else:
+        assert c_pos == 0
 
 
 def moving(trace: Trace, axis: int) -> bool:
@@ -478,9 +534,12 @@ def check_rates(samples: list[Sample], phases: list[tuple[int, tuple[Fraction, F
 def test_pos_goto_r_update_or_run_off_mid_move(axis: int, scan_ms: int,
                                                data: st.DataObject) -> None:
     """An Update with a new PosSet / SpdSet (same direction) ends exactly
-    at the new PosSet unless the block says it cannot stop in time (then
-    beyond it); Run = 0 ramps down to SpdSs and never passes PosSet.
-    Each parameter set's ramps apply while it is in force."""
+    at the new PosSet unless that many pulses were already sent (then the
+    axis stops beyond it, and says so); where the new ramps cannot end at
+    PosSet from the current speed, the deceleration is made steeper (and
+    says so) so that the count is still exact.  Run = 0 ramps down to SpdSs
+    and never passes PosSet.  Each parameter set's ramps apply while it is
+    in force."""
     cmd = data.draw(goto_cmds(axis))
     scan = scan_ms * 1000
     t_cmd = scan * data.draw(st.integers(2, 1_000 // scan_ms), label="command scan")
@@ -501,8 +560,11 @@ def test_pos_goto_r_update_or_run_off_mid_move(axis: int, scan_ms: int,
     extra = tuple(data.draw(st.lists(st.integers(scan, t_end), max_size=30), label="extra"))
     tr = simulate([cmd], script, scan_ms, t_end, extra)
     samples = tr.samples[axis]
-    check_motion(samples, replace(cmd, v_set=max(cmd.v_set, new.v_set)), scan)
-    check_rates(samples, [(0, cmd.rates()), (t_cmd, new.rates())])
+    steep = any("programmed end" in d.message for d in tr.plc.diagnostics)
+    passed = any("is already passed" in d.message for d in tr.plc.diagnostics)
+    if not steep:
+        check_motion(samples, replace(cmd, v_set=max(cmd.v_set, new.v_set)), scan)
+        check_rates(samples, [(0, cmd.rates()), (t_cmd, new.rates())])
     if moving(tr, axis):
         event("still moving at the end")
         return  # still moving at the bounded end
@@ -510,14 +572,53 @@ def test_pos_goto_r_update_or_run_off_mid_move(axis: int, scan_ms: int,
     if tr.outputs[t_cmd][0] != 1:
         # the move had ended before the command: nothing to update or stop
         assert final == abs(cmd.pos)
-    elif update and not any("cannot be reached" in d.message for d in tr.plc.diagnostics):
+    elif update and not passed:
         assert final == abs(new.pos), "an updated PosSet must be reached exactly"
     elif update:
-        assert final >= abs(new.pos)
+        assert final > abs(new.pos)
     else:
         assert final <= abs(cmd.pos), "Run = 0 must not run past PosSet"
     tr.plc.scan()
     assert tr.plc[cmd.outputs[0]] == 8 and tr.plc[cmd.outputs[1]] == final
+
+
+@PROPS
+@given(axis=st.integers(0, 1), scan_ms=st.sampled_from([1, 5, 10]), data=st.data())
+def test_an_early_stop_never_ends_beyond_the_programmed_end(axis: int, scan_ms: int,
+                                                            data: st.DataObject) -> None:
+    """Run = 0, E_Stop or a write to InnerState at any scan of a POS_GOTO_R
+    move or a POS_RUN envelope: the axis stops at or before the move's
+    programmed end (PosSet, the envelope's total), C_Status reads 8, and
+    C_Step / C_Pos name the step that was running and the pulses sent in
+    it (3.2.5, 3.2.6)."""
+    cmd = data.draw(st.one_of(goto_cmds(axis), run_cmds(axis)))
+    scan = scan_ms * 1000
+    bound = move_end_bound(cmd)
+    t_cmd = scan * data.draw(st.integers(2, max(2, min(bound, 2 * US) // scan)),
+                             label="stop scan")
+    how = data.draw(st.sampled_from(["run0", "estop", "inner"]), label="stop")
+    addr, value = {"run0": (cmd.run_bit, 0), "estop": (cmd.estop_bit, 1),
+                   "inner": (f"VD{cmd.base + 16}", 12345)}[how]
+    script = [(scan, cmd.run_bit, 1), (t_cmd, addr, value)]
+    t_end = t_cmd + min(bound, 3 * US) + 2 * scan
+    tr = simulate([cmd], script, scan_ms, t_end)
+    if moving(tr, axis):
+        event("still moving at the end")
+        return
+    total = abs(cmd.distance())
+    final = tr.samples[axis][-1][1] * cmd.sign()
+    assert 0 <= final <= total, f"stopped at {final}, beyond the programmed end {total}"
+    tr.plc.scan()
+    out = [tr.plc[o] for o in cmd.outputs]
+    assert out[0] == 8
+    if cmd.kind == "goto":
+        assert out[1] == final
+        return
+    ends = [0]
+    for row in cmd.table:
+        ends.append(ends[-1] + abs(row[3]))
+    k = next((i for i in range(1, len(ends)) if final < ends[i]), len(cmd.table))
+    assert (out[3], out[1]) == (k, final - ends[k - 1]), (out, final, ends)
 
 
 @PROPS

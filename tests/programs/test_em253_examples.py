@@ -441,11 +441,12 @@ def test_pos_run_step_6_speed_limit(scan_ms: int, differential: bool) -> None:
 
 @pytest.mark.parametrize("differential", [False, True], ids=["single-ended", "differential"])
 def test_pos_run_long_step_6_cruises_at_the_output_limit(differential: bool) -> None:
-    """With step 6 made long enough (3 000 000 pulses) to reach its speed,
-    the axis cruises at 200 kHz single-ended and at 500 kHz differential."""
+    """With step 6 made long enough (6 000 000 pulses) to reach its speed
+    and, with look-ahead, to slow down for step 7 before its end, the axis
+    cruises at 200 kHz single-ended and at 500 kHz differential."""
     table = (EM253 / "pos_run.db").read_text(encoding="utf-8")
     assert table.count("VD1068  30000\n") == 1
-    table = table.replace("VD1068  30000\n", "VD1068  3000000\n")
+    table = table.replace("VD1068  30000\n", "VD1068  6000000\n")
     # plant.toml's L1+ at 3 000 000 would stop this longer envelope: no limits
     free = {"module": {"0": {"axis": {"1": {}}}}}
     plc = plcrt.load(EM253 / "pos_run.awl", plant=free, data=table, scan_ms=10)
@@ -458,8 +459,11 @@ def test_pos_run_long_step_6_cruises_at_the_output_limit(differential: bool) -> 
     assert plc.axis(0, 1)["speed"] == limit
     plc.scan()
     assert (plc["VB316"], plc["VD312"]) == (6, limit)    # C_Step, C_Spd
-    run_to(plc, 80.0)
-    assert plc.axis(0, 1)["position"] == 1_530_000 - 30_000 + 3_000_000
+    run_to(plc, 120.0)
+    assert plc.axis(0, 1)["position"] == 1_530_000 - 30_000 + 6_000_000
+    # look-ahead: step 6 slows down before its end so that step 7 (50 000
+    # pulses at SpdSs) reaches SpdSs; the pulses never stop at high speed
+    assert not any("too short" in d.message for d in plc.diagnostics)
 
 
 def test_pos_run_same_positions_at_1_and_10_ms() -> None:

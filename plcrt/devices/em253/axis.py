@@ -143,6 +143,9 @@ class Axis:
         """Stop the pulse train at ``t`` (E_Stop, STF, a hard limit, or the
         end of the move) and tell the move's owner."""
         self._rebase(t)
+        # the terminals (P, D, limits, Z) must be recomputed at the next
+        # scan end: a stopped axis is no longer recomputed every scan
+        self.dirty = True
         self.segs = []
         self.si = 0
         self.t_end = None
@@ -166,6 +169,7 @@ class Axis:
             # current move in now, or they would be lost from the counter
             self._rebase(t)
         self.direction = direction
+        self.dirty = True
         self.segs = segs
         self.si = 0
         self.on_done = on_done

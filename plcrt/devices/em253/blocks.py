@@ -24,11 +24,12 @@ Common rules (manual 3.2, notes 1-5; decisions in docs/em253.md):
 from __future__ import annotations
 
 from fractions import Fraction
+from functools import partial
 from typing import Any, Optional
 
 from ...blocks import register_block
 from ...compiler.operands import POINTER_AREA_NAMES
-from ..motion import plan_hold
+from ..motion import plan_distance, plan_hold, ramp_distance, sqrt_floor
 from .axis import Axis, distance_plan, stop_plan, velocity_plan
 from .module import EM253Module
 
@@ -154,8 +155,11 @@ class _Base:
         return [(lim, self._hit_limit)]
 
     def limit_active(self, direction: int) -> bool:
+        return self.limit_active_at(direction, self.now())
+
+    def limit_active_at(self, direction: int, t: int) -> bool:
         assert self.axis is not None
-        p, m = self.axis.plant, self.axis.mechanical(self.now())
+        p, m = self.axis.plant, self.axis.mechanical(t)
         if direction > 0:
             return p.limit_pos is not None and m >= p.limit_pos
         return p.limit_neg is not None and m <= p.limit_neg
@@ -180,15 +184,80 @@ class _Base:
     def _done(self, t: int) -> None:
         self.status = ST_STOPPED
 
-    def ramp_down(self, t: int, v_ss: int, rate: Fraction) -> None:
-        """Run went to 0: decelerate to SpdSs and stop (planned once)."""
+    def ramp_down(self, t: int, v_ss: int, rate: Fraction,
+                  end: Optional[Fraction] = None) -> None:
+        """Run went to 0: decelerate to SpdSs and stop (planned once).
+
+        ``end`` is the travel at which the move is programmed to end (the
+        PosSet of POS_GOTO_R, the envelope's total); the stop never passes
+        it (see :meth:`bounded_stop`).
+        """
         if self.stopping:
             return
         ax = self.axis
         assert ax is not None
         x, v = ax.exact_state(t)
-        self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss), rate), keep=True)
+        self.begin(ax.direction, self.bounded_stop(t, x, v, v_ss, rate, end, "Run = 0"),
+                   keep=True)
         self.stopping = True
+
+    def bounded_stop(self, t: int, x: Fraction, v: Fraction, v_ss: int, rate: Fraction,
+                     end: Optional[Fraction], why: str) -> list:
+        """Segments that slow from ``v`` to SpdSs at ``rate`` and stop, but
+        never beyond the travel ``end`` of the programmed move.
+
+        A positioning module's pulse count is the program's: where the ramp
+        at ``rate`` would need more pulses than remain, the ramp is made
+        steeper so that it ends exactly at ``end`` at SpdSs, and a diagnostic
+        gives the rate used (docs/em253.md, decisions log).
+        """
+        vss = Fraction(v_ss)
+        if end is None or v <= vss or x + ramp_distance(v, vss, rate) <= end:
+            return stop_plan(t, x, v, vss, rate)
+        left = end - x
+        if left <= 0:
+            # the last pulse of the move is out: the pulse train ends now
+            self.warn(f"{why}: the programmed end is reached at {float(v):.0f} Hz; the "
+                      f"pulses stop at once", f"steep{self.plc.scans}")
+            return stop_plan(t, x, v, v, rate)
+        need = (v * v - vss * vss) / (2 * left * 1_000_000)  # Hz per µs
+        self.warn(f"{why}: slowing down from {float(v):.0f} Hz at the set rate of "
+                  f"{float(rate) * 1000:.3f} Hz/ms needs "
+                  f"{float(ramp_distance(v, vss, rate)):.0f} pulses but only {float(left):.0f} "
+                  f"remain to the programmed end; the axis slows down at "
+                  f"{float(need) * 1000:.3f} Hz/ms and stops exactly at the end",
+                  f"steep{self.plc.scans}")
+        segs, _ = plan_distance(Fraction(t), x, v, v, vss, left, rate, need)
+        return segs
+
+    def output_limit_lowered(self, t: int) -> None:
+        """P_DorCCW went from differential (500 kHz) to single-ended
+        (200 kHz) while this block's move runs above 200 kHz: the move's
+        parameters are applied again, as an Update would, so that the speed
+        ramps down to the new limit (with the block's DecTime) and a
+        positioning move still ends exactly on its count."""
+        if not self.running() or self.stopping or not getattr(self, "applied", None):
+            return
+        self.warn("P_DorCCW switched to single-ended while the axis runs above "
+                  "200 kHz: the speed is brought down to the single-ended limit",
+                  f"dorccw{self.plc.scans}")
+        self._update(t, *self.applied)
+
+    def restart_while_stopping(self, rising: bool, update: int) -> None:
+        """Run back to 1 (or an Update) while the axis slows down after Run = 0.
+
+        The module finishes the stop it was commanded (C_Status stays 1
+        until the pulses end, then reads 8); a Run edge after that starts
+        again.  Nothing in the manual says a stop can be taken back, so the
+        command is not acted on, and the diagnostic says so.
+        """
+        if rising:
+            self.warn("Run went back to 1 while the axis slows down after Run = 0: the "
+                      "stop is completed first; set Run to 0 and back to 1 after C_Status "
+                      "reads 8 to start again", f"rerun{self.plc.scans}")
+        if update:
+            self.warn("Update while the axis slows down after Run = 0 is not applied",
+                      f"updstop{self.plc.scans}")
 
     def estop(self) -> None:
         if self.axis is not None and self.axis.moving and self.owns():
@@ -242,7 +311,18 @@ class MotionEn3(_Base):
                 and self._last_out[2] == 1:
             return self._last_out
         t = self.now()
+        lowered = mod.differential and not p_dor_ccw
         mod.differential = bool(p_dor_ccw)
+        if lowered:
+            for ax in mod.axes:
+                owner = ax.owner
+                if ax.segs and abs(ax.speed(t)) > mod.max_hz and owner is not None:
+                    if hasattr(owner, "_update"):
+                        owner.output_limit_lowered(t)
+                    else:
+                        owner.warn("P_DorCCW switched to single-ended while the homing "
+                                   "runs above 200 kHz: the homing keeps its speeds",
+                                   "dorccw")
         out = []
         for i, (sev, clr) in enumerate(((sev0, clr0), (sev1, clr1))):
             ax = mod.axes[i]
@@ -326,12 +406,16 @@ class SpdCtrl(_Base):
         elif self.running():
             if not run:
                 self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec))
+            elif self.stopping:
+                self.restart_while_stopping(rising, update)
             elif update:
-                self._update(t, acc, dec, v_ss, v_set, d)
+                self.applied = (acc, dec, v_ss, v_set, d)
+                self._update(t, *self.applied)
         elif rising and self.can_start(d):
             top = self.speeds_ok(v_ss, v_set)
             if top is not None:
                 self.top = top
+                self.applied = (acc, dec, v_ss, v_set, d)
                 self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
                                             Fraction(top), _rate(top, v_ss, acc),
                                             _rate(top, v_ss, dec)))
@@ -348,17 +432,37 @@ class SpdCtrl(_Base):
         if top is None:
             return
         x, v = ax.exact_state(t)
+        ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
         if d != ax.direction:
-            # manual note 5 advises against it; plcrt slows to a stop first
-            self.warn("direction changed while running (not recommended, manual note 5): "
-                      "the axis decelerates to a stop; start it again to reverse", "dirchg")
-            self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss),
-                                               _rate(top, v_ss, dec)), keep=True)
+            # note 5: Update applies the direction too ("不建议在运行过程中更改方向",
+            # not recommended): the axis slows to SpdSs with the new DecTime,
+            # the pulses stop, and it starts again the other way from SpdSs
+            self.warn("direction changed with Update while running (not recommended, "
+                      "manual note 5): the axis slows down to SpdSs, stops and runs the "
+                      "other way", "dirchg")
+            self.top = top
+            self.begin(ax.direction, stop_plan(t, x, v, Fraction(v_ss), rd), keep=True)
+            # a partial, not a closure: fork() deep-copies the device state
+            ax.on_done = partial(self._reverse, d=d, v_ss=v_ss, top=top, ra=ra, rd=rd)
             return
         self.top = top
-        self.begin(ax.direction, velocity_plan(t, x, v, Fraction(v_ss), Fraction(top),
-                                               _rate(top, v_ss, acc), _rate(top, v_ss, dec)),
+        self.begin(ax.direction, velocity_plan(t, x, v, Fraction(v_ss), Fraction(top), ra, rd),
                    keep=True)
+
+    def _reverse(self, t: int, d: int, v_ss: int, top: int, ra: Fraction,
+                 rd: Fraction) -> None:
+        """The stop before a reversal ended at ``t``: start the other way."""
+        ax = self.axis
+        assert ax is not None
+        if ax.stf or self.limit_active_at(d, t):
+            self.warn("the reversal does not start: the STF input or the hard limit in "
+                      "the new direction is active", "revblocked")
+            self.status = ST_STOPPED
+            return
+        ax.owner = self
+        ax.start(t, d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                     Fraction(top), ra, rd), self._done)
+        ax.watch_positions(t, self.limit_watch(d))
 
 
 @register_block("POS_GOTO_R")
@@ -387,9 +491,12 @@ class PosGotoR(_Base):
             self.estop()
         elif self.running():
             if not run:
-                self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec))
+                self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec), self.target)
+            elif self.stopping:
+                self.restart_while_stopping(rising, update)
             elif update:
-                self._update(t, acc, dec, v_ss, v_set, pos)
+                self.applied = (acc, dec, v_ss, v_set, pos)
+                self._update(t, *self.applied)
         elif rising:
             d = 1 if pos > 0 else -1
             if pos == 0:
@@ -401,9 +508,13 @@ class PosGotoR(_Base):
                     segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
                                             Fraction(top), Fraction(abs(pos)),
                                             _rate(top, v_ss, acc), _rate(top, v_ss, dec))
+                    self.target = Fraction(abs(pos))
+                    self.applied = (acc, dec, v_ss, v_set, pos)
                     self.begin(d, segs)
         if ax.owner is not self:
-            return INNER_OK, 0, self.status, 0, 0
+            # another instruction moves the axis: C_Pos keeps this block's
+            # last move until its next start (3.2.5 "已发送脉冲数")
+            return INNER_OK, 0, self.status, self.last_pos, 0
         if ax.segs:
             self.last_spd = ax.speed(t)
             return INNER_OK, 0, self.status, ax.travel(t), self.last_spd
@@ -432,11 +543,20 @@ class PosGotoR(_Base):
         remaining = Fraction(abs(pos)) - x
         self.top = top
         ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
-        segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)
-        if remaining <= 0 or not ok:
-            self.warn("the updated PosSet cannot be reached with a ramp from the current "
-                      "speed: the axis decelerates and stops beyond it", "overshoot")
+        sent = x.numerator // x.denominator
+        if sent > abs(pos):
+            # physically impossible: the pulses are already out
+            self.warn(f"the updated PosSet {abs(pos)} is already passed ({sent} pulses of "
+                      f"this move are sent): the axis decelerates with DecTime and stops "
+                      f"beyond it", "passed")
             segs = stop_plan(t, x, v, Fraction(v_ss), rd)
+        else:
+            self.target = Fraction(abs(pos))
+            segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)
+            if not ok:
+                # the new ramps cannot end at PosSet from this speed: PosSet
+                # (the number of pulses, 3.2.5) wins over DecTime
+                segs = self.bounded_stop(t, x, v, v_ss, rd, self.target, "Update")
         self.begin(ax.direction, segs, keep=True)
 
 
@@ -458,14 +578,22 @@ class PosRun(_Base):
             self.estop()
         elif self.running():
             if not run:
-                self.ramp_down(t, v_ss, self.stop_rate)
-            elif update and not self.stopping:
-                self._update(t, v_ss, ptr, steps)
+                # the running step's DecTime (3.2.6 gives each step its own
+                # DecTime); never beyond the envelope's end
+                x = self.axis.travel(t) if self.axis is not None else 0
+                k, _ = self._step_at(x)
+                self.ramp_down(t, v_ss, self.step_rd[max(k - 1, 0)], self.bounds[-1])
+            elif self.stopping:
+                self.restart_while_stopping(rising, update)
+            elif update:
+                self.applied = (v_ss, ptr, steps)
+                self._update(t, *self.applied)
         elif rising and self.can_start(-1 if self._first_sign(ptr, steps) < 0 else 1):
             if mode != 0:
                 self.warn(f"Mode {mode} is not defined (manual: 0); running as mode 0", "mode")
             table = self._table(ptr, steps)
             if table is not None:
+                self.applied = (v_ss, ptr, steps)
                 self._start(t, v_ss, table)
         step, c_pos = self._progress(t)
         if self.status == ST_RUN and not self.running():
@@ -488,17 +616,24 @@ class PosRun(_Base):
                 return v
         return 1
 
-    def _table(self, ptr: int, steps: int) -> Optional[list[tuple[int, int, int, int]]]:
+    def _table(self, ptr: int, steps: int,
+               update: bool = False) -> Optional[list[tuple[int, int, int, int]]]:
+        """The profile table's rows, or None (with a diagnostic) when the
+        envelope cannot run: at a Run edge it then does not start, on an
+        Update the running envelope goes on as planned."""
+        refused = ("the Update is ignored and the running envelope goes on as planned"
+                   if update else "the envelope does not start")
+        key = "upd" if update else ""
         if not 1 <= steps <= MAX_STEPS:
-            self.warn(f"Step is {steps}; the module runs 1..{MAX_STEPS} steps and does not "
-                      f"start otherwise", "steps")
+            self.warn(f"Step is {steps}; the module runs 1..{MAX_STEPS} steps: {refused}",
+                      "steps" + key)
             return None
         area = POINTER_AREA_NAMES.get(ptr >> 24)
         off = ptr & 0xFFFFFF
         buf = self.plc.mem.areas.get({"T": "TV", "C": "CV"}.get(area, area)) if area else None
         if buf is None or off + steps * STEP_BYTES > len(buf):
             self.warn(f"ProfilePtr 16#{ptr:08X} does not point to {steps} x {STEP_BYTES} "
-                      f"bytes of memory", "ptr")
+                      f"bytes of memory: {refused}", "ptr" + key)
             return None
         rows = []
         for i in range(steps):
@@ -513,19 +648,28 @@ class PosRun(_Base):
             k = next(i for i, r in enumerate(rows) if r[3] != 0 and
                      (1 if r[3] > 0 else -1) != (1 if rows[0][3] >= 0 else -1))
             self.warn(f"step {k + 1} changes direction inside the envelope, which the module "
-                      f"does not allow (manual 3.2.6): the envelope does not start", "dir")
+                      f"does not allow (manual 3.2.6): {refused}", "dir" + key)
             return None
         return rows
 
     def _plan(self, t: int, x0: Fraction, v0: Fraction, v_ss: int, rows: list,
-              first: int, start: Fraction) -> Optional[tuple[list, list]]:
-        """Segments and step end positions for steps ``first``.. of ``rows``,
-        starting at time ``t`` with travel ``x0`` and speed ``v0``; ``start``
-        is where step ``first`` began (its PosSet counts from there)."""
-        segs: list = []
-        x, v, tt = x0, v0, Fraction(t)
-        bounds: list = []
+              first: int, start: Fraction) -> Optional[tuple[list, list, list]]:
+        """Segments, step end positions and step deceleration rates for steps
+        ``first``.. of ``rows``, starting at time ``t`` with travel ``x0`` and
+        speed ``v0``; ``start`` is where step ``first`` began (its PosSet
+        counts from there).
+
+        The steps run back to back (3.2.6: "每段指令可不必减速到 0"), each
+        ramping toward its SpdSet with its own rates, with look-ahead: a step
+        slows down before its end (with its own DecTime rate) as far as the
+        following steps need to reach SpdSs exactly at the envelope's end
+        with theirs.
+        """
         n = len(rows)
+        lens: list[Fraction] = []
+        tops: list[int] = []
+        rates: list[tuple[Fraction, Fraction]] = []
+        x, v = x0, v0
         for i in range(first, n):
             acc, dec, spd, pos = rows[i]
             top = self.speeds_ok(v_ss, spd, allow_equal=True)
@@ -537,23 +681,44 @@ class PosRun(_Base):
                 ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
             else:
                 # a step at SpdSs: note 3's (SpdSet - SpdSs) / time is 0, so the
-                # step's times apply to the change from the speed it enters with
+                # step's times apply to the change from the speed it enters
+                # with (the speed the step before it holds)
                 change = max(abs(int(v) - top), 1)
                 ra = Fraction(change, max(acc, 1) * 1000)
                 rd = Fraction(change, max(dec, 1) * 1000)
-            if i == n - 1:
-                part, ok = _last(tt, x, v, v_ss, top, length, ra, rd)
+            lens.append(length)
+            tops.append(top)
+            rates.append((ra, rd))
+            # the speed the next step is entered with, without look-ahead:
+            # a step at SpdSs takes its rates from it
+            held = plan_hold(Fraction(t), x, v, Fraction(top), length, ra, rd)
+            x, v = end, (held[-1].v1 if held else v)
+        # look-ahead: the highest speed at which each step may end so that
+        # every later step can still slow down to SpdSs by the envelope's end
+        m = len(lens)
+        cap = [Fraction(v_ss)] * m
+        for j in range(m - 1, 0, -1):
+            cap[j - 1] = sqrt_floor(cap[j] * cap[j] + 2 * rates[j][1] * lens[j] * 1_000_000)
+        segs: list = []
+        bounds: list = []
+        x, v, tt = x0, v0, Fraction(t)
+        for j in range(m):
+            ra, rd = rates[j]
+            top = Fraction(tops[j])
+            if j == m - 1:
+                part, ok = _last(tt, x, v, v_ss, tops[j], lens[j], ra, rd)
                 if not ok:
                     self.warn("the last step is too short to decelerate to SpdSs; the "
                               "pulses stop at a higher speed", "short")
-                self.stop_rate = rd
             else:
-                part = plan_hold(tt, x, v, Fraction(top), length, ra, rd)
+                part = plan_hold(tt, x, v, top, lens[j], ra, rd)
+                if part and part[-1].v1 > cap[j]:
+                    part, _ = plan_distance(tt, x, v, top, cap[j], lens[j], ra, rd)
             if part:
                 segs.extend(part)
                 tt, x, v = part[-1].t1, part[-1].x1, part[-1].v1
             bounds.append(x)
-        return segs, bounds
+        return segs, bounds, [r[1] for r in rates]
 
     def _start(self, t: int, v_ss: int, rows: list) -> None:
         assert self.axis is not None and self.module is not None
@@ -561,7 +726,7 @@ class PosRun(_Base):
         plan = self._plan(t, Fraction(0), Fraction(v_ss), v_ss, rows, 0, Fraction(0))
         if plan is None:
             return
-        segs, bounds = plan
+        segs, bounds, self.step_rd = plan
         self.bounds = bounds
         self.direction = d
         self.begin(d, segs)
@@ -572,13 +737,14 @@ class PosRun(_Base):
         may change in the same direction, not the direction)."""
         ax = self.axis
         assert ax is not None
-        rows = self._table(ptr, steps)
+        rows = self._table(ptr, steps, update=True)
         if rows is None:
             return
         d = -1 if any(r[3] < 0 for r in rows) else 1
         if any(r[3] for r in rows) and d != self.direction:
             self.warn("Update changes the direction of the running envelope, which the "
-                      "module does not allow (manual 3.2.6): the change is ignored", "upddir")
+                      "module does not allow (manual 3.2.6): the Update is ignored and the "
+                      "running envelope goes on as planned", "upddir")
             return
         x, v = ax.exact_state(t)
         k = next((i for i, b in enumerate(self.bounds) if x < b), len(self.bounds) - 1)
@@ -587,32 +753,40 @@ class PosRun(_Base):
         plan = self._plan(t, x, v, v_ss, rows, k, start)
         if plan is None:
             return
-        segs, bounds = plan
+        segs, bounds, rds = plan
         self.bounds = self.bounds[:k] + bounds
+        self.step_rd = self.step_rd[:k] + rds
         self.begin(ax.direction, segs, keep=True)
+
+    def _step_at(self, x: int) -> tuple[int, int]:
+        """(C_Step, C_Pos) at envelope travel ``x``: the step whose pulses are
+        being sent and the pulses sent in it (3.2.6: "当前步数发送的脉冲数").
+
+        At a boundary the next step has begun (0 pulses sent in it); at the
+        envelope's end the last step is complete.
+        """
+        start = 0
+        last = len(self.bounds) - 1
+        for i, b in enumerate(self.bounds):
+            if x < b or i == last:
+                return i + 1, x - start
+            start = int(b)
+        return 0, 0
 
     def _progress(self, t: int) -> tuple[int, int]:
         if not self.owns() or not hasattr(self, "bounds"):
             return getattr(self, "last", (0, 0))
         assert self.axis is not None
-        x = self.axis.travel(t) if self.axis.moving else None
-        if x is None:
+        if not self.axis.moving:
             return getattr(self, "last", (0, 0))
-        start = 0
-        for i, b in enumerate(self.bounds):
-            if x < b or i == len(self.bounds) - 1:
-                res = (i + 1, x - start)
-                self.last = res
-                return res
-            start = int(b)
-        return 0, 0
+        self.last = res = self._step_at(self.axis.travel(t))
+        return res
 
     def _done(self, t: int) -> None:
+        # the move ended for any reason (its end, Run = 0, E_Stop, STF, a
+        # limit, InnerState written): report the step that was running
         assert self.axis is not None
-        n = len(self.bounds)
-        prev = int(self.bounds[-2]) if n > 1 else 0
-        total = self.axis.last_travel
-        self.last = (n, total - prev)
+        self.last = self._step_at(self.axis.last_travel)
         self.status = ST_STOPPED
 
 
@@ -656,6 +830,8 @@ class Homing(_Base):
                 seq.abort(t)
                 x, v = ax.exact_state(t)
                 self.begin(ax.direction, stop_plan(t, x, v, seq.v_low, seq.rate), keep=True)
+        elif rising and ax.moving and ax.owner is self:
+            self.restart_while_stopping(rising, 0)
         elif rising and ax.moving:
             self.warn("the axis is already moved by another instruction: the homing does "
                       "not start", "busy")

@@ -82,7 +82,7 @@ from fractions import Fraction
 from functools import partial
 from typing import Any
 
-from ..motion import Seg, cruise, plan_distance
+from ..motion import Seg, cruise, plan_distance, ramp_distance
 from .axis import Axis, stop_plan, velocity_plan
 
 HOMING_RAMP_US = 100_000  #: SpdLow <-> SpdHigh ramp time (HOMING has no ramp inputs)
@@ -179,6 +179,8 @@ class HomingSequence:
         self.phase = "idle"
         self.reversed = False
         self.home: int | None = None   #: mechanical home point, once known
+        #: (switch edge, speed) while slowing down after the switch was found
+        self.braking: tuple[int, Fraction] | None = None
         self._end: int | None = None   #: planned end (µs) of the current finite move
 
     # -- helpers ----------------------------------------------------------------
@@ -341,21 +343,42 @@ class HomingSequence:
         if self.phase != "search" or self.reversed:
             what = "again during the search" if self.phase == "search" else \
                 f"during the {self.phase} phase"
-            self.fail(t, f"limit switch {name} reached at {pos} {what}")
+            self.fail(t, f"limit switch {name} reached at {pos} {what}" + self._why_braking(pos))
             return
+        self.braking = None
         self.reversed = True   # appendix 1, tracks 1/3: reverse at the limit
         self._seek(t, -d)
+
+    def _why_braking(self, limit_at: int) -> str:
+        """Why a limit was reached while slowing down on the switch: the
+        fixed 100 ms ramp (HOMING has no DecTime) needs more pulses than lie
+        between the switch edge and the limit.  A real module cannot brake
+        harder than its ramp either, so it too meets the limit; this says
+        what to change."""
+        if self.braking is None:
+            return ""
+        edge, v = self.braking
+        need = ramp_distance(v, self.v_low, self.rate)
+        room = abs(limit_at - edge)
+        v_max = max(int(20 * room - self.v_low), 0)   # (V + SpdLow) / 2 x 0.1 s <= room
+        return (f", while slowing down from {float(v):.0f} Hz to SpdLow after the reference "
+                f"switch edge at {edge}: the fixed {HOMING_RAMP_US // 1000} ms homing ramp "
+                f"needs {float(need):.0f} pulses but the limit is {room} pulses past the "
+                f"edge (use SpdHigh of at most {v_max} Hz, or move the switch farther from "
+                f"the limit)")
 
     def _found_switch(self, t: int, pos: int) -> None:
         """The RPS came on during the search: decelerate to SpdLow and stop
         ("检测到原点开关信号后减速停止"); the stop may lie past the switch."""
         ax = self.ax
         x, v = ax.exact_state(t)
+        self.braking = (pos, v)
         self._move(t, ax.direction, stop_plan(t, x, v, self.v_low, self.rate), [],
                    self._position, keep=True)
 
     def _position(self, t: int) -> None:
         """Get to the approach side of the edge at SpdLow if needed."""
+        self.braking = None
         m = self.mode
         assert m is not None and m.edge is not None
         c = crossing(m, self._rps())

@@ -108,6 +108,27 @@ def test_differential_output_drives_the_same_pulse_and_direction_terminals() -> 
 
 
 # ---------------------------------------------------------------------------
+# note 1: slots 0..6
+# ---------------------------------------------------------------------------
+@pytest.mark.parametrize("cpu,slot,fits", [
+    ("CPU221", 0, False), ("CPU222", 1, True), ("CPU222", 2, False), ("CPU224", 6, True),
+])
+def test_expansion_slots_per_cpu(cpu: str, slot: int, fits: bool) -> None:
+    """Note 1: "200CPU 后可挂 7 个模块 ... 第 7 个模块的模块槽号为 6"; docs/em253.md
+    adds the CPU's own limit on expansion modules (CPU 221: none, CPU 222:
+    two, the others seven): a slot beyond it is a PlcConfigError."""
+    plant = {"module": {str(slot): {}}}
+    text = ob1(EN3.replace("MOTION_EN3, 0", f"MOTION_EN3, {slot}"))
+    if fits:
+        plc = plcrt.load(text, plant=plant, cpu=cpu, scan_ms=1)
+        plc.scan()
+        assert plc["VW0"] == 1
+    else:
+        with pytest.raises(plcrt.PlcConfigError, match=f"slot {slot}"):
+            plcrt.load(text, plant=plant, cpu=cpu, scan_ms=1)
+
+
+# ---------------------------------------------------------------------------
 # 2.1 items 2, 3 / 3.2.1 P_DorCCW / 3.2.4 SpdSet
 # ---------------------------------------------------------------------------
 @pytest.mark.parametrize("p_dor_ccw,limit,kind", [(0, 200_000, "single-ended"),
@@ -127,6 +148,20 @@ def test_spd_ctrl_speed_is_limited_by_the_output_type(p_dor_ccw: int, limit: int
     plc.scan()
     assert plc["VD108"] == limit
     assert any(f"above the {kind} output limit of {limit} Hz" in m for m in messages(plc))
+
+
+def test_pos_goto_r_speed_is_limited_by_the_output_type() -> None:
+    """3.2.5 SpdSet: "单端最大值 200000, 差分最大值 500000": a POS_GOTO_R move
+    asking for 300 kHz on the single-ended output cruises at 200 kHz and
+    still sends exactly PosSet pulses."""
+    plc = load(EN3, GOTO, data="VW300 10\nVW302 10\nVD304 5000\nVD308 300000\n"
+                              "VD312 200000\n", scan_ms=10)
+    plc["M2.0"] = 1
+    plc.run(seconds=0.5)
+    assert plc.axis(0, 0)["speed"] == 200_000
+    plc.run(seconds=1)
+    assert plc.axis(0, 0)["position"] == 200_000
+    assert any("above the single-ended output limit" in m for m in messages(plc))
 
 
 # ---------------------------------------------------------------------------
@@ -305,6 +340,17 @@ def test_note_3_example_acceleration() -> None:
     assert plc.axis(0, 0)["speed"] == 5000 + 2250 * 10
     plc.scan(10)
     assert plc.axis(0, 0)["speed"] == 50_000
+
+
+def test_acc_time_0_counts_as_1_ms() -> None:
+    """3.2.4 AccTime "推荐值>10" (recommended, not required); docs/em253.md:
+    AccTime 0 counts as 1 ms: SpdSet is reached 1 ms after the start."""
+    plc = load(EN3, SPD, data="VW300 0\nVW302 0\nVD304 1000\nVD308 10000\n")
+    plc["M1.1"] = 1
+    plc["M1.0"] = 1
+    plc.scan()
+    assert plc.axis(0, 0)["speed"] == 10_000
+    assert not messages(plc)
 
 
 # ---------------------------------------------------------------------------
@@ -486,6 +532,41 @@ def test_homing_needs_spd_low_above_0_and_not_above_spd_high(low: int, high: int
     plc.scan(20)
     assert plc.axis(0, 0)["status"] == "stopped" and plc["VW210"] == 0
     assert any("0 < SpdLow <= SpdHigh" in m for m in messages(plc))
+
+
+RPS_PLANT = {"module": {"0": {"axis": {"0": {
+    "rps": [4000, 6999], "z_period": 1000, "z_offset": 250,
+    "limit_neg": -100_000, "limit_pos": 100_000}}}}}
+
+
+@pytest.mark.parametrize("mode,start", [(1, 30_000), (2, -20_000), (3, 30_000),
+                                        (4, -20_000)])
+def test_homing_decelerates_on_the_switch_then_reverses(mode: int, start: int) -> None:
+    """Appendix 1, modes 1-4: "在检测到原点开关信号后减速停止，再反转退出原点开关":
+    after the switch comes on the speed falls through values between SpdHigh
+    and SpdLow (no dead stop), and the axis reverses only after it has
+    slowed to SpdLow."""
+    plant = {"module": {"0": {"axis": {"0": dict(RPS_PLANT["module"]["0"]["axis"]["0"],
+                                                 start=start)}}}}
+    plc = load(EN3, HOMING, data=f"VW220 {mode}\nVD224 10000\nVD228 40000\n",
+               plant=plant)
+    plc["M5.0"] = 1
+    speeds = []
+    while plc["VW210"] != 8:
+        plc.scan()
+        a = plc.axis(0, 0)
+        speeds.append((4000 <= a["mechanical"] <= 6999, a["speed"]))
+    first_in = next(i for i, (inside, _) in enumerate(speeds) if inside)
+    search = speeds[first_in - 1][1]
+    assert abs(search) == 40_000
+    after = [v for _, v in speeds[first_in:]]
+    flip = next(i for i, v in enumerate(after) if v * search < 0)
+    slowing = [abs(v) for v in after[:flip] if v]
+    assert any(10_000 < v < 40_000 for v in slowing)
+    assert slowing == sorted(slowing, reverse=True)
+    # the 100 ms ramp (SpdHigh - SpdLow) / 100 ms is 300 Hz per 1 ms scan
+    assert 10_000 <= slowing[-1] <= 10_300
+    assert abs(after[flip]) == 10_000
 
 
 # ---------------------------------------------------------------------------

@@ -220,11 +220,13 @@ HOMING_PLANT = {"module": {"0": {"axis": {"0": {"z_period": 400}, "1": {}}}}}
 @pytest.mark.parametrize("name", list(BLOCKS))
 def test_c_status_0_before_1_running_8_stopped(name: str) -> None:
     """3.2.4-3.2.7 C_Status: "初始值显示为 0，运行时显示为 1，运行停止后显示为 8";
-    InnerState: "正常运行时显示为 257"."""
+    InnerState: "正常运行时显示为 257" (plcrt: from the first call on)."""
     call, data, run, status, inner = BLOCKS[name]
     plc = load(EN3, call, data=data, plant=HOMING_PLANT if name == "HOMING" else None)
     plc.scan(3)
     assert (plc[status], plc[inner]) == (0, 257)
+    if name == "POS_RUN":
+        assert plc["VB156"] == 0     # C_Step before the first run (docs/em253.md)
     plc[run] = 1
     plc.scan(2)
     assert plc[status] == 1 and plc.axis(0, 0)["status"] == "moving"
@@ -257,6 +259,25 @@ def test_e_stop_held_uses_up_the_run_edge(name: str) -> None:
     plc[run] = 1
     plc.scan(3)
     assert plc.axis(0, 0)["status"] == "moving" and plc[status] == 1
+
+
+@pytest.mark.parametrize("name", ["POS_GOTO_R", "POS_RUN", "HOMING"])
+def test_start_while_another_call_moves_the_axis_is_refused(name: str) -> None:
+    """docs/em253.md (one block instance per CALL): two CALLs for the same
+    axis share it; a Run edge while the axis moves for another CALL starts
+    nothing (diagnostic), the running move goes on."""
+    call, data, run, status, _ = BLOCKS[name]
+    plc = load(EN3, SPD, call, data=SPEEDS + data, plant=HOMING_PLANT)
+    plc["M1.1"] = 1
+    plc["M1.0"] = 1
+    plc.scan(200)
+    assert plc.axis(0, 0)["speed"] == 10_000
+    plc[run] = 1
+    plc.scan(100)
+    assert plc.axis(0, 0)["speed"] == 10_000
+    assert plc[status] == 0 and plc["VW106"] == 1
+    assert any(m.startswith(name) and "already moved by another instruction" in m
+               for m in messages(plc))
 
 
 def test_update_any_non_zero_value_applies_and_is_cleared() -> None:
@@ -641,3 +662,26 @@ def test_ignored_homing_keeps_its_c_spd() -> None:
     plc.scan()
     assert plc.axis(0, 0)["speed"] == 1000
     assert plc["VD212"] == 1000
+
+
+@pytest.mark.xfail(strict=True, reason="SpdSet is limited to the output's maximum but SpdSs "
+                                       "is not: the pulses start at SpdSs above the limit")
+@pytest.mark.parametrize("name", ["SPD_CTRL", "POS_GOTO_R", "POS_RUN"])
+def test_spd_ss_above_the_output_limit_does_not_pulse_above_it(name: str) -> None:
+    """2.1: 单端输出 "频率最高 200Khz"; docs/em253.md: "A speed above the
+    limit is limited to it".  SpdSs 300 kHz below SpdSet 400 kHz on the
+    single-ended output: the block says "the module runs at 200000 Hz", so
+    the axis must never pulse faster than 200 kHz (HOMING limits SpdLow
+    with SpdHigh and does)."""
+    call, _, run, _, _ = BLOCKS[name]
+    data = (table([(100, 100, 400_000, 1_000_000)])
+            + "VW300 100\nVW302 100\nVD304 300000\nVD308 400000\nVD312 1000000\n")
+    plc = load(EN3, call, data=data)
+    plc["M1.1"] = 1
+    plc[run] = 1
+    fastest = 0
+    for _ in range(50):
+        plc.scan()
+        fastest = max(fastest, abs(plc.axis(0, 0)["speed"]))
+    assert any("the module runs at 200000 Hz" in m for m in messages(plc))
+    assert 0 < fastest <= 200_000

@@ -280,6 +280,24 @@ def test_start_while_another_call_moves_the_axis_is_refused(name: str) -> None:
                for m in messages(plc))
 
 
+@pytest.mark.parametrize("name", ["SPD_CTRL", "POS_GOTO_R", "POS_RUN", "HOMING"])
+def test_no_start_while_the_stf_input_is_on(name: str) -> None:
+    """2.1 item 6 / 2.2 STF0 (硬件急停输入): while the axis's emergency-stop
+    input is on, a Run edge does not move it (diagnostic); MOTION_EN3
+    reports Status 4."""
+    call, data, run, _, _ = BLOCKS[name]
+    plant = {"module": {"0": {"axis": {"0": {"z_period": 400, "events": [
+        {"at": 0, "input": "STF", "value": True}]}}}}}
+    plc = load(EN3, call, data=data, plant=plant)
+    plc.scan(2)
+    plc["M1.1"] = 1
+    plc[run] = 1
+    plc.scan(50)
+    assert plc.axis(0, 0)["position"] == 0 and plc.axis(0, 0)["status"] == "stopped"
+    assert plc["VW0"] == 4
+    assert any(m.startswith(name) and "STF" in m for m in messages(plc))
+
+
 def test_update_any_non_zero_value_applies_and_is_cleared() -> None:
     """3.2.4 Update (byte 1~255): "如果改参数不为 0，则更新指令参数 ... 指令更新完
     后，会自动清 0"; note 5: "更改完成后，此值自动复位".  255 works as 1 does."""

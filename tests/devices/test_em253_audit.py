@@ -515,21 +515,55 @@ def test_pos_run_table_outside_memory_does_not_start() -> None:
     assert any("does not point to 1 x 12 bytes" in m for m in messages(plc))
 
 
-def manual_data_block() -> str:
-    """The data block of the manual's POS_RUN example, as printed."""
-    text = MANUAL.read_text(encoding="utf-8")
-    return text.split("多段包络数据最好写在数据块中，如下：")[1].split("```")[1]
+#: The data block of the manual's POS_RUN example (3.2.6), as printed.
+MANUAL_DATA_BLOCK = (
+    "//\n"
+    "VW1000 1000\n"
+    "VW1002 1000\n"
+    "VD1004 20000\n"
+    "VD1008 500000 //第一段\n"
+    "VW1012 10000\n"
+    "VW1014 10000\n"
+    "VD1016 10000\n"
+    "VD1020 300000 //第二段\n"
+    "VW1024 5000\n"
+    "VW1026 5000\n"
+    "VD1028 30000\n"
+    "VD1032 100000 //第三段\n"
+    "VW1036 20000\n"
+    "VW1038 20000\n"
+    "VD1040 50000\n"
+    "VD1044 50000 //第四段\n"
+    "VW1048 800\n"
+    "VW1050 800\n"
+    "VD1052 50000\n"
+    "VD1056 500000 //第五段\n"
+    "VW1060 8000\n"
+    "VW1062 8000\n"
+    "VD1064 500000\n"
+    "VD1068 30000 //第六段\n"
+    "VW1072 1000\n"
+    "VW1074 1000\n"
+    "VD1076 5000\n"
+    "VD1080 50000 //第七段\n"
+)
 
 
 @pytest.mark.skipif(not MANUAL.exists(), reason="the manual's text is not available")
+def test_the_data_block_is_the_manuals() -> None:
+    """MANUAL_DATA_BLOCK is the manual's text, line for line."""
+    text = MANUAL.read_text(encoding="utf-8")
+    printed = text.split("多段包络数据最好写在数据块中，如下：")[1].split("```")[1]
+    assert printed.strip("\n") + "\n" == MANUAL_DATA_BLOCK
+
+
 def test_pos_run_manual_data_block_verbatim() -> None:
     """3.2.6: "多段包络数据最好写在数据块中": the manual's data block, as printed
     (with its // comments), loads and runs the example: 1 530 000 pulses,
     C_Step 7, C_Pos 50 000."""
-    block = manual_data_block()
-    assert "VD1080 50000 //第七段" in block
-    plc = plcrt.load(EM253 / "pos_run.awl", plant=EM253 / "plant.toml", data=block,
-                     scan_ms=10)
+    assert "VD1080 50000 //第七段" in MANUAL_DATA_BLOCK
+    plc = plcrt.load(EM253 / "pos_run.awl", plant=EM253 / "plant.toml",
+                     data=MANUAL_DATA_BLOCK, scan_ms=10)
     plc["M3.0"] = 1
     plc.run(seconds=70)
     plc.scan()

@@ -122,12 +122,16 @@ class _Base:
     def owns(self) -> bool:
         return self.axis is not None and getattr(self.axis, "owner", None) is self
 
-    def speeds_ok(self, v_ss: int, v_set: int, allow_equal: bool = False) -> Optional[int]:
-        """Validate speeds; returns the (possibly clamped) SpdSet or None.
+    def speeds_ok(self, v_ss: int, v_set: int,
+                  allow_equal: bool = False) -> Optional[tuple[int, int]]:
+        """Validate speeds; returns (SpdSs, SpdSet), both limited to the
+        output's maximum (2.1: 200 kHz single-ended, 500 kHz differential),
+        or None when the motor does not start.
 
         Note 4: the start speed must be below the run speed, else the motor
-        does not start.  An envelope step may run at SpdSs itself
-        (``allow_equal``): the manual's own POS_RUN table ends with one.
+        does not start (checked on the values the program gives).  An
+        envelope step may run at SpdSs itself (``allow_equal``): the
+        manual's own POS_RUN table ends with one.
         """
         assert self.module is not None
         if v_ss < 0 or v_set <= 0:
@@ -142,8 +146,11 @@ class _Base:
             kind = "differential" if self.module.differential else "single-ended"
             self.warn(f"SpdSet {v_set} Hz is above the {kind} output limit of {lim} Hz; "
                       f"the module runs at {lim} Hz", "maxhz")
-            return lim
-        return v_set
+            if v_ss > lim:
+                self.warn(f"SpdSs {v_ss} Hz is above the {kind} output limit too; the "
+                          f"pulses start and stop at {lim} Hz", "maxss")
+            return min(v_ss, lim), lim
+        return v_ss, v_set
 
     def limit_watch(self, direction: int) -> list:
         """Thresholds that stop the axis at a hard limit in ``direction``."""
@@ -405,6 +412,7 @@ class SpdCtrl(_Base):
             self.estop()
         elif self.running():
             if not run:
+                v_ss = min(v_ss, self.top)
                 self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec))
             elif self.stopping:
                 self.restart_while_stopping(rising, update)
@@ -412,10 +420,11 @@ class SpdCtrl(_Base):
                 self.applied = (acc, dec, v_ss, v_set, d)
                 self._update(t, *self.applied)
         elif rising and self.can_start(d):
-            top = self.speeds_ok(v_ss, v_set)
-            if top is not None:
-                self.top = top
+            sp = self.speeds_ok(v_ss, v_set)
+            if sp is not None:
                 self.applied = (acc, dec, v_ss, v_set, d)
+                v_ss, self.top = sp
+                top = self.top
                 self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
                                             Fraction(top), _rate(top, v_ss, acc),
                                             _rate(top, v_ss, dec)))
@@ -428,9 +437,10 @@ class SpdCtrl(_Base):
     def _update(self, t, acc, dec, v_ss, v_set, d) -> None:
         ax = self.axis
         assert ax is not None
-        top = self.speeds_ok(v_ss, v_set)
-        if top is None:
+        sp = self.speeds_ok(v_ss, v_set)
+        if sp is None:
             return
+        v_ss, top = sp
         x, v = ax.exact_state(t)
         ra, rd = _rate(top, v_ss, acc), _rate(top, v_ss, dec)
         if d != ax.direction:
@@ -468,6 +478,7 @@ class SpdCtrl(_Base):
 @register_block("POS_GOTO_R")
 class PosGotoR(_Base):
     name = "POS_GOTO_R"
+    c_pos = 0   #: the C_Pos last written
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
                  run) -> tuple:
@@ -479,11 +490,13 @@ class PosGotoR(_Base):
                 and self._axis_no == axis_no and self.initialised:
             t = self.plc.now_us
             self.last_spd = spd = ax.speed(t)
-            return INNER_OK, 0, self.status, ax.travel(t), spd
+            self.c_pos = c_pos = ax.travel(t)
+            return INNER_OK, 0, self.status, c_pos, spd
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
-            return inner, update, self.status, self.last_pos, self.last_spd
+            # an ignored call leaves its outputs as they were
+            return inner, update, self.status, self.c_pos, self.last_spd
         ax = self.axis
         assert ax is not None
         t = self.now()
@@ -491,6 +504,7 @@ class PosGotoR(_Base):
             self.estop()
         elif self.running():
             if not run:
+                v_ss = min(v_ss, self.top)
                 self.ramp_down(t, v_ss, _rate(self.top, v_ss, dec), self.target)
             elif self.stopping:
                 self.restart_while_stopping(rising, update)
@@ -502,26 +516,27 @@ class PosGotoR(_Base):
             if pos == 0:
                 self.status = ST_STOPPED
             elif self.can_start(d):
-                top = self.speeds_ok(v_ss, v_set)
-                if top is not None:
+                sp = self.speeds_ok(v_ss, v_set)
+                if sp is not None:
+                    self.applied = (acc, dec, v_ss, v_set, pos)
+                    v_ss, top = sp
                     self.top = top
                     segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
                                             Fraction(top), Fraction(abs(pos)),
                                             _rate(top, v_ss, acc), _rate(top, v_ss, dec))
                     self.target = Fraction(abs(pos))
-                    self.applied = (acc, dec, v_ss, v_set, pos)
                     self.begin(d, segs)
         if ax.owner is not self:
             # another instruction moves the axis: C_Pos keeps this block's
             # last move until its next start (3.2.5 "已发送脉冲数")
-            return INNER_OK, 0, self.status, self.last_pos, 0
-        if ax.segs:
-            self.last_spd = ax.speed(t)
-            return INNER_OK, 0, self.status, ax.travel(t), self.last_spd
-        self.last_spd = 0
-        if self.status == ST_RUN:
-            self.status = ST_STOPPED
-        return INNER_OK, 0, self.status, self.last_pos, 0
+            self.c_pos, self.last_spd = self.last_pos, 0
+        elif ax.segs:
+            self.c_pos, self.last_spd = ax.travel(t), ax.speed(t)
+        else:
+            self.c_pos, self.last_spd = self.last_pos, 0
+            if self.status == ST_RUN:
+                self.status = ST_STOPPED
+        return INNER_OK, 0, self.status, self.c_pos, self.last_spd
 
     def _done(self, t: int) -> None:
         assert self.axis is not None
@@ -531,12 +546,13 @@ class PosGotoR(_Base):
     def _update(self, t, acc, dec, v_ss, v_set, pos) -> None:
         ax = self.axis
         assert ax is not None
-        top = self.speeds_ok(v_ss, v_set)
-        if top is None:
+        sp = self.speeds_ok(v_ss, v_set)
+        if sp is None:
             return
+        v_ss, top = sp
         d = 1 if pos > 0 else -1
         x, v = ax.exact_state(t)
-        if d != ax.direction:
+        if pos != 0 and d != ax.direction:   # 0 has no sign: a total already passed
             self.warn("PosSet changed sign while moving: a direction change is not "
                       "allowed during a move; the new PosSet is ignored", "dirchg")
             return
@@ -582,7 +598,8 @@ class PosRun(_Base):
                 # DecTime); never beyond the envelope's end
                 x = self.axis.travel(t) if self.axis is not None else 0
                 k, _ = self._step_at(x)
-                self.ramp_down(t, v_ss, self.step_rd[max(k - 1, 0)], self.bounds[-1])
+                self.ramp_down(t, min(v_ss, self.module.max_hz) if self.module else v_ss,
+                               self.step_rd[max(k - 1, 0)], self.bounds[-1])
             elif self.stopping:
                 self.restart_while_stopping(rising, update)
             elif update:
@@ -643,10 +660,10 @@ class PosRun(_Base):
             spd = int.from_bytes(buf[b + 4:b + 8], "big", signed=True)
             pos = int.from_bytes(buf[b + 8:b + 12], "big", signed=True)
             rows.append((acc, dec, spd, pos))
-        signs = {1 if r[3] > 0 else -1 for r in rows if r[3] != 0}
-        if len(signs) > 1:
-            k = next(i for i, r in enumerate(rows) if r[3] != 0 and
-                     (1 if r[3] > 0 else -1) != (1 if rows[0][3] >= 0 else -1))
+        moves = [(i, 1 if r[3] > 0 else -1) for i, r in enumerate(rows) if r[3] != 0]
+        if len({sign for _, sign in moves}) > 1:
+            # the first step that moves against the first step that moves
+            k = next(i for i, sign in moves if sign != moves[0][1])
             self.warn(f"step {k + 1} changes direction inside the envelope, which the module "
                       f"does not allow (manual 3.2.6): {refused}", "dir" + key)
             return None
@@ -672,9 +689,10 @@ class PosRun(_Base):
         x, v = x0, v0
         for i in range(first, n):
             acc, dec, spd, pos = rows[i]
-            top = self.speeds_ok(v_ss, spd, allow_equal=True)
-            if top is None:
+            sp = self.speeds_ok(v_ss, spd, allow_equal=True)
+            if sp is None:
                 return None
+            v_ss, top = sp
             end = (start if i == first else x) + abs(pos)
             length = max(end - x, Fraction(0))
             if top > v_ss:
@@ -723,7 +741,8 @@ class PosRun(_Base):
     def _start(self, t: int, v_ss: int, rows: list) -> None:
         assert self.axis is not None and self.module is not None
         d = -1 if any(r[3] < 0 for r in rows) else 1
-        plan = self._plan(t, Fraction(0), Fraction(v_ss), v_ss, rows, 0, Fraction(0))
+        v0 = Fraction(min(v_ss, self.module.max_hz))
+        plan = self._plan(t, Fraction(0), v0, v_ss, rows, 0, Fraction(0))
         if plan is None:
             return
         segs, bounds, self.step_rd = plan
@@ -812,7 +831,7 @@ class Homing(_Base):
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
-            return inner, self.status, 0
+            return inner, self.status, self.last_spd   # an ignored call: outputs kept
         ax = self.axis
         assert ax is not None
         t = self.now()
@@ -837,7 +856,7 @@ class Homing(_Base):
                       "not start", "busy")
         elif rising:
             self._start(t, mode, v_low, v_high, offset)
-        spd = ax.speed(t) if self.owns() else 0
+        self.last_spd = spd = ax.speed(t) if self.owns() else 0
         # C_Status stays 1 while the axis still moves for this block (also
         # while it decelerates after Run = 0) and reads 8 once it stopped
         if self.status == ST_RUN and not self.running():

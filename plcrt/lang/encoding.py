@@ -329,7 +329,7 @@ def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
         if text in seen:
             continue  # reads the same as a preferred code page
         seen.add(text)
-        score = _plausibility(text, family) - mess_ratio(text, maximum_threshold=1.0)
+        score = _plausibility(text, codec, family) - mess_ratio(text, maximum_threshold=1.0)
         scored.append((score, codec))
     if not scored:
         return None
@@ -347,11 +347,12 @@ _RUN = re.compile(r"[^\x00-\x7f]+")
 _ASCII_ALNUM = re.compile(r"[A-Za-z0-9]")
 
 
-def _plausibility(text: str, family: str) -> float:
-    """Mean weight of the non-ASCII characters of ``text`` read in a code
-    page of ``family`` (1.0: what such a PC writes; 0: never)."""
+def _plausibility(text: str, codec: str, family: str) -> float:
+    """Mean weight of the non-ASCII characters of ``text`` read in ``codec``
+    of script ``family`` (1.0: what such a PC writes; 0: never)."""
     total = 0.0
     count = 0
+    alphabet = _best_alphabet(text, codec)
     for m in _RUN.finditer(text):
         run = m.group()
         start, end = m.start(), m.end()
@@ -359,7 +360,10 @@ def _plausibility(text: str, family: str) -> float:
         in_ascii_word = bool(start and _ASCII_ALNUM.match(text, start - 1)
                              or _ASCII_ALNUM.match(text, end))
         for k, c in enumerate(run):
-            total += _weight(c, family, len(run), in_ascii_word, text[start + k + 1:start + k + 2])
+            w = _weight(c, family, len(run), in_ascii_word, text[start + k + 1:start + k + 2])
+            if alphabet is not None and c.isalpha() and c.lower()[0] not in alphabet:
+                w *= 0.4  # no one language of the code page writes all these letters
+            total += w
         count += len(run)
     return total / count if count else 1.0
 
@@ -421,6 +425,30 @@ def _weight(c: str, family: str, run: int, in_ascii_word: bool, after: str) -> f
         # Traditional Chinese is the least common reading of the two
         return (0.8 if _lead(c, "cp950") < 0xC7 else 0.4) if "CJK" in name else 0.2
     return 0.1
+
+
+#: The accented letters of the languages written in each Latin code page.
+#: One language must account for a text's letters: Czech read as CP1252
+#: gives è, ø and š together, which no Western language writes.
+_WESTERN = ("äöüß", "àâæçéèêëîïôœùûüÿ", "áéíóúüñ¡¿", "àèéìíîòóùú", "áâãàçéêíóôõú",
+            "éëïóöü", "æøåé", "åäöé")
+LATIN_LANGUAGES: dict[str, tuple[str, ...]] = {
+    "cp1252": _WESTERN,
+    "cp1250": ("ąćęłńóśźż", "áčďéěíňóřšťúůýž", "áäčďéíĺľňóôŕšťúýž", "áéíóöőúüű",
+               "čšž", "čćđšž", "ăâîşţ", "äöüß"),
+    "cp1254": ("çğıöşüâîû", *_WESTERN),
+    "cp1257": ("ąčęėįšųūž", "āčēģīķļņšūž", "äõöüšž", "äöüß"),
+}
+
+
+def _best_alphabet(text: str, codec: str) -> str | None:
+    """The alphabet of ``codec``'s languages that holds most of the
+    non-ASCII letters of ``text`` (None for a non-Latin code page)."""
+    languages = LATIN_LANGUAGES.get(codec)
+    if languages is None:
+        return None
+    letters = [c.lower()[0] for c in text if not c.isascii() and c.isalpha()]
+    return max(languages, key=lambda a: sum(c in a for c in letters))
 
 
 def _hanzi(c: str) -> float:

@@ -283,7 +283,7 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
         try:
             spec.encoding = resolve_encoding(encoding)
         except PlcConfigError as e:
-            raise PlcUsageError(f"encoding= {e.message}") from None
+            raise PlcUsageError(e.message) from None
     return spec
 
 

@@ -297,6 +297,8 @@ CANDIDATES: tuple[tuple[str, str], ...] = (
     ("cp1257", "latin"),     # Baltic
 )
 
+#: Size of the text scored (non-ASCII lines, evenly spread over the files).
+SAMPLE_BYTES = 16384
 #: Scores this close count as equal.
 TIE = 0.05
 #: A guess is confident when it scores at least this much ...
@@ -315,8 +317,11 @@ def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
     and scores best on their non-ASCII lines together, or None."""
     from charset_normalizer.md import mess_ratio
 
-    sample = b"\n".join(line for data in blobs for line in data.splitlines()
-                        if not line.isascii())
+    lines = [line for data in blobs for line in data.splitlines() if not line.isascii()]
+    # perf: the scoring is pure Python; lines spread over the files, about
+    # SAMPLE_BYTES of them, decide as well as all of them
+    step = -(-sum(map(len, lines)) // SAMPLE_BYTES)
+    sample = b"\n".join(lines[::max(step, 1)])
     seen: set[str] = set()
     scored: list[tuple[float, str]] = []
     for codec, family in CANDIDATES:
@@ -343,6 +348,7 @@ def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
     return codec, confident
 
 
+_ALPHABETIC = ("latin", "cyrillic", "greek")
 _RUN = re.compile(r"[^\x00-\x7f]+")
 _ASCII_ALNUM = re.compile(r"[A-Za-z0-9]")
 
@@ -363,6 +369,8 @@ def _plausibility(text: str, codec: str, family: str) -> float:
             w = _weight(c, family, len(run), in_ascii_word, text[start + k + 1:start + k + 2])
             if alphabet is not None and c.isalpha() and c.lower()[0] not in alphabet:
                 w *= 0.4  # no one language of the code page writes all these letters
+            if k and c.isupper() and run[k - 1].islower() and family in _ALPHABETIC:
+                w *= 0.5  # a capital after a small letter inside a word: "ЦчіМРт"
             total += w
         count += len(run)
     return total / count if count else 1.0

@@ -42,8 +42,8 @@ from typing import NoReturn, Sequence
 
 from ..errors import Diagnostic, PlcConfigError, PlcSyntaxError, SourceLoc
 
-__all__ = ["Decoded", "decode_bytes", "decode_files", "encoding_note", "read_bytes",
-           "read_decoded", "resolve_encoding"]
+__all__ = ["Decoded", "decode_bytes", "decode_files", "decode_many", "encoding_note",
+           "read_bytes", "read_decoded", "resolve_encoding"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,14 +80,12 @@ def resolve_encoding(name: str | None) -> str | None:
     if key.isdigit():
         key = "cp" + key
     try:
-        info = codecs.lookup(key)
+        # str.encode accepts text encodings only (not hex, base64, rot13 ...)
+        "".encode(key)
+        return codecs.lookup(key).name
     except LookupError:
-        info = None
-    # hex, base64, rot13 ... are codecs too, but not of text files
-    if info is None or not getattr(info, "_is_text_encoding", True):
         raise PlcConfigError(f"unknown encoding {name[:40]!r}; give a name such as cp1252, "
-                             f"gbk, gb18030, cp1251, cp932, utf-8 or utf-16")
-    return info.name
+                             f"gbk, gb18030, cp1251, cp932, utf-8 or utf-16") from None
 
 
 def read_bytes(path: str | Path) -> bytes:

@@ -52,3 +52,20 @@ def test_encoding_not_a_name(plc):
         "*test_unknown_encoding: @pytest.mark.plc: unknown encoding 'klingon'*",
         "*test_encoding_not_a_name: @pytest.mark.plc: encoding must be a name*",
     ])
+
+
+def test_harness_load_encoding() -> None:
+    """Harness.load passes encoding= on, for files and for a parsed program
+    whose table is still a path; an unknown name is a PlcConfigError."""
+    from plcrt import PlcConfigError
+    from plcrt.engine.runtime import parse_sources
+    from plcrt.testing import Harness
+
+    awl, sym = DATA / "de_table.awl", DATA / "de_table.sym"
+    h = Harness.load(awl, symbols=sym, encoding="gbk")
+    assert "Start_F鰎derband" in h.plc.symbols.entries
+    parsed = parse_sources(awl, encoding="gbk")
+    h = Harness.load(parsed, symbols=sym, encoding="gbk")
+    assert "Start_F鰎derband" in h.plc.symbols.entries
+    with pytest.raises(PlcConfigError, match="unknown encoding"):
+        Harness.load(parsed, symbols=sym, encoding="klingon")

@@ -603,71 +603,23 @@ def _system_symbols() -> dict[str, str]:
     return dict(SYSTEM_SYMBOLS)
 
 
-def _is_file(x: Any) -> bool:
-    """Whether a program, symbol or data argument names a file (a Path, or
-    a string without a newline) rather than holding the text itself."""
-    return isinstance(x, Path) or (isinstance(x, str) and "\n" not in x and len(x) < 4096)
-
-
 def _text_or_path(x: Any, encoding: str | None = None) -> tuple[str, str]:
     """(text, file name) for a path or literal text argument."""
     from ..lang import read_source
-    if _is_file(x):
+    if isinstance(x, Path):
         return read_source(x, encoding), str(x)
-    return str(x), "<string>"
-
-
-def parse_inputs(source: str | Path | Sequence[str | Path], symbols: Any = None,
-                 data: Any = None, *, encoding: str | None = None) -> tuple[ir.Program, Any, Any]:
-    """Parse a program with its symbol table and data block.
-
-    Each is a path, text, or (for the tables) an already parsed object.  The
-    files among them are decoded together (:func:`plcrt.lang.encoding.decode_files`):
-    one encoding that reads them all is preferred, so a symbol name reads
-    the same in the program and in its table.  A syntax error in a file whose
-    encoding was guessed carries a note saying so.
-    """
-    from ..lang import parse_datablock, parse_program, parse_symbols
-    from ..lang.encoding import decode_files, encoding_note, resolve_encoding
-    codec = resolve_encoding(encoding)
-    items = [source] if isinstance(source, (str, Path)) else list(source)
-    if not items:
-        raise PlcConfigError("no program given")
-    tables = [x if isinstance(x, (str, Path)) else None for x in (symbols, data)]
-    files = [x for x in items + tables if x is not None and _is_file(x)]
-    decoded = {id(x): d for x, d in zip(files, decode_files(files, codec))}
-
-    def parse(fn: Callable[[str, str], Any], x: Any) -> Any:
-        d = decoded.get(id(x))
-        text, name = (d.text, str(x)) if d is not None else (str(x), "<string>")
-        try:
-            return fn(text, name)
-        except PlcError as e:
-            note = encoding_note(d, e.loc or SourceLoc(name, 1, 1))
-            if note is not None:
-                e.diagnostics.append(note)
-            raise
-
-    programs = [parse(parse_program, x) for x in items]
-    used = {decoded[id(x)].encoding for x in items if id(x) in decoded}
-    shared = used.pop() if len(used) == 1 else ""
-    pous = tuple(p for prog in programs for p in prog.pous)
-    if len(programs) > 1:
-        # OB1 first, as in a Micro/WIN project
-        pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
-    program = ir.Program(pous, programs[0].file, programs[0].source, shared)
-    if tables[0] is not None:
-        symbols = parse(parse_symbols, tables[0])
-    if tables[1] is not None:
-        data = parse(parse_datablock, tables[1])
-    return program, symbols, data
+    s = str(x)
+    if "\n" not in s and len(s) < 4096:
+        return read_source(s, encoding), s
+    return s, "<string>"
 
 
 def parse_sources(sources: str | Path | Sequence[str | Path], *,
                   encoding: str | None = None) -> ir.Program:
     """Parse one program file or text, or several (their blocks are merged,
     as Micro/WIN keeps OB1 and its subroutines in one project)."""
-    return parse_inputs(sources, encoding=encoding)[0]
+    from ..lang.sources import read_program
+    return read_program(sources, encoding=encoding)[0]
 
 
 def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
@@ -693,8 +645,9 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
-    program, symbols, data = parse_inputs(source, symbols, data, encoding=encoding)
+    from ..lang.sources import read_program
+    program, symbols, data = read_program(source, symbols, data, encoding=encoding)
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 
-__all__ = ["Plc", "load", "parse_inputs", "parse_sources"]
+__all__ = ["Plc", "load", "parse_sources"]

@@ -535,7 +535,7 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
                      cpu: str | None, instrument: bool, encoding: str | None = None) -> Plc:
     """:func:`plcrt.load` for a program that is already parsed: the same
     handling of the symbol table, data block and plant arguments (the tables
-    are decoded alone here; :func:`plcrt.engine.runtime.parse_inputs` decodes
+    are decoded alone here; :func:`plcrt.lang.sources.read_program` decodes
     them together with the program)."""
     from ..engine.runtime import _text_or_path
     from ..lang import parse_datablock, parse_symbols

@@ -296,7 +296,7 @@ def _parsed(sess: _Session, spec: _Spec) -> tuple[Any, Any, Any]:
     version of the files.  The program files and the symbol and data files
     are decoded together, as :func:`plcrt.load` does; tables given as text
     are returned as they are."""
-    from ..engine.runtime import parse_inputs
+    from ..lang.sources import read_program
     assert not isinstance(spec.program, str)
     tables = [x if isinstance(x, Path) else None for x in (spec.symbols, spec.data)]
     key = (tuple((str(p), st.st_mtime_ns, st.st_size) for p, st in
@@ -304,7 +304,7 @@ def _parsed(sess: _Session, spec: _Spec) -> tuple[Any, Any, Any]:
            tuple(t is not None for t in tables), spec.encoding)
     parsed = sess.programs.get(key)
     if parsed is None:
-        parsed = parse_inputs(list(spec.program), *tables, encoding=spec.encoding)
+        parsed = read_program(list(spec.program), *tables, encoding=spec.encoding)
         sess.programs[key] = parsed
     program, symbols, data = parsed
     return (program, symbols if tables[0] else spec.symbols,

@@ -49,8 +49,9 @@ WORKEROUTPUT_KEY = "plcrt_coverage"
 
 MARKER_HELP = (
     "plc(program, *, symbols=None, data=None, plant=None, scan_ms=None, cpu=None, "
-    "watch=(), history=None, max_time=None, encoding=None): the S7-200 STL program (a .awl path or a list of them, "
-    "relative to the test file or the rootdir) that the `plc` fixture loads"
+    "watch=(), history=None, max_time=None, encoding=None): the S7-200 STL program "
+    "(a .awl path or a list of them, relative to the test file or the rootdir) that the "
+    "`plc` fixture loads"
 )
 
 
@@ -386,7 +387,8 @@ def plc(request: pytest.FixtureRequest) -> Harness:
 def plc_factory(request: pytest.FixtureRequest) -> Callable[..., Harness]:
     """``plc_factory("prog.awl", **options) -> Harness``: a fresh harness per
     call, with the marker's options (``symbols``, ``data``, ``plant``,
-    ``scan_ms``, ``cpu``, ``watch``, ``history``).  Paths are relative to
+    ``scan_ms``, ``cpu``, ``watch``, ``history``, ``max_time``,
+    ``encoding``).  Paths are relative to
     the test file, then the rootdir.  Every harness made is in the PLC
     trace and the coverage."""
     node = request.node

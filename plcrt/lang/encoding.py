@@ -25,8 +25,9 @@ say which, so this module decides, in this order (docs/decisions.md,
 
 Several files of one program (its ``.awl`` files, symbol table and data
 block) are decided together by :func:`decode_files`: one encoding that
-decodes all of them cleanly is preferred, so a symbol name reads the same in
-the program and in its table.
+decodes all of them cleanly is preferred, and a reading that has the names
+of the files already decoded (a UTF-8 symbol table) scores more, so a symbol
+name reads the same in the program and in its table.
 
 This module reads and decodes bytes; it does not parse anything.
 """
@@ -111,10 +112,11 @@ def read_decoded(path: str | Path, encoding: str | None = None) -> Decoded:
 def decode_files(paths: Sequence[str | Path], encoding: str | None = None) -> list[Decoded]:
     """Read and decode the files of one program with one encoding where possible.
 
-    Files with a byte-order mark, UTF-16 files and pure-ASCII files are
+    Files with a byte-order mark, UTF-16, pure-ASCII and UTF-8 files are
     decided alone.  The others are decoded with the one encoding that reads
     all of them cleanly and scores best over their text together; only if no
-    encoding reads them all is each decided alone.
+    encoding reads them all is each decided alone.  Either way a reading
+    that has the non-ASCII words of the files decided alone scores more.
     """
     return decode_many([(read_bytes(p), str(p)) for p in paths], encoding)
 
@@ -133,13 +135,17 @@ def decode_many(items: Sequence[tuple[bytes, str]],
             legacy.append(i)
         else:
             fixed[i] = d
+    # the non-ASCII words of the files already decoded (a UTF-8 symbol
+    # table): a reading of the others that has them is the right one
+    context = frozenset(w for d in fixed.values() for w in _words(d.text))
     if len(legacy) > 1:
-        joint = _best_candidate([items[i][0] for i in legacy])
+        joint = _best_candidate([items[i][0] for i in legacy], context)
         if joint is not None:
             codec, confident = joint
             for i in legacy:
                 fixed[i] = Decoded(items[i][0].decode(codec), codec, "detected", confident)
-    return [fixed[i] if i in fixed else decode_bytes(*items[i]) for i in range(len(items))]
+    return [fixed[i] if i in fixed else _detect(*items[i], context)
+            for i in range(len(items))]
 
 
 def decode_bytes(data: bytes, file: str, encoding: str | None = None) -> Decoded:
@@ -154,10 +160,14 @@ def decode_bytes(data: bytes, file: str, encoding: str | None = None) -> Decoded
     codec = resolve_encoding(encoding)
     if codec is not None:
         return _checked(data, file, _strip_bom(data, codec), codec, "given", True)
+    return _detect(data, file, frozenset())
+
+
+def _detect(data: bytes, file: str, context: frozenset[str]) -> Decoded:
     found = _decode_unambiguous(data, file)
     if found is not None:
         return found
-    best = _best_candidate([data])
+    best = _best_candidate([data], context)
     if best is None:
         # Nothing reads it: the most likely intent is UTF-8 with a few bytes
         # from elsewhere pasted in, so point at the first byte UTF-8 rejects.
@@ -297,6 +307,8 @@ CANDIDATES: tuple[tuple[str, str], ...] = (
 
 #: Size of the text scored (non-ASCII lines, evenly spread over the files).
 SAMPLE_BYTES = 16384
+#: Weight of the words a reading shares with the program's other files.
+SHARED = 0.5
 #: Scores this close count as equal.
 TIE = 0.05
 #: A guess is confident when it scores at least this much ...
@@ -310,9 +322,12 @@ _FOLLOWERS = {"œ": "uiUI", "Œ": "uiUI", "ñ": "aeiouáéíóú", "Ñ": "AEIOUa
 _SIGNS = frozenset("°µ€–—„“”‘’‚«»·×²³§©®™…\u00a0№")
 
 
-def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
+def _best_candidate(blobs: Sequence[bytes],
+                    context: frozenset[str] = frozenset()) -> tuple[str, bool] | None:
     """(codec, confident) for the code page that reads every blob cleanly
-    and scores best on their non-ASCII lines together, or None."""
+    and scores best on their non-ASCII lines together, or None.  A reading
+    whose non-ASCII words are among the ``context`` words (those of the
+    program's other, already decoded files) scores up to SHARED more."""
     from charset_normalizer.md import mess_ratio
 
     lines = [line for data in blobs for line in data.splitlines() if not line.isascii()]
@@ -333,6 +348,9 @@ def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
             continue  # reads the same as a preferred code page
         seen.add(text)
         score = _plausibility(text, codec, family) - mess_ratio(text, maximum_threshold=1.0)
+        if context:
+            words = _words(text)
+            score += SHARED * len(words & context) / max(len(words), 1)
         scored.append((score, codec))
     if not scored:
         return None
@@ -346,6 +364,12 @@ def _best_candidate(blobs: Sequence[bytes]) -> tuple[str, bool] | None:
     return codec, confident
 
 
+def _words(text: str) -> set[str]:
+    """The words of ``text`` that have a non-ASCII letter (names, comments)."""
+    return {w for w in _WORD.findall(text) if not w.isascii()}
+
+
+_WORD = re.compile(r"\w+")
 _ALPHABETIC = ("latin", "cyrillic", "greek")
 _RUN = re.compile(r"[^\x00-\x7f]+")
 _ASCII_ALNUM = re.compile(r"[A-Za-z0-9]")

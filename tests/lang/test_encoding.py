@@ -143,6 +143,19 @@ def test_german_program_with_table_and_data_block() -> None:
     assert plc.read("Förderband_Ein") == 1
 
 
+def test_legacy_program_with_a_utf8_table(tmp_path: Path) -> None:
+    """A CP1250 program whose one name alone reads as CP1252 (`Èerpadlo`)
+    is read so that it has the names of its UTF-8 symbol table."""
+    awl, sym = tmp_path / "p.awl", tmp_path / "p.sym"
+    awl.write_bytes((DATA / "cz_table.awl").read_bytes())
+    sym.write_text("Čerpadlo\tI0.0\tčerpadlo\r\n", encoding="utf-8")
+    plc = plcrt.load(awl, symbols=sym)
+    assert plc.program.encoding == "cp1250"
+    plc.write("Čerpadlo", 1)
+    plc.scan()
+    assert plc.read("Q0.0") == 1
+
+
 def test_files_no_one_encoding_reads_are_decoded_alone() -> None:
     """A UTF-8 program with a CP1251 table: each in its own encoding."""
     utf8 = "// Насос\n".encode("utf-8")

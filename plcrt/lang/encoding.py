@@ -316,9 +316,11 @@ CONFIDENT_SCORE = 0.6
 #: ... and at least this much more than the next candidate.
 CONFIDENT_MARGIN = 0.2
 
+#: Letters whose next letter spelling fixes: French œ comes before u or i
+#: (cœur, œil), Spanish ñ before a vowel (señal, año).
+_FOLLOWERS = {"œ": "uiUI", "Œ": "uiUI", "ñ": "aeiouáéíóú", "Ñ": "AEIOUaeiou"}
 #: Typographic signs a comment in a Latin, Cyrillic or Greek code page uses
 #: alone (``80 °C``, ``„Tür“``, ``5 €``, ``№ 3``); others are mojibake-ish.
-_FOLLOWERS = {"œ": "uiUI", "Œ": "uiUI", "ñ": "aeiouáéíóú", "Ñ": "AEIOUaeiou"}
 _SIGNS = frozenset("°µ€–—„“”‘’‚«»·×²³§©®™…\u00a0№")
 
 
@@ -347,6 +349,8 @@ def _best_candidate(blobs: Sequence[bytes],
         if text in seen:
             continue  # reads the same as a preferred code page
         seen.add(text)
+        # charset-normalizer's mess detector: 0 for clean text, more for
+        # mojibake (odd symbol runs, suspicious accents, mixed scripts)
         score = _plausibility(text, codec, family) - mess_ratio(text, maximum_threshold=1.0)
         if context:
             words = _words(text)
@@ -401,23 +405,23 @@ def _plausibility(text: str, codec: str, family: str) -> float:
 def _weight(c: str, family: str, run: int, in_ascii_word: bool, after: str) -> float:
     """How plausible character ``c`` is in text of ``family``.
 
-    ``run`` is the length of the run of non-ASCII characters it is in and
-    ``in_ascii_word`` whether its word also has ASCII letters, ``after``
-    the character that follows it.  The rules
-    follow how each script is written: Latin languages put one or two
-    accented letters inside mostly-ASCII words (``Förderband``, ``élevée``),
-    Cyrillic and Greek words are non-ASCII throughout, Chinese text uses the
-    common hanzi of GB2312 almost exclusively, Japanese mixes kana and the
-    JIS X 0208 kanji.  Misreadings break these patterns: CP1252 read as GBK
-    gives rare hanzi, GBK read as CP1252 gives long runs of accented letters
-    and signs, CP1252 read as CP1251 gives Cyrillic letters inside Latin words.
+    ``run`` is the length of the run of non-ASCII characters it is in,
+    ``in_ascii_word`` whether its word also has ASCII letters, ``after`` the
+    character that follows it.  The rules follow how each script is
+    written: Latin languages put one or two accented letters inside
+    mostly-ASCII words (``Förderband``, ``élevée``), Cyrillic and Greek
+    words are non-ASCII throughout, Chinese text uses the common hanzi of
+    GB2312 almost exclusively, Japanese mixes kana and the JIS X 0208 kanji.
+    Misreadings break these patterns: CP1252 read as GBK gives rare hanzi,
+    GBK read as CP1252 gives long runs of accented letters and signs, CP1252
+    read as CP1251 gives Cyrillic letters inside Latin words.
     """
     cat = unicodedata.category(c)
     if cat[0] == "C":     # controls, private use, unassigned
         return 0.0
     name = unicodedata.name(c, "")
     if cat[0] != "L":
-        if family in ("latin", "cyrillic", "greek"):
+        if family in _ALPHABETIC:
             return 0.9 if c in _SIGNS and run == 1 else 0.1
         # CJK punctuation and full-width forms belong to CJK text
         return 0.8 if ("\u3000" <= c <= "\u303f" or "\uff00" <= c <= "\uffef") else 0.2
@@ -426,8 +430,6 @@ def _weight(c: str, family: str, run: int, in_ascii_word: bool, after: str) -> f
             return 0.1
         if run > 2:
             return 0.25
-        # letters whose neighbour is fixed by spelling: French œ comes
-        # before u or i (cœur, œil), Spanish ñ before a vowel (señal, año)
         follow = _FOLLOWERS.get(c)
         return 1.0 if follow is None or (after and after in follow) else 0.4
     if family in ("cyrillic", "greek"):
@@ -460,7 +462,7 @@ def _weight(c: str, family: str, run: int, in_ascii_word: bool, after: str) -> f
 #: The accented letters of the languages written in each Latin code page.
 #: One language must account for a text's letters: Czech read as CP1252
 #: gives è, ø and š together, which no Western language writes.
-_WESTERN = ("äöüß", "àâæçéèêëîïôœùûüÿ", "áéíóúüñ¡¿", "àèéìíîòóùú", "áâãàçéêíóôõú",
+_WESTERN = ("äöüß", "àâæçéèêëîïôœùûüÿ", "áéíóúüñ", "àèéìíîòóùú", "áâãàçéêíóôõú",
             "éëïóöü", "æøåé", "åäöé")
 LATIN_LANGUAGES: dict[str, tuple[str, ...]] = {
     "cp1252": _WESTERN,

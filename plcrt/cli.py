@@ -116,10 +116,14 @@ def _main(argv: list[str]) -> int:
 
 def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool = True,
                      plant: bool = True) -> None:
-    """The program, symbol table, data, CPU and plant options commands share."""
+    """The program, symbol table, encoding, data, CPU and plant options
+    commands share."""
     p.add_argument("programs", nargs="+", metavar="PROGRAM",
                    help="STL export (.awl); several files are merged into one program")
     p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
+    p.add_argument("--encoding", metavar="NAME",
+                   help="text encoding of the program and table files, e.g. cp1252, gbk, "
+                        "cp1251, cp932, utf-8 (default: detected)")
     if data:
         p.add_argument("--data", metavar="F", help="data block (V memory initial values)")
     if cpu:
@@ -200,7 +204,8 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
-                plant=Path(plant) if plant else None, instrument=instrument)
+                plant=Path(plant) if plant else None, instrument=instrument,
+                encoding=getattr(args, "encoding", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:

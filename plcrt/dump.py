@@ -92,7 +92,8 @@ def _source_lines(plc: Plc) -> dict[str, list[str]]:
     texts: dict[str, list[str]] = {}
     for f in files:
         try:
-            text = read_source(f)
+            # the encoding the program was loaded with, not a new guess
+            text = read_source(f, plc.program.encoding or None)
         except PlcError:
             # A file that vanished since loading: fall back to the text kept
             # in the program, which is right for the first file at least.

@@ -603,36 +603,28 @@ def _system_symbols() -> dict[str, str]:
     return dict(SYSTEM_SYMBOLS)
 
 
-def _text_or_path(x: Any) -> tuple[str, str]:
+def _text_or_path(x: Any, encoding: str | None = None) -> tuple[str, str]:
     """(text, file name) for a path or literal text argument."""
     from ..lang import read_source
     if isinstance(x, Path):
-        return read_source(x), str(x)
+        return read_source(x, encoding), str(x)
     s = str(x)
     if "\n" not in s and len(s) < 4096:
-        return read_source(s), s
+        return read_source(s, encoding), s
     return s, "<string>"
 
 
-def parse_sources(sources: str | Path | Sequence[str | Path]) -> ir.Program:
+def parse_sources(sources: str | Path | Sequence[str | Path], *,
+                  encoding: str | None = None) -> ir.Program:
     """Parse one program file or text, or several (their blocks are merged,
     as Micro/WIN keeps OB1 and its subroutines in one project)."""
-    from ..lang import parse_program
-    items = [sources] if isinstance(sources, (str, Path)) else list(sources)
-    if not items:
-        raise PlcConfigError("no program given")
-    programs = [parse_program(*_text_or_path(x)) for x in items]
-    if len(programs) == 1:
-        return programs[0]
-    pous = tuple(p for prog in programs for p in prog.pous)
-    # OB1 first, as in a Micro/WIN project
-    pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
-    return ir.Program(pous, programs[0].file, programs[0].source)
+    from ..lang.sources import read_program
+    return read_program(sources, encoding=encoding)[0]
 
 
 def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
          data: Any = None, scan_ms: float = 10.0, cpu: str | None = None,
-         **kw: Any) -> Plc:
+         encoding: str | None = None, **kw: Any) -> Plc:
     """Parse, compile and bind a program.
 
     Args:
@@ -642,21 +634,19 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
         data: path or text of a data block, or a parsed one.
         scan_ms: simulated scan time in milliseconds.
         cpu: CPU model name (default CPU 226).
+        encoding: text encoding of the files (``"cp1252"``, ``"gbk"``,
+            ``"utf-8"`` ...); by default it is detected, one for all files
+            where one fits (:mod:`plcrt.lang.encoding`).
 
     Raises:
         PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
     """
-    from ..lang import parse_datablock, parse_symbols
-
     plant = kw.pop("plant", None)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
-    program = parse_sources(source)
-    if isinstance(symbols, (str, Path)):
-        symbols = parse_symbols(*_text_or_path(symbols))
-    if isinstance(data, (str, Path)):
-        data = parse_datablock(*_text_or_path(data))
+    from ..lang.sources import read_program
+    program, symbols, data = read_program(source, symbols, data, encoding=encoding)
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 

@@ -1,8 +1,8 @@
 """The plcrt front end: program, symbol table and data block text to data.
 
 ``parse_program`` reads Micro/WIN STL export text into the IR of
-:mod:`plcrt.lang.ir`; ``read_source`` decodes such files from disk (UTF-8,
-GBK or CP1252); ``parse_symbols`` and ``parse_datablock`` read the symbol
+:mod:`plcrt.lang.ir`; ``read_source`` decodes such files from disk in the
+encoding :mod:`plcrt.lang.encoding` detects; ``parse_symbols`` and ``parse_datablock`` read the symbol
 table and data block files that travel with a program.
 
 Nothing here checks what instructions mean or whether addresses exist; that

@@ -86,6 +86,8 @@ class Program:
     pous: tuple[Pou, ...]
     file: str
     source: str = field(repr=False, default="")
+    #: codec its files were decoded with ("" for text, or files that differ)
+    encoding: str = ""
 
     def instruction_count(self) -> int:
         return sum(len(n.insns) for p in self.pous for n in p.networks)

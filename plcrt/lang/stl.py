@@ -28,6 +28,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from ..errors import DiagnosticSink, PlcSyntaxError, SourceLoc
+from .encoding import read_decoded
 from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl, VarSection
 
 __all__ = ["parse_program", "read_source"]
@@ -41,51 +42,16 @@ _MAX_SYNTAX_ERRORS = 20
 # Reading files
 # --------------------------------------------------------------------------
 
-def read_source(path: str | Path) -> str:
+def read_source(path: str | Path, encoding: str | None = None) -> str:
     """Read a program, symbol or data-block file and return its text.
 
-    Real Micro/WIN exports are written in the Windows ANSI code page, not
-    UTF-8, so the bytes are decoded by trying, in order: UTF-8 (strict, after
-    dropping a UTF-8 byte-order mark), GBK (Chinese Micro/WIN SMART) and
-    CP1252 (western Micro/WIN).  A UTF-16 byte-order mark is honoured too.
-    Raises :class:`PlcSyntaxError` naming the file if it cannot be read.
+    Micro/WIN writes exports in the Windows code page of the PC that made
+    them; :mod:`plcrt.lang.encoding` decides which (``encoding`` overrides
+    the detection).  Raises :class:`PlcSyntaxError` naming the file if it
+    cannot be read or decoded, :class:`PlcConfigError` for an unknown
+    ``encoding``.
     """
-    name = str(path)
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise PlcSyntaxError("cannot read file: no such file",
-                             SourceLoc(name, 1, 1)) from None
-    except IsADirectoryError:
-        raise PlcSyntaxError("cannot read file: it is a directory",
-                             SourceLoc(name, 1, 1)) from None
-    except OSError as exc:
-        reason = exc.strerror or exc.__class__.__name__
-        raise PlcSyntaxError(f"cannot read file: {reason}",
-                             SourceLoc(name, 1, 1)) from None
-    return _decode(data)
-
-
-def _decode(data: bytes) -> str:
-    if data.startswith(b"\xef\xbb\xbf"):
-        data = data[3:]
-    elif data.startswith((b"\xff\xfe", b"\xfe\xff")):
-        # Notepad's "Unicode" save; harmless to support.
-        try:
-            return data.decode("utf-16")
-        except UnicodeDecodeError:
-            pass
-    # GBK accepts most byte pairs, so it must come after strict UTF-8; a
-    # western CP1252 file with two accented letters in a row may still decode
-    # as GBK, which is the price of supporting Chinese exports at all.
-    for encoding in ("utf-8", "gbk"):
-        try:
-            return data.decode(encoding)
-        except UnicodeDecodeError:
-            continue
-    # CP1252 leaves five byte values undefined; replace them rather than fail
-    # so that a comment with a stray byte does not make the program unreadable.
-    return data.decode("cp1252", errors="replace")
+    return read_decoded(path, encoding).text
 
 
 # --------------------------------------------------------------------------

@@ -171,13 +171,15 @@ class Harness:
     def load(cls, program: str | Path | Sequence[str | Path], *, symbols: Any = None,
              data: Any = None, plant: Any = None, scan_ms: float = 10.0,
              cpu: str | None = None, watch: Sequence[str] = (), history: int = 20,
-             instrument: bool = False, max_time: Duration | None = None) -> Harness:
+             instrument: bool = False, max_time: Duration | None = None,
+             encoding: str | None = None) -> Harness:
         """Load a program (paths, STL text, or an already parsed
         :class:`plcrt.lang.ir.Program`) and wrap it.
 
         ``instrument=True`` compiles the network-coverage and breakpoint
         probes in (slightly slower scans).  ``max_time`` limits the simulated
-        time (see :meth:`limit_time`).
+        time (see :meth:`limit_time`).  ``encoding`` is the text encoding of
+        the files (detected by default, as in :func:`plcrt.load`).
         """
         from ..lang import ir
         symbols = Path(symbols) if isinstance(symbols, str) and "\n" not in symbols else symbols
@@ -187,12 +189,13 @@ class Harness:
             # already parsed (the pytest plugin parses each file once per
             # session and compiles it per test)
             plc = _plc_from_parsed(program, symbols=symbols, data=data, plant=plant,
-                                   scan_ms=scan_ms, cpu=cpu, instrument=instrument)
+                                   scan_ms=scan_ms, cpu=cpu, instrument=instrument,
+                                   encoding=encoding)
             return cls(plc, watch=watch, history=history, max_time=max_time)
         if isinstance(program, str) and "\n" not in program:
             program = Path(program)
         plc = load(program, symbols=symbols, data=data, plant=plant,
-                   scan_ms=scan_ms, cpu=cpu, instrument=instrument)
+                   scan_ms=scan_ms, cpu=cpu, instrument=instrument, encoding=encoding)
         return cls(plc, watch=watch, history=history, max_time=max_time)
 
     def __repr__(self) -> str:
@@ -529,18 +532,22 @@ def _release(plc: Plc, addresses: Iterable[str]) -> None:
 
 
 def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,
-                     cpu: str | None, instrument: bool) -> Plc:
+                     cpu: str | None, instrument: bool, encoding: str | None = None) -> Plc:
     """:func:`plcrt.load` for a program that is already parsed: the same
-    handling of the symbol table, data block and plant arguments."""
+    handling of the symbol table, data block and plant arguments (the tables
+    are decoded alone here; :func:`plcrt.lang.sources.read_program` decodes
+    them together with the program)."""
     from ..engine.runtime import _text_or_path
     from ..lang import parse_datablock, parse_symbols
+    from ..lang.encoding import resolve_encoding
+    encoding = resolve_encoding(encoding)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
     if isinstance(symbols, (str, Path)):
-        symbols = parse_symbols(*_text_or_path(symbols))
+        symbols = parse_symbols(*_text_or_path(symbols, encoding))
     if isinstance(data, (str, Path)):
-        data = parse_datablock(*_text_or_path(data))
+        data = parse_datablock(*_text_or_path(data, encoding))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                instrument=instrument)
 

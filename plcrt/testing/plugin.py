@@ -4,7 +4,7 @@ Registered through the ``pytest11`` entry point, so every pytest run in an
 environment where plcrt is installed loads it.  It provides:
 
 * the marker ``@pytest.mark.plc(program, symbols=, data=, plant=, scan_ms=,
-  cpu=, watch=[...], history=)`` naming the program of a test (the closest
+  cpu=, watch=[...], history=, max_time=, encoding=)`` naming the program of a test (the closest
   marker wins: function over class over module ``pytestmark``);
 * the fixture ``plc``: a fresh :class:`~plcrt.testing.Harness` at power-up,
   built from the marker;
@@ -38,7 +38,8 @@ if TYPE_CHECKING:
     from .harness import Harness
 
 #: keyword arguments of the marker and of ``plc_factory``
-OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "max_time")
+OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "max_time",
+           "encoding")
 DEFAULT_SCAN_MS = 10.0
 DEFAULT_HISTORY = 20
 #: name of the JUnit XML property that carries the trace of a failing test
@@ -48,8 +49,9 @@ WORKEROUTPUT_KEY = "plcrt_coverage"
 
 MARKER_HELP = (
     "plc(program, *, symbols=None, data=None, plant=None, scan_ms=None, cpu=None, "
-    "watch=(), history=None, max_time=None): the S7-200 STL program (a .awl path or a list of them, "
-    "relative to the test file or the rootdir) that the `plc` fixture loads"
+    "watch=(), history=None, max_time=None, encoding=None): the S7-200 STL program "
+    "(a .awl path or a list of them, relative to the test file or the rootdir) that the "
+    "`plc` fixture loads"
 )
 
 
@@ -67,10 +69,12 @@ class _Session:
     max_time: float | None
     coverage: bool
     coverage_report: Path | None
-    #: parsed programs: ((path, mtime_ns, size), ...) -> ir.Program.  The IR
-    #: is frozen, so one parse can serve every test; each test still gets
-    #: its own compiled Plc (and so its own memory and power-up state).
-    programs: dict[tuple[tuple[str, int, int], ...], Any] = field(default_factory=dict)
+    #: parsed programs with their tables: (((path, mtime_ns, size), ...),
+    #: which tables, encoding) -> (ir.Program, symbols, data).  The IR is
+    #: frozen and the tables are only read, so one parse can serve every
+    #: test; each test still gets its own compiled Plc (and so its own memory
+    #: and power-up state).
+    programs: dict[Any, tuple[Any, Any, Any]] = field(default_factory=dict)
     #: merged coverage: program key -> coverage_report entry
     store: dict[str, Any] = field(default_factory=dict)
 
@@ -90,6 +94,7 @@ class _Spec:
     watch: tuple[str, ...] = ()
     history: int | None = None
     max_time: float | None = None
+    encoding: str | None = None         #: codec name, None to detect
 
 
 _SESSION = pytest.StashKey[_Session]()
@@ -272,6 +277,14 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
         except PlcConfigError:
             raise PlcUsageError(f"max_time= must be a duration such as 60, '90s' or '5min', "
                                 f"got {max_time!r}") from None
+    encoding = kwargs.get("encoding")
+    if encoding is not None:
+        from ..errors import PlcConfigError
+        from ..lang.encoding import resolve_encoding
+        try:
+            spec.encoding = resolve_encoding(encoding)
+        except PlcConfigError as e:
+            raise PlcUsageError(e.message) from None
     return spec
 
 
@@ -279,16 +292,24 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
 # Building harnesses
 # ---------------------------------------------------------------------------
 
-def _parsed(sess: _Session, files: tuple[Path, ...]) -> Any:
-    """The parsed program of ``files`` (parsed once per session and version)."""
-    from ..engine.runtime import parse_sources
-    key = tuple((str(p), st.st_mtime_ns, st.st_size) for p, st in
-                ((p, p.stat()) for p in files))
-    prog = sess.programs.get(key)
-    if prog is None:
-        prog = parse_sources(list(files))
-        sess.programs[key] = prog
-    return prog
+def _parsed(sess: _Session, spec: _Spec) -> tuple[Any, Any, Any]:
+    """(program, symbols, data) of ``spec``, parsed once per session and
+    version of the files.  The program files and the symbol and data files
+    are decoded together, as :func:`plcrt.load` does; tables given as text
+    are returned as they are."""
+    from ..lang.sources import read_program
+    assert not isinstance(spec.program, str)
+    tables = [x if isinstance(x, Path) else None for x in (spec.symbols, spec.data)]
+    key = (tuple((str(p), st.st_mtime_ns, st.st_size) for p, st in
+                 ((p, p.stat()) for p in (*spec.program, *(t for t in tables if t)))),
+           tuple(t is not None for t in tables), spec.encoding)
+    parsed = sess.programs.get(key)
+    if parsed is None:
+        parsed = read_program(list(spec.program), *tables, encoding=spec.encoding)
+        sess.programs[key] = parsed
+    program, symbols, data = parsed
+    return (program, symbols if tables[0] else spec.symbols,
+            data if tables[1] else spec.data)
 
 
 def _build(sess: _Session, spec: _Spec) -> Harness:
@@ -296,13 +317,17 @@ def _build(sess: _Session, spec: _Spec) -> Harness:
     program without OB1 or a bad ``watch`` address is a PlcUsageError."""
     from ..errors import PlcError
     from .harness import Harness
-    program = spec.program if isinstance(spec.program, str) else _parsed(sess, spec.program)
-    h = Harness.load(program, symbols=spec.symbols, data=spec.data, plant=spec.plant,
+    if isinstance(spec.program, str):
+        program, symbols, data = spec.program, spec.symbols, spec.data
+    else:
+        program, symbols, data = _parsed(sess, spec)
+    h = Harness.load(program, symbols=symbols, data=data, plant=spec.plant,
                      scan_ms=spec.scan_ms if spec.scan_ms is not None else sess.scan_ms,
                      cpu=spec.cpu,
                      history=spec.history if spec.history is not None else sess.history,
                      instrument=sess.coverage,
-                     max_time=spec.max_time if spec.max_time is not None else sess.max_time)
+                     max_time=spec.max_time if spec.max_time is not None else sess.max_time,
+                     encoding=spec.encoding)
     if "OB1" not in h.plc.unit.pous:
         # scans would do nothing, and every assertion on "nothing changes" pass
         raise PlcUsageError(f"{spec.label} has no main program block (OB1), so there is "
@@ -362,7 +387,8 @@ def plc(request: pytest.FixtureRequest) -> Harness:
 def plc_factory(request: pytest.FixtureRequest) -> Callable[..., Harness]:
     """``plc_factory("prog.awl", **options) -> Harness``: a fresh harness per
     call, with the marker's options (``symbols``, ``data``, ``plant``,
-    ``scan_ms``, ``cpu``, ``watch``, ``history``).  Paths are relative to
+    ``scan_ms``, ``cpu``, ``watch``, ``history``, ``max_time``,
+    ``encoding``).  Paths are relative to
     the test file, then the rootdir.  Every harness made is in the PLC
     trace and the coverage."""
     node = request.node

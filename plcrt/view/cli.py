@@ -61,7 +61,7 @@ def cmd_show(args: argparse.Namespace) -> int:
                                       "give the file with OB1 as well")
             program = plc.program
         else:
-            program = parse_sources([Path(p) for p in args.programs])
+            program = parse_sources([Path(p) for p in args.programs], encoding=args.encoding)
         if not program.pous:
             raise PlcConfigError(f"nothing to show: {', '.join(args.programs)} holds no block "
                                  f"(an empty file, or only comments)")

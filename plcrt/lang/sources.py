@@ -1,0 +1,78 @@
+"""Read a program with its symbol table and data block, in one encoding.
+
+:func:`read_program` is what :func:`plcrt.load` and the pytest plugin use to
+turn their ``source``, ``symbols`` and ``data`` arguments (paths, text, or
+already parsed tables) into parsed objects.  The files among them are decoded
+together by :func:`plcrt.lang.encoding.decode_files`, so a symbol name reads
+the same in the program and in its table; a syntax error in a file whose
+encoding was guessed carries a note saying so.
+
+It does not compile anything; that is :mod:`plcrt.compiler`'s job.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+from ..errors import PlcConfigError, PlcError, SourceLoc
+from . import ir
+from .datablock import parse_datablock
+from .encoding import Decoded, decode_files, encoding_note, resolve_encoding
+from .stl import parse_program
+from .symbols import parse_symbols
+
+__all__ = ["is_file_arg", "read_program"]
+
+
+def is_file_arg(x: Any) -> bool:
+    """Whether a program, symbol or data argument names a file (a Path, or
+    a string without a newline) rather than holding the text itself."""
+    return isinstance(x, Path) or (isinstance(x, str) and "\n" not in x and len(x) < 4096)
+
+
+def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
+                 data: Any = None, *, encoding: str | None = None
+                 ) -> tuple[ir.Program, Any, Any]:
+    """(program, symbols, data), parsed.
+
+    ``source`` is a path or program text, or a list of them whose blocks are
+    merged (OB1 first, as Micro/WIN keeps OB1 and its subroutines in one
+    project).  ``symbols`` and ``data`` are a path, text, an already parsed
+    table (returned as it is) or None.  ``encoding`` forces the encoding of
+    every file; by default it is detected.  The program's
+    :attr:`~plcrt.lang.ir.Program.encoding` is the one its files were
+    decoded with.
+    """
+    codec = resolve_encoding(encoding)
+    items = [source] if isinstance(source, (str, Path)) else list(source)
+    if not items:
+        raise PlcConfigError("no program given")
+    tables = [x if isinstance(x, (str, Path)) else None for x in (symbols, data)]
+    files = [x for x in items + tables if x is not None and is_file_arg(x)]
+    decoded = {id(x): d for x, d in zip(files, decode_files(files, codec))}
+    programs = [_parse(parse_program, x, decoded.get(id(x))) for x in items]
+    used = {decoded[id(x)].encoding for x in items if id(x) in decoded}
+    pous = tuple(p for prog in programs for p in prog.pous)
+    if len(programs) > 1:
+        pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
+    program = ir.Program(pous, programs[0].file, programs[0].source,
+                         used.pop() if len(used) == 1 else "")
+    if tables[0] is not None:
+        symbols = _parse(parse_symbols, tables[0], decoded.get(id(tables[0])))
+    if tables[1] is not None:
+        data = _parse(parse_datablock, tables[1], decoded.get(id(tables[1])))
+    return program, symbols, data
+
+
+def _parse(fn: Callable[[str, str], Any], x: Any, decoded: Decoded | None) -> Any:
+    """``fn(text, file name)`` for one argument; a parse error of a file
+    decoded with a guessed encoding gets a note after its first error."""
+    text, name = (decoded.text, str(x)) if decoded is not None else (str(x), "<string>")
+    try:
+        return fn(text, name)
+    except PlcError as e:
+        note = encoding_note(decoded, e.loc or SourceLoc(name, 1, 1))
+        if note is not None:
+            e.diagnostics.append(note)
+        raise

@@ -149,10 +149,10 @@ WATCHDOG = [
 def test_endless_loops_trip_the_watchdog_quickly(label: str, networks: tuple[str, ...]) -> None:
     """An endless loop raises a watchdog PlcRuntimeError, stops the CPU, and does so fast."""
     p = _load(*networks, "LD SM0.0\n= Q0.0")
-    start = time.perf_counter()
+    start = time.process_time()   # CPU time: the machine may be shared
     with pytest.raises(PlcRuntimeError, match="watchdog"):
         p.scan()
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
     assert p.mode == "STOP" and p.mem.areas["PQ"][0] == 0
     p.scan()
     assert p.mode == "STOP"

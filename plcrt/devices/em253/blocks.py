@@ -304,8 +304,8 @@ class PosGotoR(MotionBlock):
             # physically impossible: the pulses are already out
             self.warn(f"the updated PosSet {abs(pos)} is already passed ({sent} pulses of "
                       f"this move are sent): the axis decelerates with DecTime and stops "
-                      f"beyond it", "passed")
-            segs = stop_plan(t, x, v, Fraction(v_ss), rd)
+                      f"beyond it, but not beyond the PosSet it was moving to", "passed")
+            segs = self.bounded_stop(t, x, v, v_ss, rd, self.target, "Update")
         else:
             self.target = Fraction(abs(pos))
             segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)

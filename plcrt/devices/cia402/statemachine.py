@@ -679,6 +679,7 @@ class Drive402:
 
     def _actions(self, n: int, t: float, events: list[Event]) -> list[Action]:
         if n in (4, 16):
+            self.quick_stop, self.at_rest_in_quick_stop = None, False
             return [Action("power-on", "operation enabled: the mode runs (HCFA §7.2)")]
         if n in (5, 8, 9):
             return [Action("power-off", f"transition {n}: the drive function is disabled at "

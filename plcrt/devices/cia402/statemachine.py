@@ -1,13 +1,12 @@
-"""The CiA 402 power state machine of a bus drive, as tables (HCFA §7.2–§7.4).
+"""The CiA 402 power state machine of a bus drive (HCFA §7.2–§7.4, §4.7).
 
-What it is: the eight states, the transitions 0–16 as a data table
-``(state, command) -> (next state, transition, manual §)``, the controlword
-6040h decoded as levels (bits 0–3 and 7; fault reset on the rising edge of
-bit 7 only), the statusword 6041h per state with HCFA's vendor bits and
-per-mode idle values, the quick stop options of 605Ah, the fault reaction with
-the 603Fh codes / alarm numbers of HCFA §4.7, and :class:`Drive402`, which
-applies controlwords and faults and keeps a numbered event log in which every
-command that changes nothing is explained.
+What it is: :class:`Drive402`, which runs the tables of :mod:`.states`
+(transitions 0–16, controlword 6040h decoded as levels with fault reset on the
+rising edge of bit 7, statusword 6041h per state and mode) and of
+:mod:`.reactions` (quick stop per 605Ah, 603Fh faults, the model's
+personality).  It applies controlwords, cycles and faults and keeps a numbered
+event log in which every command that changes nothing is explained with the
+steps it needs and the manual section.  All those tables are re-exported here.
 
 What it is not: it has no clock and no motion.  Time is a number the caller
 passes in and only recorded; a quick stop or a fault reaction is returned as an
@@ -19,358 +18,28 @@ statusword bits (8, 10–15) through :meth:`Drive402.set_mode_bits`.
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, field
-from enum import StrEnum
+from dataclasses import dataclass
 from typing import Literal
 
-from ...errors import PlcConfigError
+from .reactions import (FAULT_CODES, PERSONALITIES, QUICK_STOP_OPTIONS, FaultCode,
+                        Personality, QuickStopPlan, personality, quick_stop_plan)
+from .states import (AUTOMATIC_TRANSITIONS, COMMAND_WORD, HOLDS, IDLE_STATUSWORD,
+                     MODE_BITS_MASK, STATE_MASKS, STATUSWORD, TRANSITION_ROWS, TRANSITIONS,
+                     Cia402Error, Command, State, Transition, decode_controlword,
+                     state_of_statusword)
 
 __all__ = [
-    "State", "Command", "Transition", "TRANSITIONS", "AUTOMATIC_TRANSITIONS",
-    "STATE_MASKS", "STATUSWORD", "IDLE_STATUSWORD", "QUICK_STOP_OPTIONS",
-    "QuickStopPlan", "quick_stop_plan", "FaultCode", "FAULT_CODES",
-    "Personality", "PERSONALITIES", "personality", "decode_controlword",
-    "state_of_statusword", "Action", "Event", "Result", "Drive402",
-    "Cia402Error",
+    # re-exported tables (states, reactions)
+    "State", "Command", "COMMAND_WORD", "Transition", "TRANSITION_ROWS", "TRANSITIONS",
+    "AUTOMATIC_TRANSITIONS", "HOLDS", "STATE_MASKS", "STATUSWORD", "IDLE_STATUSWORD",
+    "MODE_BITS_MASK", "decode_controlword", "state_of_statusword", "Cia402Error",
+    "QuickStopPlan", "QUICK_STOP_OPTIONS", "quick_stop_plan", "FaultCode", "FAULT_CODES",
+    "Personality", "PERSONALITIES", "personality",
+    # the drive
+    "Action", "Event", "Result", "command_path", "Drive402",
 ]
 
-
-class Cia402Error(PlcConfigError):
-    """A value given to the drive model is not one the drive can take."""
-
-
-class State(StrEnum):
-    """The power states (HCFA §7.2 figure 5); values are canopen's names."""
-
-    NOT_READY_TO_SWITCH_ON = "NOT READY TO SWITCH ON"
-    SWITCH_ON_DISABLED = "SWITCH ON DISABLED"
-    READY_TO_SWITCH_ON = "READY TO SWITCH ON"
-    SWITCHED_ON = "SWITCHED ON"
-    OPERATION_ENABLED = "OPERATION ENABLED"
-    QUICK_STOP_ACTIVE = "QUICK STOP ACTIVE"
-    FAULT_REACTION_ACTIVE = "FAULT REACTION ACTIVE"
-    FAULT = "FAULT"
-
-
 S = State
-
-
-class Command(StrEnum):
-    """The device control commands of HCFA §7.4.1 (bits 7 and 3–0)."""
-
-    SHUTDOWN = "Shutdown"
-    SWITCH_ON = "Switch on"            # also "Disable operation" in OE
-    ENABLE_OPERATION = "Enable operation"
-    DISABLE_VOLTAGE = "Disable voltage"
-    QUICK_STOP = "Quick stop"
-    FAULT_RESET = "Fault reset"        # the 0->1 edge of bit 7
-    NONE = "no command"                # bit 7 held at 1: nothing matches
-
-
-#: Typical controlword of each command (HCFA §7.4.1 "6040典型值").
-COMMAND_WORD: dict[Command, int] = {
-    Command.SHUTDOWN: 0x0006, Command.SWITCH_ON: 0x0007,
-    Command.ENABLE_OPERATION: 0x000F, Command.DISABLE_VOLTAGE: 0x0000,
-    Command.QUICK_STOP: 0x0002, Command.FAULT_RESET: 0x0080,
-}
-
-
-def decode_controlword(cw: int, previous: int = 0) -> Command:
-    """The command of controlword *cw* given the *previous* one (§7.4.1).
-
-    Commands are levels except fault reset, the 0->1 edge of bit 7; while bit 7
-    stays 1 no command matches.  Disable voltage is tested first, then quick
-    stop, then the rest (masks of the digest §1.3)."""
-    if not 0 <= cw <= 0xFFFF:
-        raise Cia402Error(f"controlword 6040h = {cw} is not a UINT16 (HCFA §7.4.1)")
-    if cw & 0x80:
-        return Command.FAULT_RESET if not previous & 0x80 else Command.NONE
-    if cw & 0x02 == 0:
-        return Command.DISABLE_VOLTAGE
-    if cw & 0x06 == 0x02:
-        return Command.QUICK_STOP
-    if cw & 0x07 == 0x06:
-        return Command.SHUTDOWN
-    return Command.ENABLE_OPERATION if cw & 0x08 else Command.SWITCH_ON
-
-
-@dataclass(frozen=True, slots=True)
-class Transition:
-    """One row of the HCFA §7.2 transition table."""
-
-    number: int
-    source: State | None          # None: any state (13) or power-on (0)
-    target: State
-    trigger: str                  # the command, or "automatic" / "fault"
-    statusword: int               # the §7.2 statusword after the transition
-    section: str = "HCFA §7.2"
-
-
-def _t(n: int, src: State | None, dst: State, trig: str, sw: int,
-       sec: str = "HCFA §7.2") -> Transition:
-    return Transition(n, src, dst, trig, sw, sec)
-
-
-#: Transitions 0–16, numbered as HCFA §7.2 (and CiA 402).
-TRANSITION_ROWS: dict[int, Transition] = {r.number: r for r in (
-    _t(0, None, S.NOT_READY_TO_SWITCH_ON, "automatic (power-on)", 0x0000),
-    _t(1, S.NOT_READY_TO_SWITCH_ON, S.SWITCH_ON_DISABLED, "automatic", 0x0250),
-    _t(2, S.SWITCH_ON_DISABLED, S.READY_TO_SWITCH_ON, "Shutdown", 0x0231),
-    _t(3, S.READY_TO_SWITCH_ON, S.SWITCHED_ON, "Switch on", 0x0233, "HCFA §7.2, §7.4.1"),
-    _t(4, S.SWITCHED_ON, S.OPERATION_ENABLED, "Enable operation", 0x0237),
-    _t(5, S.OPERATION_ENABLED, S.SWITCHED_ON, "Disable operation", 0x0233),
-    _t(6, S.SWITCHED_ON, S.READY_TO_SWITCH_ON, "Shutdown", 0x0231),
-    _t(7, S.READY_TO_SWITCH_ON, S.SWITCH_ON_DISABLED, "Disable voltage / Quick stop", 0x0250),
-    _t(8, S.OPERATION_ENABLED, S.READY_TO_SWITCH_ON, "Shutdown", 0x0231),
-    _t(9, S.OPERATION_ENABLED, S.SWITCH_ON_DISABLED, "Disable voltage", 0x0250),
-    _t(10, S.SWITCHED_ON, S.SWITCH_ON_DISABLED, "Disable voltage / Quick stop", 0x0250),
-    _t(11, S.OPERATION_ENABLED, S.QUICK_STOP_ACTIVE, "Quick stop", 0x0217),
-    _t(12, S.QUICK_STOP_ACTIVE, S.SWITCH_ON_DISABLED,
-       "automatic once stopped (605Ah 0–4) or Disable voltage", 0x0250),
-    _t(13, None, S.FAULT_REACTION_ACTIVE, "fault", 0x021F, "HCFA §7.2, §4.7"),
-    _t(14, S.FAULT_REACTION_ACTIVE, S.FAULT, "automatic (reaction done)", 0x0218),
-    _t(15, S.FAULT, S.SWITCH_ON_DISABLED, "Fault reset (bit 7 0->1)", 0x0250,
-       "HCFA §7.2, §7.4.1"),
-    _t(16, S.QUICK_STOP_ACTIVE, S.OPERATION_ENABLED, "Enable operation", 0x0237),
-)}
-
-#: The controlword-driven table: (state, command) -> transition number.
-TRANSITIONS: dict[tuple[State, Command], int] = {
-    (S.SWITCH_ON_DISABLED, Command.SHUTDOWN): 2,
-    (S.READY_TO_SWITCH_ON, Command.SWITCH_ON): 3,
-    (S.READY_TO_SWITCH_ON, Command.ENABLE_OPERATION): 3,   # §7.4.1 "3**"
-    (S.SWITCHED_ON, Command.ENABLE_OPERATION): 4,
-    (S.OPERATION_ENABLED, Command.SWITCH_ON): 5,
-    (S.SWITCHED_ON, Command.SHUTDOWN): 6,
-    (S.READY_TO_SWITCH_ON, Command.DISABLE_VOLTAGE): 7,
-    (S.READY_TO_SWITCH_ON, Command.QUICK_STOP): 7,
-    (S.OPERATION_ENABLED, Command.SHUTDOWN): 8,
-    (S.OPERATION_ENABLED, Command.DISABLE_VOLTAGE): 9,
-    (S.SWITCHED_ON, Command.DISABLE_VOLTAGE): 10,
-    (S.SWITCHED_ON, Command.QUICK_STOP): 10,
-    (S.OPERATION_ENABLED, Command.QUICK_STOP): 11,
-    (S.QUICK_STOP_ACTIVE, Command.DISABLE_VOLTAGE): 12,
-    (S.FAULT, Command.FAULT_RESET): 15,
-    (S.QUICK_STOP_ACTIVE, Command.ENABLE_OPERATION): 16,
-}
-
-#: Transitions no controlword triggers (HCFA §7.2 "自然过渡").
-AUTOMATIC_TRANSITIONS = frozenset({0, 1, 12, 13, 14})
-
-#: Commands that keep a state as it is (a held level, not a refusal).
-HOLDS: frozenset[tuple[State, Command]] = frozenset({
-    (S.SWITCH_ON_DISABLED, Command.DISABLE_VOLTAGE),
-    (S.SWITCH_ON_DISABLED, Command.QUICK_STOP),
-    (S.READY_TO_SWITCH_ON, Command.SHUTDOWN),
-    (S.SWITCHED_ON, Command.SWITCH_ON),
-    (S.OPERATION_ENABLED, Command.ENABLE_OPERATION),
-    (S.QUICK_STOP_ACTIVE, Command.QUICK_STOP),
-})
-
-#: Statusword mask and value of each state (HCFA §7.4.2, CiA 402).
-STATE_MASKS: dict[State, tuple[int, int]] = {
-    S.NOT_READY_TO_SWITCH_ON: (0x4F, 0x00), S.SWITCH_ON_DISABLED: (0x4F, 0x40),
-    S.READY_TO_SWITCH_ON: (0x6F, 0x21), S.SWITCHED_ON: (0x6F, 0x23),
-    S.OPERATION_ENABLED: (0x6F, 0x27), S.QUICK_STOP_ACTIVE: (0x6F, 0x07),
-    S.FAULT_REACTION_ACTIVE: (0x4F, 0x0F), S.FAULT: (0x4F, 0x08),
-}
-
-#: Statusword per state with VE (bit 4) and remote (bit 9), HCFA §7.2.
-STATUSWORD: dict[State, int] = {
-    S.NOT_READY_TO_SWITCH_ON: 0x0000, S.SWITCH_ON_DISABLED: 0x0250,
-    S.READY_TO_SWITCH_ON: 0x0231, S.SWITCHED_ON: 0x0233,
-    S.OPERATION_ENABLED: 0x0237, S.QUICK_STOP_ACTIVE: 0x0217,
-    S.FAULT_REACTION_ACTIVE: 0x021F, S.FAULT: 0x0218,
-}
-
-#: The per-mode idle statuswords of HCFA §7.3 (6061h = 1 PP, 3 PV, 6 HM, 8 CSP):
-#: (mode, state) -> 6041h with the axis at rest and nothing started.
-IDLE_STATUSWORD: dict[tuple[int, State], int] = {
-    (1, S.SWITCH_ON_DISABLED): 0x0650, (1, S.READY_TO_SWITCH_ON): 0x0631,
-    (1, S.SWITCHED_ON): 0x0633, (1, S.OPERATION_ENABLED): 0x8637, (1, S.FAULT): 0x0638,
-    (3, S.SWITCH_ON_DISABLED): 0x0650, (3, S.READY_TO_SWITCH_ON): 0x0631,
-    (3, S.SWITCHED_ON): 0x0633, (3, S.OPERATION_ENABLED): 0x0237, (3, S.FAULT): 0x0638,
-    (6, S.SWITCH_ON_DISABLED): 0x0670, (6, S.READY_TO_SWITCH_ON): 0x0631,
-    (6, S.SWITCHED_ON): 0x0633, (6, S.OPERATION_ENABLED): 0x8737, (6, S.FAULT): 0x0638,
-    (8, S.READY_TO_SWITCH_ON): 0x0631, (8, S.SWITCHED_ON): 0x0633,
-    (8, S.OPERATION_ENABLED): 0x1637,
-}
-
-#: Bits the mode layer owns in 6041h (8 and 10–15; HCFA §7.4.2, §7.5, §7.6).
-MODE_BITS_MASK = 0xFD00
-
-
-def state_of_statusword(sw: int) -> State:
-    """The state a statusword shows, by the §7.4.2 masks."""
-    for state, (mask, value) in STATE_MASKS.items():
-        if sw & mask == value:
-            return state
-    raise Cia402Error(f"statusword 6041h = 0x{sw:04X} shows no state of HCFA §7.4.2")
-
-
-# --------------------------------------------------------------------------- quick stop
-
-Ramp = Literal["none", "6084h", "6085h", "current limit", "voltage limit"]
-
-
-@dataclass(frozen=True, slots=True)
-class QuickStopPlan:
-    """What a quick stop with 605Ah = *option* does (CiA 402; digest §1.4)."""
-
-    option: int
-    ramp: Ramp                 # how the axis stops
-    deceleration: int          # P/s², 0 = at once
-    then: State                # SWITCH ON DISABLED (0–4) or QUICK STOP ACTIVE (5–8)
-    explanation: str
-
-
-#: 605Ah option -> (ramp, final state); HCFA §8.3 gives only "0–65535, default 2".
-QUICK_STOP_OPTIONS: dict[int, tuple[Ramp, State]] = {
-    0: ("none", S.SWITCH_ON_DISABLED),
-    1: ("6084h", S.SWITCH_ON_DISABLED), 2: ("6085h", S.SWITCH_ON_DISABLED),
-    3: ("current limit", S.SWITCH_ON_DISABLED), 4: ("voltage limit", S.SWITCH_ON_DISABLED),
-    5: ("6084h", S.QUICK_STOP_ACTIVE), 6: ("6085h", S.QUICK_STOP_ACTIVE),
-    7: ("current limit", S.QUICK_STOP_ACTIVE), 8: ("voltage limit", S.QUICK_STOP_ACTIVE),
-}
-
-
-def quick_stop_plan(option: int, dec_6084: int, dec_6085: int,
-                    limit_as_6085h: bool = True) -> QuickStopPlan:
-    """The stop a quick stop performs for 605Ah = *option* (0–8).
-
-    *limit_as_6085h*: the current/voltage-limit options 3/4/7/8 ramp on 6085h
-    (a stepper has no torque-limited stop).  A ramp whose deceleration is 0 is
-    undefined in the manual (6084h/6085h default 0, HCFA §8.3): the axis stops
-    at once and the plan says so."""
-    if option not in QUICK_STOP_OPTIONS:
-        raise Cia402Error(
-            f"605Ah quick-stop option code = {option} is not one of 0–8 "
-            "(CiA 402; HCFA §8.3 gives no codes): SDO abort 0x06090030")
-    ramp, then = QUICK_STOP_OPTIONS[option]
-    if ramp in ("current limit", "voltage limit") and limit_as_6085h:
-        ramp = "6085h"
-    dec = {"6084h": dec_6084, "6085h": dec_6085}.get(ramp, 0)
-    stay = "then stays in QUICK STOP ACTIVE" if then is S.QUICK_STOP_ACTIVE \
-        else "then goes to SWITCH ON DISABLED (transition 12)"
-    if ramp == "none":
-        why = f"605Ah = {option}: the drive is disabled at once, {stay}"
-    elif ramp in ("6084h", "6085h") and dec == 0:
-        why = (f"605Ah = {option} ramps on {ramp}, but {ramp} = 0 (its default, HCFA "
-               f"§8.3): a ramp at 0 is undefined, so the axis stops at once, {stay}")
-    elif ramp in ("6084h", "6085h"):
-        why = f"605Ah = {option}: ramp to rest on {ramp} = {dec} P/s², {stay}"
-    else:
-        why = f"605Ah = {option}: stop at the {ramp}, {stay}"
-    return QuickStopPlan(option, ramp, dec, then, why)
-
-
-# --------------------------------------------------------------------------- faults
-
-@dataclass(frozen=True, slots=True)
-class FaultCode:
-    """One 603Fh error code (HCFA §4.7 table, or a CiA 402 code)."""
-
-    code: int                    # 603Fh value
-    alarm: int | None            # the drive's alarm number (HCFA: = 603Fh)
-    name: str
-    resettable: bool             # False: power cycle only ("否")
-    section: str
-    led_blinks: int | None = None  # red LED blinks, HCFA §4.6
-
-
-def _f(code: int, name: str, reset: bool, sec: str = "HCFA §4.7",
-       blinks: int | None = None, alarm: bool = True) -> FaultCode:
-    return FaultCode(code, code if alarm else None, name, reset, sec, blinks)
-
-
-#: 603Fh codes the model can raise, keyed by code.  HCFA's alarm numbers are
-#: the 603Fh values themselves (§4.7 "故障编号 (603F)").
-FAULT_CODES: dict[int, FaultCode] = {f.code: f for f in (
-    _f(4, "parameter storage fault", False),
-    _f(17, "EtherCAT communication fault", False),
-    _f(8, "motor phase loss", False),
-    _f(20640, "op-amp fault (current sampling)", False, blinks=9),
-    _f(20704, "over-current", False, blinks=1),
-    _f(12828, "under-voltage", False, blinks=3),
-    _f(12827, "over-voltage", True, blinks=2),
-    _f(10256, "encoder deviation", True, blinks=7),
-    _f(83, "parameter change needs a power cycle", True),
-    _f(62, "invalid homing method", True),
-    _f(63, "homing timeout", True),
-    _f(35, "PDO mapping error", True),
-    _f(70, "SYNC0 error", True),
-    _f(71, "severe synchronisation error", True),
-    # Standard CiA 402 codes for faults HCFA numbers nowhere (not from the seeds).
-    _f(0x8611, "following error (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
-    _f(0x7305, "incremental sensor 1 fault (CiA 402, not in the seeds)", True,
-       "CiA 402", alarm=False),
-    _f(0x5441, "E-stop input (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
-)}
-
-
-# --------------------------------------------------------------------------- personality
-
-@dataclass(frozen=True, slots=True)
-class Personality:
-    """Where a drive model departs from the HCFA tables or the standard.
-
-    Each field is paired with ``sources`` naming where its value comes from."""
-
-    model: str
-    bit15: Literal["can-trigger", "reference-found"]
-    transition_16_options: frozenset[int]   # 605Ah values that allow QSA -> OE
-    auto_qsa_to_sod_options: frozenset[int]  # 605Ah values ending in transition 12
-    enable_from_ready: Literal["two-step", "through"]
-    limit_stops_as_6085h: bool
-    idle_statuswords: bool                  # use the HCFA §7.3 per-mode idle table
-    default_quick_stop_option: int
-    sources: dict[str, str] = field(default_factory=dict)
-
-
-PERSONALITIES: dict[str, Personality] = {
-    "hcfa-am0520b": Personality(
-        model="hcfa-am0520b", bit15="can-trigger",
-        transition_16_options=frozenset({5, 6, 7, 8}),
-        auto_qsa_to_sod_options=frozenset({0, 1, 2, 3, 4}),
-        enable_from_ready="two-step", limit_stops_as_6085h=True,
-        idle_statuswords=True, default_quick_stop_option=2,
-        sources={
-            "bit15": "HCFA §7.5.3 / §7.5.4: bit 15 = a move or homing can be triggered",
-            "transition_16_options": "HCFA §7.2 row 16 lists QSA->OE; allowed only for "
-                                     "605Ah 5–8 as CiA 402-2 (digest §1.3 rule 3)",
-            "auto_qsa_to_sod_options": "HCFA §7.2 row 12 (automatic); CiA 402 codes 0–4",
-            "enable_from_ready": "HCFA §7.4.1 footnote **: 0x000F in READY TO SWITCH ON "
-                                 "gives Switched on (3); 4 follows at the next evaluation",
-            "limit_stops_as_6085h": "a stepper has no torque-limited stop (digest §1.4)",
-            "idle_statuswords": "HCFA §7.3 per-mode table",
-            "default_quick_stop_option": "HCFA §8.3: 605Ah default 2",
-        }),
-    "kinco-servo": Personality(
-        model="kinco-servo", bit15="reference-found",
-        transition_16_options=frozenset({5, 6, 7, 8}),
-        auto_qsa_to_sod_options=frozenset({0, 1, 2, 3, 4}),
-        enable_from_ready="through", limit_stops_as_6085h=False,
-        idle_statuswords=False, default_quick_stop_option=2,
-        sources={
-            "bit15": "Kinco §2.6: bit 15 Reference_Found, stays set once homed",
-            "transition_16_options": "CiA 402-2 (Kinco seed silent)",
-            "auto_qsa_to_sod_options": "CiA 402-2 (Kinco seed silent)",
-            "enable_from_ready": "CiA 402-2: 3 then 4 in one evaluation (Kinco seed silent)",
-            "limit_stops_as_6085h": "a servo stops at its current limit (CiA 402)",
-            "idle_statuswords": "Kinco §2.6 gives the bits only, no per-mode values",
-            "default_quick_stop_option": "CiA 402 default 2 (Kinco seed silent)",
-        }),
-}
-
-
-def personality(model: str) -> Personality:
-    """The personality of drive *model*; an unknown model is a located error."""
-    try:
-        return PERSONALITIES[model]
-    except KeyError:
-        raise Cia402Error(f"unknown CiA 402 drive model {model!r}; known: "
-                          + ", ".join(sorted(PERSONALITIES))) from None
-
 
 # --------------------------------------------------------------------------- the drive
 

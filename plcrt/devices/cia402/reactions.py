@@ -50,18 +50,22 @@ QUICK_STOP_OPTIONS: dict[int, tuple[Ramp, State]] = {
 
 
 def quick_stop_plan(option: int, dec_6084: int, dec_6085: int,
-                    limit_as_6085h: bool = True) -> QuickStopPlan:
+                    limit_as_6085h: bool = True,
+                    to_sod: frozenset[int] = frozenset({0, 1, 2, 3, 4})) -> QuickStopPlan:
     """The stop a quick stop performs for 605Ah = *option* (0–8).
 
     *limit_as_6085h*: the current/voltage-limit options 3/4/7/8 ramp on 6085h
     (a stepper has no torque-limited stop).  A ramp whose deceleration is 0 is
     undefined in the manual (6084h/6085h default 0, HCFA §8.3): the axis stops
-    at once and the plan says so."""
+    at once and the plan says so.  *to_sod*: the options after which the drive
+    goes on to SWITCH ON DISABLED by itself (transition 12); the others stay in
+    QUICK STOP ACTIVE."""
     if option not in QUICK_STOP_OPTIONS:
         raise Cia402Error(
             f"605Ah quick-stop option code = {option} is not one of 0–8 "
             "(CiA 402; HCFA §8.3 gives no codes): SDO abort 0x06090030")
-    ramp, then = QUICK_STOP_OPTIONS[option]
+    ramp, _ = QUICK_STOP_OPTIONS[option]
+    then = S.SWITCH_ON_DISABLED if option in to_sod else S.QUICK_STOP_ACTIVE
     if ramp in ("current limit", "voltage limit") and limit_as_6085h:
         ramp = "6085h"
     dec = {"6084h": dec_6084, "6085h": dec_6085}.get(ramp, 0)

@@ -144,7 +144,7 @@ class Drive402:
         self.state = S.NOT_READY_TO_SWITCH_ON
         self.controlword = 0
         self.log: list[Event] = []
-        self.quick_stop_option = self.personality.default_quick_stop_option
+        self._quick_stop_option = self.personality.default_quick_stop_option
         self.dec_6084 = 0
         self.dec_6085 = 0
         self.mode = mode
@@ -160,6 +160,19 @@ class Drive402:
         self._mode_bits: int | None = None
         if power_on:
             self.power_on(t)
+
+    @property
+    def quick_stop_option(self) -> int:
+        """605Ah, the quick-stop option code (0–8)."""
+        return self._quick_stop_option
+
+    @quick_stop_option.setter
+    def quick_stop_option(self, option: int) -> None:
+        if option not in QUICK_STOP_OPTIONS:
+            raise Cia402Error(
+                f"605Ah quick-stop option code = {option} is not one of 0–8 "
+                "(CiA 402; HCFA §8.3 gives no codes): SDO abort 0x06090030")
+        self._quick_stop_option = option
 
     # ---------------------------------------------------------------- statusword
     @property
@@ -265,6 +278,7 @@ class Drive402:
             ev = self._log(None, source, t, self.state, self.statusword, fc.section,
                            f"already in {self.state}; 603Fh now reads {code}")
             return self._result(None, [ev], [], f"already in {self.state}: 603Fh = {code}")
+        self.quick_stop, self.at_rest_in_quick_stop = None, False
         ev = self._enter(13, source, t)
         act = Action("fault-reaction", f"{fc.name}: the axis is switched off ({fc.section}; "
                      "605Eh is not in the manual, the reaction lasts one drive cycle)")
@@ -357,8 +371,9 @@ class Drive402:
             self.quick_stop, self.at_rest_in_quick_stop = None, False
             return [Action("power-off", "quick stop ended: SWITCH ON DISABLED (HCFA §7.2)")]
         if n == 11:
+            p = self.personality
             plan = quick_stop_plan(self.quick_stop_option, self.dec_6084, self.dec_6085,
-                                   self.personality.limit_stops_as_6085h)
+                                   p.limit_stops_as_6085h, p.auto_qsa_to_sod_options)
             self.quick_stop, self.at_rest_in_quick_stop = plan, False
             acts = [Action("quick-stop", plan.explanation, plan)]
             if plan.ramp == "none" or plan.deceleration == 0 and plan.ramp in ("6084h", "6085h"):

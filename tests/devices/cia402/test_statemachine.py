@@ -438,3 +438,36 @@ def test_any_sequence_keeps_statusword_and_log_consistent(model, option, dec, mo
         assert row.source in (None, ev.before) or ev.transition == 0
         if ev.transition == 16:
             assert option in (5, 6, 7, 8)
+
+
+def test_605A_out_of_range_is_refused_when_set():
+    """An option outside 0–8 never reaches a quick stop: setting it is an error."""
+    d = reach(S.OPERATION_ENABLED)
+    with pytest.raises(PlcError, match="0x06090030"):
+        d.quick_stop_option = 9
+    assert d.quick_stop_option == 2
+
+
+def test_fault_during_quick_stop_drops_the_plan():
+    d = reach(S.QUICK_STOP_ACTIVE, qs_option=2, dec=1000)
+    d.raise_fault(62, 62, "x", 1.0)
+    assert d.quick_stop is None
+    assert d.motion_stopped(2.0).transitions == ()
+
+
+def test_options_ending_in_sod_come_from_the_personality():
+    assert quick_stop_plan(5, 1, 1, True, frozenset({5})).then is S.SWITCH_ON_DISABLED
+    assert quick_stop_plan(2, 1, 1, True, frozenset()).then is S.QUICK_STOP_ACTIVE
+
+
+@pytest.mark.parametrize("mode", [None, 1, 3, 6, 8])
+def test_hcfa_enable_example_7_4_4(mode):
+    """§7.4.4: write 0, 6, 7, 15 and test 0x250, 0x231, 0x233; the last check
+    (sw & 0x237 == 0x1237) is a typo that no statusword can pass, while the
+    strict state test (0x6F / 0x27) does."""
+    d = Drive402(mode=mode)
+    for cw, mask in ((0, 0x250), (6, 0x231), (7, 0x233)):
+        d.apply_controlword(cw, 0.0)
+        assert d.statusword & mask == mask
+    d.apply_controlword(15, 0.0)
+    assert d.statusword & 0x237 != 0x1237 and d.statusword & 0x6F == 0x27

@@ -179,10 +179,15 @@ class PdoConfig:
 
     def write(self, index: int, sub: int, value: int) -> WriteResult:
         """One SDO download; the abort code names the broken rule."""
-        where = f"{index:04X}h:{sub:02X} = 0x{value:X}"
+        where = f"{index:04X}h:{sub:02X} = {value:#x}"
         bad = self._check_object(index, sub, raise_=False)
         if bad:
             return self._abort(bad, where, "HCFA §6.7.2, §6.7.3")
+        limit = 0xFF if sub == 0 else (0xFFFFFFFF if index not in ASSIGN else 0xFFFF)
+        if not 0 <= value <= limit:
+            return self._abort(0x06090030, where, f"{index:04X}h:{sub:02X} is a "
+                               f"{'USINT' if sub == 0 else 'UDINT' if limit > 0xFFFF else 'UINT'}"
+                               " (HCFA §3.1)")
         state = self.state()
         if state is not EsmState.PREOP:
             return self._abort(0x08000022, where, f"PDO mapping is written in PRE-OP only, the "

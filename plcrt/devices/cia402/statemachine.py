@@ -70,6 +70,7 @@ class Event:
     sw_after: int
     section: str
     note: str = ""
+    command: Command | None = None   # the decoded controlword, if one caused it
 
     def __str__(self) -> str:
         what = f"transition {self.transition}" if self.transition is not None else "no transition"
@@ -297,11 +298,12 @@ class Drive402:
         n = TRANSITIONS.get((state, cmd))
         refusal = self._guard(state, cmd, n)
         if refusal is None and n is not None:
-            events.append(self._enter(n, source, t))
+            events.append(self._enter(n, source, t, cmd=cmd))
             actions += self._actions(n, t, events)
             if n == 3 and cmd is Command.ENABLE_OPERATION \
                     and self.personality.enable_from_ready == "through":
-                events.append(self._enter(4, source, t, "CiA 402: Enable operation goes on"))
+                events.append(self._enter(4, source, t, "CiA 402: Enable operation goes on",
+                                          cmd=cmd))
                 actions += self._actions(4, t, events)
         elif (state, cmd) in HOLDS:
             explanation = f"{cmd} holds {state} (HCFA §7.4.1)"
@@ -309,7 +311,7 @@ class Drive402:
             explanation = refusal or self._explain(state, cmd)
             if log_refusal:
                 events.append(self._log(None, source, t, state, self.statusword,
-                                        "HCFA §7.2, §7.4.1", explanation))
+                                        "HCFA §7.2, §7.4.1", explanation, cmd))
         if self.state is S.FAULT_REACTION_ACTIVE and state is S.FAULT_REACTION_ACTIVE:
             events.append(self._enter(14, "fault reaction done", t))
         return self._result(cmd, events, actions, explanation)
@@ -397,19 +399,20 @@ class Drive402:
                           self.state, sw, "CiA 402 605Ah 5–8",
                           "stays in QUICK STOP ACTIVE; bit 10 set")]
 
-    def _enter(self, n: int, source: str, t: float, note: str = "") -> Event:
+    def _enter(self, n: int, source: str, t: float, note: str = "",
+               cmd: Command | None = None) -> Event:
         row = TRANSITION_ROWS[n]
         before, sw_before = self.state, self.statusword
         if row.source is not None and row.source is not before:
             raise AssertionError(f"transition {n} from {before}")
         self.state = row.target
         self._mode_bits = None
-        return self._log(n, source, t, before, sw_before, row.section, note)
+        return self._log(n, source, t, before, sw_before, row.section, note, cmd)
 
     def _log(self, n: int | None, source: str, t: float, before: State, sw_before: int,
-             section: str, note: str = "") -> Event:
+             section: str, note: str = "", cmd: Command | None = None) -> Event:
         ev = Event(len(self.log) + 1, t, n, source, before, self.state, sw_before,
-                   self.statusword, section, note)
+                   self.statusword, section, note, cmd)
         self.log.append(ev)
         return ev
 

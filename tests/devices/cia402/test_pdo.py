@@ -281,3 +281,10 @@ def test_pack_unpack_round_trip(rows):
     image = pack(entries, values)
     assert len(image) == sum(b for _, b, _, _ in rows) // 8
     assert unpack(entries, image, frozenset(signed)) == values
+
+
+@pytest.mark.parametrize("index,sub,value", [(0x1600, 0, -1), (0x1600, 0, 256),
+                                             (0x1600, 1, 1 << 32), (0x1C12, 1, 0x10000)])
+def test_values_outside_the_object_type_are_0x06090030(index, sub, value):
+    cfg, _ = make()
+    assert cfg.write(index, sub, value).abort == 0x06090030

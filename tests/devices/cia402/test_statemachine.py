@@ -433,6 +433,10 @@ def test_any_sequence_keeps_statusword_and_log_consistent(model, option, dec, mo
         if ev.transition is None:
             assert ev.before is ev.after
             continue
+        if ev.command is not None:
+            assert TRANSITIONS[(ev.before, ev.command)] == ev.transition
+        else:
+            assert ev.transition in AUTOMATIC_TRANSITIONS
         row = TRANSITION_ROWS[ev.transition]
         assert row.target is ev.after
         assert row.source in (None, ev.before) or ev.transition == 0
@@ -471,3 +475,23 @@ def test_hcfa_enable_example_7_4_4(mode):
         assert d.statusword & mask == mask
     d.apply_controlword(15, 0.0)
     assert d.statusword & 0x237 != 0x1237 and d.statusword & 0x6F == 0x27
+
+
+def test_drive_command_leaves_the_held_controlword_alone():
+    """The bus leaving OP takes the drive to SOD (9) on its own account; the
+    master's held 0x000F then needs 0x0006 first and does not re-enable."""
+    d = reach(S.OPERATION_ENABLED)
+    r = d.command(Command.DISABLE_VOLTAGE, 1.0, "ESM left OP")
+    assert r.transitions == (9,) and d.controlword == 0x000F
+    assert d.log[-1].source == "ESM left OP"
+    r = d.cycle(1.1)
+    assert r.transitions == () and d.state is S.SWITCH_ON_DISABLED
+    assert "first 0x0006 Shutdown (2)" in r.explanation
+
+
+def test_event_log_text_names_transition_source_and_statuswords():
+    d = reach(S.SWITCH_ON_DISABLED)
+    d.apply_controlword(6, 2.5)
+    assert str(d.log[-1]) == ("#3 t=2.5s transition 2 (6040h = 0x0006): SWITCH ON DISABLED -> "
+                              "READY TO SWITCH ON, 6041h 0x0250 -> 0x0231 [HCFA §7.2]")
+    assert d.log[-1].command is Command.SHUTDOWN

@@ -133,6 +133,9 @@ class Esm:
 
     def request(self, state: EsmState | int, t: float = 0.0, ack: bool = False) -> AlResult:
         """Write AL Control with the requested *state* (and the ack bit)."""
+        if not 0 <= int(state) <= 0x0F:
+            raise Cia402Error(f"requested AL state {int(state)} does not fit AL Control "
+                              "bits 0–3 (ETG.1000.6)")
         return self.write_al_control(int(state) | (0x10 if ack else 0), t)
 
     def write_al_control(self, value: int, t: float = 0.0) -> AlResult:

@@ -148,6 +148,8 @@ def test_al_code_table_is_the_digest_table():
 def test_al_control_out_of_range_is_an_error():
     with pytest.raises(PlcError, match="AL Control"):
         esm_in(E.INIT).write_al_control(0x10000)
+    with pytest.raises(PlcError, match="bits 0–3"):
+        esm_in(E.INIT).request(16)
 
 
 @settings(max_examples=200, deadline=None)

@@ -308,7 +308,7 @@ class Drive402:
         elif (state, cmd) in HOLDS:
             explanation = f"{cmd} holds {state} (HCFA §7.4.1)"
         else:
-            explanation = refusal or self._explain(state, cmd)
+            explanation = refusal or self._explain(state, cmd, source)
             if log_refusal:
                 events.append(self._log(None, source, t, state, self.statusword,
                                         "HCFA §7.2, §7.4.1", explanation, cmd))
@@ -332,9 +332,8 @@ class Drive402:
                     "once at rest (12); then 0x0006, 0x0007, 0x000F")
         return None
 
-    def _explain(self, state: State, cmd: Command) -> str:
-        cw = COMMAND_WORD.get(cmd)
-        what = f"{cmd} (0x{cw:04X})" if cw is not None else str(cmd)
+    def _explain(self, state: State, cmd: Command, source: str) -> str:
+        what = f"{cmd} ({source})"
         if cmd is Command.NONE:
             return ("no command: bit 7 (fault reset) is held at 1 and only its 0->1 edge acts; "
                     "no other command matches until it returns to 0 (HCFA §7.4.1)")
@@ -350,8 +349,15 @@ class Drive402:
         if state is S.FAULT:
             rest = command_path(S.SWITCH_ON_DISABLED, _COMMAND_GOAL[cmd])
             then = f", then {_steps(rest)}" if rest else ""
+            fc = self.fault
+            if fc is not None and not fc.resettable:
+                return (f"{what} refused in FAULT (603Fh = {fc.code}, {fc.name}): only a power "
+                        f"cycle clears it ({fc.section}: reset '否'){then}")
+            cause = (f"once its cause is gone ({self.fault_why}), "
+                     if fc is not None and self.fault_cause_active else "")
             return (f"{what} refused in FAULT (603Fh = {self.error_code}): FAULT is left only "
-                    f"by a 0->1 edge of bit 7, 0x0080 Fault reset (15){then} (HCFA §7.2, §7.4.1)")
+                    f"{cause}by a 0->1 edge of bit 7, 0x0080 Fault reset (15){then} "
+                    "(HCFA §7.2, §7.4.1)")
         if state is S.QUICK_STOP_ACTIVE:
             rest = command_path(S.SWITCH_ON_DISABLED, _COMMAND_GOAL[cmd])
             return (f"{what} refused in QUICK STOP ACTIVE: it is left by 0x0000 Disable voltage "

@@ -495,3 +495,15 @@ def test_event_log_text_names_transition_source_and_statuswords():
     assert str(d.log[-1]) == ("#3 t=2.5s transition 2 (6040h = 0x0006): SWITCH ON DISABLED -> "
                               "READY TO SWITCH ON, 6041h 0x0250 -> 0x0231 [HCFA §7.2]")
     assert d.log[-1].command is Command.SHUTDOWN
+
+
+def test_refusal_in_fault_says_when_only_a_power_cycle_helps():
+    d = reach(S.SWITCHED_ON)
+    d.raise_fault(4, 4, "EEPROM", 0.0)
+    d.cycle(0.1)
+    r = d.apply_controlword(0x0F, 1.0)
+    assert "only a power cycle clears it" in r.explanation and "§4.7" in r.explanation
+    d = reach(S.SWITCHED_ON)
+    d.raise_fault(12827, 12827, "bus at 160 V", 0.0, cause_active=True)
+    d.cycle(0.1)
+    assert "once its cause is gone (bus at 160 V)" in d.apply_controlword(6, 1.0).explanation

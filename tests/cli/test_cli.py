@@ -266,13 +266,24 @@ def test_run_compile_error_json(tmp_path: Path, capsys: pytest.CaptureFixture[st
     (["--set", "VB99999=1"], "VB99999"),
     (["--watch", "XQ9"], "not an address"),
     (["--watch", "VW0:REAL"], "double word"),
-    (["--watch", "VW0:BCD"], "unknown format ':BCD'"),
+    (["--watch", "VW0:BCD"], "--watch VW0:BCD: unknown suffix ':BCD' (:REAL reads"),
     (["--scan-ms", "0"], "scan time"),
     (["--scans", "-1"], "must not be negative"),
     # used to set the bit to 1 silently
     (["--set", "I0.0=5"], "--set I0.0=5: I0.0: a bit takes 0 or 1, got 5"),
     # used to end in "internal error: OverflowError"
-    (["--set", "VD0=-1e39"], "--set VD0=-1e39: VD0: -1e+39 is out of the range of a REAL"),
+    (["--set", "VD0=-1e39"], "--set VD0=-1e39: -1e39 is out of the range of a REAL"),
+    # used to store infinity, while 3.5e38 was refused
+    (["--set", "VD0=1e999"], "--set VD0=1e999: 1e999 is out of the range of a REAL"),
+    # used to store 255: the S7-200 byte is unsigned
+    (["--set", "VB0=-1"], "--set VB0=-1: VB0: -1 does not fit in a byte (BYTE), which takes "
+                          "0 to 255; an S7-200 byte is unsigned"),
+    # used to be ignored silently: the CPU rewrites SMB0 at every scan
+    (["--set", "SM0.0=0"], "--set SM0.0=0: SM0.0: SMB0 (SM0.0 always on"),
+    (["--set", "SMB0=1"], "is set by the CPU at the start of every scan"),
+    # used to end in "internal error: ValueError" (more digits than int() converts)
+    (["--set", "VW0=" + "9" * 5000], "too long for a number"),
+    (["--set", "VW0=99999999999999999999"], "99999999999999999999 does not fit in a word"),
 ])
 def test_run_bad_options(args: list[str], message: str,
                          capsys: pytest.CaptureFixture[str]) -> None:
@@ -311,11 +322,24 @@ def test_parse_value(text: str, value: float) -> None:
     assert type(result) is type(value)
 
 
-@pytest.mark.parametrize("text", ["", "abc", "16#", "16#XYZ", "2#102", "nan", "inf", "1.2.3",
-                                  "0x10", "1e"])
+@pytest.mark.parametrize("text", ["", "abc", "16#", "16#XYZ", "2#102", "nanx", "infinit",
+                                  "1.2.3", "0x10", "1e", "1e999", "-3.5e38", "9" * 65])
 def test_parse_value_rejects(text: str) -> None:
     with pytest.raises(PlcConfigError):
         parse_value(text)
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ("NaN", "nan"), ("nan", "nan"), ("Infinity", "inf"), ("-Infinity", "-inf"),
+    ("inf", "inf"), ("-INF", "-inf"), ("+Infinity", "inf"),
+])
+def test_parse_value_non_finite_reals(text: str, expected: str) -> None:
+    """NaN and the infinities are written as JSON output writes them (and as
+    the API stores a float('nan')); a finite literal beyond the REAL range
+    is refused instead of becoming infinity."""
+    result = parse_value(text)
+    assert isinstance(result, float)
+    assert repr(result) == expected
 
 
 # ---------------------------------------------------------------------------

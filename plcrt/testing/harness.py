@@ -25,7 +25,7 @@ from typing import Any, Union
 
 from ..devices import AxisState
 from ..engine.runtime import Plc, load
-from ..engine.values import Duration, parse_number, scan_number
+from ..engine.values import Duration, check_address, parse_number, scan_number
 from ..engine.values import duration as parse_duration
 from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
 
@@ -111,6 +111,13 @@ class Harness:
 
     def __init__(self, plc: Plc, *, watch: Sequence[str] = (), history: int = 20,
                  name: str = "", max_time: Duration | None = None) -> None:
+        if not isinstance(plc, Plc):
+            raise PlcConfigError(f"Harness() wraps a plcrt.Plc (or use Harness.load(program, "
+                                 f"...)), got {type(plc).__name__}")
+        if isinstance(watch, str) or not isinstance(watch, (list, tuple)):
+            raise PlcConfigError(f"watch is a list of addresses such as ['Q0.0', 'VW10'], "
+                                 f"got {type(watch).__name__} {watch!r:.40}")
+        history = scan_number(history, "history (a number of scans)")
         self.plc = plc
         self.name = name or str(plc.program.file)
         self.history: deque[tuple[int, float, tuple[Value, ...]]] = deque(maxlen=max(1, history))
@@ -349,7 +356,7 @@ class Harness:
 
     def pulse(self, address: str, scans: int = 1, value: Value = 1) -> Harness:
         """Set ``address`` to ``value`` for ``scans`` scans, then back."""
-        return self.patch({address: value}, scans)
+        return self.patch({check_address(address): value}, scans)
 
     def force(self, address: str, value: Value) -> _Forced:
         """Force an address until :meth:`unforce` (or the end of a ``with``).
@@ -387,6 +394,9 @@ class Harness:
         its inputs).  After the last row the PLC runs on to ``until`` if it
         is given.
         """
+        if not isinstance(table, Iterable) or isinstance(table, (str, bytes, Mapping)):
+            raise PlcConfigError(f"a stimulus is a list of (time, address, value) rows, got "
+                                 f"{type(table).__name__}")
         rows = []
         for i, row in enumerate(table):
             try:
@@ -421,9 +431,9 @@ class Harness:
         """The whole PLC state now (memory, timers, devices, time)."""
         return self.plc.snapshot()
 
-    def restore(self, snap: Plc) -> Harness:
+    def restore(self, snapshot: Plc) -> Harness:
         """Go back to a :meth:`snapshot`."""
-        self.plc.restore(snap)
+        self.plc.restore(snapshot)
         return self
 
     def fork(self) -> Harness:
@@ -466,6 +476,7 @@ class Harness:
         """Assert a move that is running (or about to start within a few
         scans) ends within ``limit`` simulated seconds; returns its time."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        seconds(limit)   # a bad limit is reported before anything runs
         t0 = self.time
         if not self.axis(slot, axis).moving:
             self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))

@@ -175,6 +175,31 @@ def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert isinstance(values["VD20:REAL"], float)
 
 
+def _strict_json(text: str) -> object:
+    """json.loads that refuses the NaN/Infinity tokens Python's json writes by default."""
+    def refuse(token: str) -> object:
+        raise AssertionError(f"non-standard JSON token {token}")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_run_json_is_strict_and_spells_non_finite_reals(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """NaN and the infinities are the strings "NaN", "Infinity", "-Infinity"
+    (JSON has no token for them), and --set takes the same spellings back."""
+    watches = ["--watch", "VD0:REAL", "--watch", "VD4:REAL", "--watch", "VD8:REAL",
+               "--watch", "VD12:REAL"]
+    sets = ["--set", "VD0=NaN", "--set", "VD4=Infinity", "--set", "VD8=-Infinity",
+            "--set", "VD12=1.5"]
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", "--json", *sets, *watches)
+    assert code == 0, err
+    assert _strict_json(out)["values"] == {  # type: ignore[index]
+        "VD0:REAL": "NaN", "VD4:REAL": "Infinity", "VD8:REAL": "-Infinity", "VD12:REAL": 1.5}
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", *sets, *watches)
+    assert code == 0, err
+    assert out.splitlines()[2:] == ["VD0:REAL   NaN", "VD4:REAL   Infinity",
+                                    "VD8:REAL   -Infinity", "VD12:REAL  1.5"]
+
+
 @pytest.mark.parametrize(("setting", "watch", "expected"), [
     ("VW0=16#FF", "VW0", 255),
     ("VW0=2#1010_0101", "VW0", 0xA5),
@@ -183,6 +208,10 @@ def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     ("VD0=2.5", "VD0:REAL", 2.5),
     ("VD0=-1e3", "VD0:REAL", -1000.0),
     ("M0.3=1", "M0.3", 1),
+    ("VW0=65535", "VW0", -1),           # a WORD and an INT are the same word
+    ("VW0=2.0", "VW0", 2),              # a whole real is its integer, as in plc.write
+    ("VD0=3.4e38", "VD0:REAL", pytest.approx(3.4e38, rel=1e-7)),
+    ("VD0=Infinity", "VD0:REAL", "Infinity"),
 ])
 def test_run_set_values(setting: str, watch: str, expected: float,
                         capsys: pytest.CaptureFixture[str]) -> None:

@@ -377,7 +377,13 @@ class Plc:
 
     def write(self, address: str, value: int | float | bool) -> None:
         """Write an address.  Writing an input sets the physical input too,
-        so it keeps its value over the next scans (a switch left on)."""
+        so it keeps its value over the next scans (a switch left on).
+
+        Raises:
+            PlcAddressError: a bad address, a value the location cannot hold
+                (:func:`plcrt.engine.values.check_value`), or SMB0, which the
+                CPU sets at every scan.
+        """
         a, (buf, off, width, bit), value = self._writable(address, value)
         _store(buf, off, width, bit, value)
         if a.area == "I":

@@ -329,6 +329,11 @@ class Plc:
         counter (``T37:BIT``); ``T37`` alone is its current value.
         """
         text, kind = split_format(spec)
+        return self._where(text, kind, spec)
+
+    def _where(self, text: str, kind: str, spec: str
+               ) -> tuple[bytearray, int, int, int, str]:
+        """:meth:`locate` of an address and a checked format."""
         a = self._addr(text)
         if kind == "BIT":
             if a.area not in ("T", "C"):
@@ -373,7 +378,14 @@ class Plc:
             PlcAddressError: a bad address, or an unknown or unfitting format.
         """
         text, fmt = split_format(address, kind)
-        return self.reader(f"{text}:{fmt}" if fmt else text)[1]()
+        buf, off, width, bit, k = self._where(text, fmt, f"{text}:{fmt}" if fmt else text)
+        if k == "real":
+            return CODECS["_rf"](buf, off)[0]
+        if width == 0:
+            return buf[off] >> bit & 1
+        if width == 1:
+            return buf[off]
+        return _SIGNED[width](buf, off)[0]
 
     def write(self, address: str, value: int | float | bool) -> None:
         """Write an address.  Writing an input sets the physical input too,

@@ -23,6 +23,7 @@ import struct
 import time as _time
 import types
 from pathlib import Path
+from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
@@ -678,8 +679,8 @@ def _source_items(sources: Any) -> list[str | Path]:
     ``bytes`` are refused rather than guessed at: a file's path lets plcrt
     read and decode it as Micro/WIN wrote it (see docs/decisions.md).
     """
-    if isinstance(sources, (str, Path, bytes, bytearray)) or not isinstance(sources,
-                                                                             (list, tuple)):
+    if isinstance(sources, (str, Path, bytes, bytearray, Mapping)) \
+            or not isinstance(sources, Iterable):
         items = [sources]
     else:
         items = list(sources)

@@ -391,3 +391,9 @@ def test_arbitrary_arguments_raise_nothing_but_plc_errors(name: str) -> None:
             assert name.startswith("h.") and str(e).strip()
 
     check()
+
+
+def test_load_takes_any_iterable_of_sources() -> None:
+    """A list, a tuple or a generator (``Path.glob``) of files: the blocks are merged."""
+    for sources in ([TIMERS], (TIMERS,), (p for p in [TIMERS])):
+        assert plcrt.load(sources).program.file == str(TIMERS)

@@ -552,3 +552,36 @@ def test_output_that_cannot_encode_box_drawing(tmp_path: Path) -> None:
     assert result.stderr == ""
     assert "Network 2  Running lamp" in result.stdout
     assert "\\u2503" in result.stdout         # the rail, escaped, not lost
+
+
+def test_parse_value_takes_any_text_without_crashing() -> None:
+    """Any text is a number or a PlcConfigError (never ValueError or
+    OverflowError), and a float's repr within the REAL range reads back as
+    itself, as do the spellings --json writes for non-finite REALs."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    numbers = st.from_regex(r"[+-]?[0-9]{1,70}(\.[0-9]*)?(e[+-]?[0-9]{1,4})?", fullmatch=True)
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(st.one_of(st.text(max_size=80), numbers))
+    def any_text(text: str) -> None:
+        try:
+            parse_value(text)
+        except PlcConfigError as e:
+            assert e.message.startswith(("bad value", text.strip()[:10]))
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(st.floats(min_value=-3.4e38, max_value=3.4e38))
+    def floats(x: float) -> None:
+        text = repr(x)
+        if "e" not in text and "." not in text:
+            text += ".0"
+        assert parse_value(text) == x
+
+    any_text()
+    floats()
+    from plcrt.engine.values import NONFINITE, json_number
+    for spelling, value in NONFINITE.items():
+        assert json_number(parse_value(spelling)) == spelling
+        assert json_number(value) == spelling

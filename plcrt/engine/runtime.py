@@ -23,7 +23,6 @@ import struct
 import time as _time
 import types
 from pathlib import Path
-from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
@@ -32,13 +31,13 @@ from ..compiler.rt import CODECS, make_indirect
 from ..errors import (PlcAddressError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
 from ..lang import ir
-from ..safetext import printable
 from ..memory import MemoryImage, cpu_model
+from ..safetext import printable
 from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
-from .values import (Duration, check_address, check_value, scan_number, scan_total,
-                     split_format)
+from .values import (Duration, check_address, check_load_options, check_parsed_inputs,
+                     check_value, scan_number, scan_total, source_items, split_format)
 
 if TYPE_CHECKING:
     from ..devices import AxisState
@@ -73,7 +72,7 @@ class Plc:
         if not isinstance(program, ir.Program):
             raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
                                  f"plcrt.load(), got {type(program).__name__}")
-        _check_parsed(symbols, data, plant)
+        check_parsed_inputs(symbols, data, plant)
         if system_symbols is not None and not isinstance(system_symbols, dict):
             raise PlcConfigError(f"system_symbols must be a dict of name -> address, got "
                                  f"{type(system_symbols).__name__}")
@@ -412,7 +411,7 @@ class Plc:
         """
         a = self._addr(address)
         loc = self._locate(a)
-        if loc[0] is self._bufs[2] and loc[1] == 0:
+        if loc[0] is self.mem.areas["SM"] and loc[1] == 0:
             raise PlcAddressError(
                 f"{printable(address.strip())}: SMB0 (SM0.0 always on, SM0.1 first scan, "
                 f"SM0.4/SM0.5 clocks, SM0.6 scan clock, SM0.7 RUN switch) is set by the "
@@ -620,7 +619,7 @@ def parse_sources(sources: str | Path | Sequence[str | Path]) -> ir.Program:
     """Parse one program file or text, or several (their blocks are merged,
     as Micro/WIN keeps OB1 and its subroutines in one project)."""
     from ..lang import parse_program
-    items = _source_items(sources)
+    items = source_items(sources)
     programs = [parse_program(*_text_or_path(x)) for x in items]
     if len(programs) == 1:
         return programs[0]
@@ -648,7 +647,7 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     """
     from ..lang import parse_datablock, parse_symbols
 
-    _check_load_options(symbols=symbols, data=data, plant=kw.get("plant"), options=kw)
+    check_load_options(symbols=symbols, data=data, plant=kw.get("plant"), options=kw)
     plant = kw.pop("plant", None)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
@@ -659,73 +658,6 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     if isinstance(data, (str, Path)):
         data = parse_datablock(*_text_or_path(data))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
-
-
-# -- checks of load()'s arguments: every refusal says what was expected -------
-
-#: the keyword options of load() besides symbols, data, scan_ms and cpu
-LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols")
-
-_SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
-
-
-def _shown(x: Any) -> str:
-    return f"{type(x).__name__} {printable(repr(x))[:40]}"
-
-
-def _source_items(sources: Any) -> list[str | Path]:
-    """The program sources of load() as a list, each checked.
-
-    ``bytes`` are refused rather than guessed at: a file's path lets plcrt
-    read and decode it as Micro/WIN wrote it (see docs/decisions.md).
-    """
-    if isinstance(sources, (str, Path, bytes, bytearray, Mapping)) \
-            or not isinstance(sources, Iterable):
-        items = [sources]
-    else:
-        items = list(sources)
-        if not items:
-            raise PlcConfigError("no program given: the list of program files is empty")
-    for x in items:
-        _check_text_or_path(x, "the program", _SOURCE_FORMS + ", or a list of them")
-    return items
-
-
-def _check_text_or_path(x: Any, what: str, forms: str) -> None:
-    if isinstance(x, (bytes, bytearray)):
-        raise PlcConfigError(f"{what} is {type(x).__name__}; give {forms} -- to load a file "
-                             f"pass its path, which plcrt reads and decodes as Micro/WIN "
-                             f"wrote it, or decode the bytes to str first")
-    if isinstance(x, str) and not x.strip():
-        raise PlcConfigError(f"{what} is an empty string; give {forms}")
-    if not isinstance(x, (str, Path)):
-        raise PlcConfigError(f"{what} must be {forms}; got {_shown(x)}")
-
-
-def _check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str, Any]) -> None:
-    """load()'s file arguments given as text or paths, and its options."""
-    unknown = sorted(k for k in options if k not in LOAD_OPTIONS)
-    if unknown:
-        raise PlcConfigError(f"load() got unknown option(s) {', '.join(map(repr, unknown))}; "
-                             f"the options are symbols, data, scan_ms, cpu, "
-                             f"{', '.join(LOAD_OPTIONS)}")
-    for what, x in (("symbols", symbols), ("data", data), ("plant", plant)):
-        if isinstance(x, (str, bytes, bytearray)):
-            _check_text_or_path(x, what, "a file path or the file's text")
-
-
-def _check_parsed(symbols: Any, data: Any, plant: Any) -> None:
-    """Plc()'s symbols, data and plant: parsed, or None."""
-    from ..devices.plant import Plant
-    from ..lang import DataBlock, SymbolTable
-    for what, x, kind, forms in (
-            ("symbols", symbols, SymbolTable, "a symbol table's path or text, or a "
-                                              "plcrt.lang.SymbolTable"),
-            ("data", data, DataBlock, "a data block's path or text, or a plcrt.lang.DataBlock"),
-            ("plant", plant, Plant, "a plant file's path or TOML text, a dict, or a "
-                                    "plcrt.devices.plant.Plant")):
-        if x is not None and not isinstance(x, kind):
-            raise PlcConfigError(f"{what} must be {forms}; got {_shown(x)}")
 
 
 __all__ = ["Plc", "load", "parse_sources"]

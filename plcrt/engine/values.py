@@ -15,7 +15,10 @@ refuses the same things with the same words:
 * :func:`parse_number` -- a number written as text (``12``, ``-3``,
   ``16#FF``, ``2#1010``, ``1.5``, ``2e3``, ``NaN``, ``Infinity``);
 * :func:`duration` and :func:`scan_total` -- how long to run;
-* :data:`NONFINITE` -- how a non-finite REAL is spelled in text and JSON.
+* :data:`NONFINITE` -- how a non-finite REAL is spelled in text and JSON;
+* :func:`source_items`, :func:`check_load_options` and
+  :func:`check_parsed_inputs` -- the program, files and options of
+  :func:`plcrt.load`.
 
 Every refusal is a :class:`~plcrt.errors.PlcAddressError` (a value for an
 address) or :class:`~plcrt.errors.PlcConfigError` (an option) that says
@@ -29,6 +32,8 @@ import math
 import numbers
 import re
 import struct
+from collections.abc import Iterable, Mapping
+from pathlib import Path
 from typing import Any, Union
 
 from ..errors import PlcAddressError, PlcConfigError
@@ -347,6 +352,77 @@ def scan_total(scan_us: int, seconds: Any = None, scans: Any = None) -> int:
     return -(-us // scan_us)
 
 
-__all__ = ["FORMATS", "FORMAT_ALIASES", "INT_RANGES", "NONFINITE", "NUMBER_FORMS",
-           "as_number", "check_address", "check_format", "check_value", "duration",
-           "json_number", "parse_number", "scan_number", "scan_total", "split_format"]
+# ---------------------------------------------------------------------------
+# The arguments of plcrt.load() and Plc()
+# ---------------------------------------------------------------------------
+
+#: the keyword options of load() besides symbols, data, scan_ms and cpu
+LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols")
+
+_SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
+
+
+def source_items(sources: Any) -> list[str | Path]:
+    """The program sources of load() as a list, each checked.
+
+    ``bytes`` are refused rather than guessed at: a file's path lets plcrt
+    read and decode it as Micro/WIN wrote it (see docs/decisions.md).
+    """
+    if isinstance(sources, (str, Path, bytes, bytearray, Mapping)) \
+            or not isinstance(sources, Iterable):
+        items = [sources]
+    else:
+        items = list(sources)
+        if not items:
+            raise PlcConfigError("no program given: the list of program files is empty")
+    for x in items:
+        _check_text_or_path(x, "the program", _SOURCE_FORMS + ", or a list of them")
+    return items
+
+
+def _check_text_or_path(x: Any, what: str, forms: str) -> None:
+    if isinstance(x, (bytes, bytearray)):
+        raise PlcConfigError(f"{what} is {type(x).__name__}; give {forms} -- to load a file "
+                             f"pass its path, which plcrt reads and decodes as Micro/WIN "
+                             f"wrote it, or decode the bytes to str first")
+    if isinstance(x, str) and not x.strip():
+        raise PlcConfigError(f"{what} is an empty string; give {forms}")
+    if not isinstance(x, (str, Path)):
+        raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
+
+
+def check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str, Any]) -> None:
+    """load()'s file arguments given as text or paths, and its options."""
+    unknown = sorted(k for k in options if k not in LOAD_OPTIONS)
+    if unknown:
+        raise PlcConfigError(f"load() got unknown option(s) {', '.join(map(repr, unknown))}; "
+                             f"the options are symbols, data, scan_ms, cpu, "
+                             f"{', '.join(LOAD_OPTIONS)}")
+    for what, x in (("symbols", symbols), ("data", data), ("plant", plant)):
+        if isinstance(x, (str, bytes, bytearray)):
+            _check_text_or_path(x, what, "a file path or the file's text")
+
+
+def check_parsed_inputs(symbols: Any, data: Any, plant: Any) -> None:
+    """Plc()'s symbols, data and plant: parsed, or None."""
+    from ..devices.plant import Plant
+    from ..lang import DataBlock, SymbolTable
+    for what, x, kind, forms in (
+            ("symbols", symbols, SymbolTable, "a symbol table's path or text, or a "
+                                              "plcrt.lang.SymbolTable"),
+            ("data", data, DataBlock, "a data block's path or text, or a plcrt.lang.DataBlock"),
+            ("plant", plant, Plant, "a plant file's path or TOML text, a dict, or a "
+                                    "plcrt.devices.plant.Plant")):
+        if x is not None and not isinstance(x, kind):
+            raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
+
+
+def _typed(x: Any) -> str:
+    return f"{type(x).__name__} {_shown(x)[:40]}"
+
+
+__all__ = ["FORMATS", "FORMAT_ALIASES", "INT_RANGES", "LOAD_OPTIONS", "NONFINITE",
+           "NUMBER_FORMS", "as_number", "check_address", "check_format",
+           "check_load_options", "check_parsed_inputs", "check_value", "duration",
+           "json_number", "parse_number", "scan_number", "scan_total", "source_items",
+           "split_format"]

@@ -35,14 +35,14 @@ import importlib
 import json
 import math
 import os
-import re
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple, NoReturn, TextIO
 
 from . import __version__
 from .engine.runtime import Plc, load
+from .engine.values import json_number, parse_number, split_format
 from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
 from .dump import render_dump
 from .safetext import printable
@@ -52,13 +52,6 @@ EXIT_ERROR = 1
 EXIT_FAULT = 2
 
 PROG = "plcrt"
-
-# Value syntax for --set, after the STL constant forms (16#FF, 2#1010) so a
-# value can be copied from a program.  Reals need a dot or an exponent.
-_DEC_RE = re.compile(r"[+-]?\d+")
-_HEX_RE = re.compile(r"16#([0-9A-Fa-f][0-9A-Fa-f_]*)")
-_BIN_RE = re.compile(r"2#([01][01_]*)")
-_REAL_RE = re.compile(r"[+-]?(\d+\.\d*|\.\d+|\d+(?=[eE]))([eE][+-]?\d+)?")
 
 
 
@@ -293,7 +286,7 @@ def cmd_dump(args: argparse.Namespace) -> int:
 
 #: help of ``--set`` (``show`` says when it applies first)
 SET_HELP = ("write before the first scan (inputs keep their value); "
-            "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
+            "VALUE: 12, -3, 16#FF, 2#1010, 1.5, NaN, Infinity")
 
 #: why a program without OB1 cannot run
 NO_OB1 = ("the program has no main program block (OB1), so there is nothing to run; "
@@ -354,32 +347,34 @@ def parse_sets(items: Sequence[str]) -> list[SetItem]:
     for item in items:
         addr, sep, value = item.partition("=")
         if not sep or not addr.strip() or not value.strip():
-            raise PlcConfigError(f"--set needs ADDR=VALUE, got '{item}'")
-        out.append(SetItem(addr.strip(), parse_value(value), item))
+            raise PlcConfigError(f"--set needs ADDR=VALUE, got '{_shorten(item)}'")
+        try:
+            number = parse_value(value)
+        except PlcConfigError as e:
+            raise PlcConfigError(f"--set {_shorten(item)}: {e.message}") from None
+        out.append(SetItem(addr.strip(), number, item))
     return out
 
 
+def _shorten(text: str, limit: int = 60) -> str:
+    """An argument as a message quotes it: one line, at most ``limit`` characters."""
+    text = printable(text)
+    return text if len(text) <= limit else f"{text[:limit - 3]}..."
+
+
 def apply_sets(plc: Plc, sets: Sequence[SetItem]) -> None:
-    """Write parsed ``--set`` values in order, refusing silent truncation
-    of a real.
+    """Write parsed ``--set`` values in order, checked as :meth:`Plc.write`
+    checks every value (a real only into a double word, a byte 0..255,
+    nothing into SMB0).
 
     Raises:
-        PlcConfigError: a bad address, or a real for anything but a double word.
+        PlcConfigError: a bad address, or a value that does not fit.
     """
     for addr, value, item in sets:
-        if isinstance(value, float):
-            plc.read(addr)  # a bad address is reported as such first
-            try:
-                is_dword = isinstance(plc.read(addr, "REAL"), float)
-            except PlcError:
-                is_dword = False
-            if not is_dword:
-                raise PlcConfigError(f"--set {item}: a real value needs a double word "
-                                     f"address (VD, MD, ...)")
         try:
             plc.write(addr, value)
         except PlcError as e:
-            raise PlcConfigError(f"--set {item}: {e.message}") from None
+            raise PlcConfigError(f"--set {_shorten(item)}: {e.message}") from None
 
 
 def load_for_run(args: argparse.Namespace, sets: Sequence[SetItem] = (), *,
@@ -402,24 +397,14 @@ def load_for_run(args: argparse.Namespace, sets: Sequence[SetItem] = (), *,
 
 
 def parse_value(text: str) -> int | float:
-    """Parse a --set value: decimal, ``16#hex``, ``2#binary`` or a real.
+    """Parse a --set value: decimal, ``16#hex``, ``2#binary``, a real or
+    ``NaN``/``Infinity``/``-Infinity``
+    (:func:`plcrt.engine.values.parse_number`).
 
     Raises:
-        PlcConfigError: for anything else (``nan`` and ``inf`` included).
+        PlcConfigError: for anything else, or a real beyond the REAL range.
     """
-    t = text.strip()
-    if _DEC_RE.fullmatch(t):
-        return int(t)
-    m = _HEX_RE.fullmatch(t)
-    if m:
-        return int(m.group(1).replace("_", ""), 16)
-    m = _BIN_RE.fullmatch(t)
-    if m:
-        return int(m.group(1).replace("_", ""), 2)
-    if _REAL_RE.fullmatch(t):
-        return float(t)
-    raise PlcConfigError(f"bad value '{text}': use a decimal (12, -3), 16#hex, "
-                         f"2#binary or a real (1.5, 2e3)")
+    return parse_number(text)
 
 
 # ---------------------------------------------------------------------------
@@ -427,41 +412,44 @@ def parse_value(text: str) -> int | float:
 # ---------------------------------------------------------------------------
 
 def _parse_watch(item: str) -> tuple[str, str, str | None]:
-    """(key for the output, address, read kind) of one --watch argument."""
+    """(key for the output, address, read format) of one --watch argument."""
     spec = item.strip()
-    addr, sep, kind = spec.rpartition(":")
-    if sep and kind.strip().upper() in ("REAL", "R"):
-        if not addr.strip():
-            raise PlcConfigError(f"--watch needs an address before ':REAL', got '{item}'")
-        return spec, addr.strip(), "REAL"
-    if sep and addr.strip():
-        raise PlcConfigError(f"--watch {item}: unknown format ':{kind}' (only ':REAL' is known)")
     if not spec:
         raise PlcConfigError("--watch needs an address")
-    return spec, spec, None
+    try:
+        addr, fmt = split_format(spec)
+    except PlcError as e:
+        raise PlcConfigError(f"--watch {e.message}") from None
+    return spec, addr, fmt or None
 
 
 def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int | float],
                error: str | None) -> None:
+    """One strict JSON object (RFC 8259 has no NaN or Infinity: a
+    non-finite REAL is written as the string "NaN", "Infinity" or
+    "-Infinity", see :data:`plcrt.engine.values.NONFINITE`)."""
     obj: dict[str, Any] = {
         "program": args.programs[0],
         "scans": plc.scans if plc else 0,
         "time_s": plc.time if plc else 0.0,
         "mode": plc.mode if plc else None,
-        "values": values,
+        "values": {k: json_number(v) for k, v in values.items()},
     }
     if plc is not None and getattr(args, "plant", None):
-        obj["axes"] = plc.axes()
+        obj["axes"] = [a.to_dict() for a in plc.axes()]
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
         obj["error"] = error
-    sys.stdout.write(json.dumps(obj, ensure_ascii=False) + "\n")
+    sys.stdout.write(json.dumps(obj, ensure_ascii=False, allow_nan=False) + "\n")
 
 
 def _fmt(value: int | float) -> str:
-    # REALs are single precision: seven significant digits say all there is.
-    return f"{value:.7g}" if isinstance(value, float) else str(value)
+    # REALs are single precision: seven significant digits say all there is;
+    # NaN and the infinities are spelled as in JSON (and as --set takes them).
+    if isinstance(value, float):
+        return f"{value:.7g}" if math.isfinite(value) else str(json_number(value))
+    return str(value)
 
 
 def _print_values(program: str, plc: Plc, values: dict[str, int | float]) -> None:
@@ -502,7 +490,7 @@ def _print_rich_table(summary: str, values: dict[str, int | float]) -> bool:
 _AXIS_COLUMNS = ("slot", "axis", "position", "mechanical", "speed", "status")
 
 
-def axis_rows(axes: Sequence[dict[str, Any]]) -> list[list[str]]:
+def axis_rows(axes: Sequence[Mapping[str, Any]]) -> list[list[str]]:
     """Table cells of :meth:`plcrt.Plc.axes` entries (columns ``_AXIS_COLUMNS``)."""
     rows = []
     for a in axes:
@@ -516,7 +504,7 @@ def axis_rows(axes: Sequence[dict[str, Any]]) -> list[list[str]]:
     return rows
 
 
-def _print_axes(axes: Sequence[dict[str, Any]]) -> None:
+def _print_axes(axes: Sequence[Mapping[str, Any]]) -> None:
     """The plant's axes after the watch values: a rich table on a terminal,
     aligned plain text otherwise (numbers right-aligned)."""
     if not axes:

@@ -13,18 +13,23 @@ are watched, what is forced and where a scan is paused are the session's.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any, TextIO
 
 from ..engine.runtime import Plc
+from ..engine.values import json_number
 from ..lang import ir
 from ..safetext import printable
 
 
 def fmt(value: int | float) -> str:
     """A value as the debugger shows it."""
-    # REALs are single precision: seven significant digits say all there is
-    return f"{value:.7g}" if isinstance(value, float) else str(value)
+    # REALs are single precision: seven significant digits say all there is;
+    # NaN and the infinities are spelled as `set` takes them
+    if isinstance(value, float):
+        return f"{value:.7g}" if math.isfinite(value) else str(json_number(value))
+    return str(value)
 
 
 def ms(us: int) -> str:

@@ -10,7 +10,60 @@ only in memory and in the library blocks' calls, as on real hardware.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
+from dataclasses import asdict, dataclass, fields
 from typing import Any, Protocol
+
+
+@dataclass(frozen=True, eq=False)
+class AxisState(Mapping[str, Any]):
+    """One axis of a positioning module at a moment of simulated time.
+
+    What :meth:`plcrt.Plc.axis` and the test harness's ``axis()`` return:
+    read it as an object (``a.position``) or as a read-only mapping
+    (``a["position"]``, ``dict(a)``, ``a.to_dict()`` for JSON); it equals
+    any mapping with the same keys and values.
+    """
+
+    slot: int
+    axis: int
+    position: int       #: the module's position counter (pulses)
+    mechanical: int     #: where the machine really is (pulses from the plant origin)
+    speed: int          #: pulse frequency in Hz, signed by direction
+    status: str         #: "stopped" or "moving"
+    masked: bool = False  #: pulses masked by SevOn (the drive is not enabled)
+    stf: bool = False     #: the STF (stop) input is active
+
+    @property
+    def moving(self) -> bool:
+        """Whether the axis is moving (``status == "moving"``)."""
+        return self.status == "moving"
+
+    def to_dict(self) -> dict[str, Any]:
+        """A plain dict of the fields, for JSON."""
+        return asdict(self)
+
+    def __getitem__(self, key: str) -> Any:
+        if key not in _AXIS_KEYS:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(_AXIS_KEYS)
+
+    def __len__(self) -> int:
+        return len(_AXIS_KEYS)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Mapping):
+            return dict(self) == dict(other)
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(tuple(self.values()))
+
+
+_AXIS_KEYS = tuple(f.name for f in fields(AxisState))
 
 
 class Device(Protocol):
@@ -21,8 +74,8 @@ class Device(Protocol):
     def step(self, plc: Any, t_from: int, t_to: int) -> None:
         """Advance from ``t_from`` to ``t_to`` (µs) and update terminals."""
 
-    def snapshot(self, t: int) -> list[dict[str, Any]]:
-        """Per-axis (or per-channel) state for status displays and JSON."""
+    def snapshot(self, t: int) -> list[AxisState]:
+        """Per-axis state for status displays, tests and JSON."""
 
 
 def build_devices(plc: Any, plant: Any) -> list[Any]:

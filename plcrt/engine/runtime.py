@@ -19,12 +19,11 @@ wall-clock pace (for demos); it never changes results.
 from __future__ import annotations
 
 import copy
-import numbers
 import struct
 import time as _time
 import types
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
 from ..compiler.operands import Addr, OperandError, parse_operand
@@ -33,9 +32,15 @@ from ..errors import (PlcAddressError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
+from ..safetext import printable
 from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
+from .values import (Duration, check_address, check_load_options, check_parsed_inputs,
+                     check_value, scan_number, scan_total, source_items, split_format)
+
+if TYPE_CHECKING:
+    from ..devices import AxisState
 
 #: Estimated execution time per instruction for the watchdog (µs).  Only
 #: loops (FOR/NEXT, backward jumps) are checked, and their instructions are
@@ -55,10 +60,22 @@ class Plc:
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False) -> None:
-        if not (isinstance(scan_ms, (int, float)) and 0.001 <= scan_ms <= 60000):
+        if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
+                                             and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
         if pace not in ("simulated", "realtime"):
             raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
+        if isinstance(watchdog_ms, bool) or not (isinstance(watchdog_ms, (int, float))
+                                                 and 0 < watchdog_ms <= 1e9):
+            raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
+                                 f"got {watchdog_ms!r:.40}")
+        if not isinstance(program, ir.Program):
+            raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
+                                 f"plcrt.load(), got {type(program).__name__}")
+        check_parsed_inputs(symbols, data, plant)
+        if system_symbols is not None and not isinstance(system_symbols, dict):
+            raise PlcConfigError(f"system_symbols must be a dict of name -> address, got "
+                                 f"{type(system_symbols).__name__}")
         self.program = program
         self.symbols = symbols
         # what fork() needs to build a twin (the data block is in V already)
@@ -145,8 +162,11 @@ class Plc:
         """Run ``n`` scan cycles (nothing happens in STOP mode).
 
         Raises:
+            PlcConfigError: ``n`` is not a non-negative whole number.
             PlcRuntimeError: on a fatal fault; the CPU is left in STOP.
         """
+        if type(n) is not int or n < 0:  # perf: one test for the usual scan(1)
+            n = scan_number(n)
         for _ in range(n):
             if self.mode != "RUN":
                 return
@@ -157,16 +177,15 @@ class Plc:
                 if left > 0:
                     _time.sleep(left)
 
-    def run(self, seconds: float | None = None, scans: int | None = None) -> None:
-        """Run for a simulated duration or a number of scans."""
-        if (seconds is None) == (scans is None):
-            raise PlcConfigError("give exactly one of seconds= or scans=")
-        if scans is None:
-            assert seconds is not None
-            if seconds < 0:
-                raise PlcConfigError("seconds must not be negative")
-            scans = -(-int(round(seconds * 1e6)) // self.scan_us)
-        self.scan(scans)
+    def run(self, seconds: Duration | None = None, scans: int | None = None) -> None:
+        """Run for a simulated duration (``1.5``, ``"1.5s"``, ``"200ms"``,
+        rounded up to whole scans) or a number of ``scans``.
+
+        Raises:
+            PlcConfigError: neither or both given, or a bad value (negative,
+                NaN, infinite, not a number).
+        """
+        self.scan(scan_total(self.scan_us, seconds, scans))
 
     def _scan_once(self) -> None:
         # perf: buffers are bound once in __init__ (self._bufs)
@@ -259,9 +278,15 @@ class Plc:
         """The simulated module in expansion slot ``slot`` (EmNo), or None."""
         return self.modules.get(slot)
 
-    def axis(self, slot: int, axis: int) -> dict[str, Any]:
-        """State of one configured axis: slot, axis, position (the module's
-        counter), mechanical (plant position), speed (Hz, signed), status."""
+    def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
+        """State of one configured axis (:class:`plcrt.devices.AxisState`:
+        ``a.position`` and ``a["position"]`` alike): slot, axis, position
+        (the module's counter), mechanical (plant position), speed (Hz,
+        signed), status, masked, stf."""
+        if isinstance(slot, bool) or not isinstance(slot, int) \
+                or isinstance(axis, bool) or not isinstance(axis, int):
+            raise PlcAddressError(f"an axis is named by two ints, slot and axis, got "
+                                  f"{slot!r:.40}, {axis!r:.40}")
         mod = self.modules.get(slot)
         if mod is None:
             raise PlcAddressError(f"no module in slot {slot}")
@@ -270,7 +295,7 @@ class Plc:
                 return entry
         raise PlcAddressError(f"axis {axis} of slot {slot} is not configured in the plant")
 
-    def axes(self) -> list[dict[str, Any]]:
+    def axes(self) -> list[AxisState]:
         """State of every configured axis (see :meth:`axis`)."""
         return [e for _, m in sorted(self.modules.items()) for e in m.snapshot(self._t_us)]
 
@@ -280,7 +305,7 @@ class Plc:
 
     # -- address access (slow path, for tests, CLI and tools) -------------
     def _addr(self, address: str) -> Addr:
-        text = address.strip()
+        text = check_address(address)
         try:
             op = parse_operand(text, self.model)
         except OperandError as e:
@@ -303,13 +328,12 @@ class Plc:
         reads a double word as a float, ``:BIT`` the bit of a timer or
         counter (``T37:BIT``); ``T37`` alone is its current value.
         """
-        text, sep, suffix = spec.strip().rpartition(":")
-        if not sep:
-            text, suffix = spec.strip(), ""
-        kind = suffix.strip().upper()
-        if kind not in ("", "REAL", "BIT"):
-            raise PlcAddressError(f"{spec!r}: unknown suffix ':{suffix.strip()}' (use :REAL "
-                                  f"for a float or :BIT for a timer or counter bit)")
+        text, kind = split_format(spec)
+        return self._where(text, kind, spec)
+
+    def _where(self, text: str, kind: str, spec: str
+               ) -> tuple[bytearray, int, int, int, str]:
+        """:meth:`locate` of an address and a checked format."""
         a = self._addr(text)
         if kind == "BIT":
             if a.area not in ("T", "C"):
@@ -338,7 +362,7 @@ class Plc:
         unpack = _SIGNED[width]
         return kind, lambda: unpack(buf, off)[0]
 
-    def __getitem__(self, address: str) -> int:
+    def __getitem__(self, address: str) -> int | float:
         return self.read(address)
 
     def __setitem__(self, address: str, value: int | float | bool) -> None:
@@ -346,34 +370,53 @@ class Plc:
 
     def read(self, address: str, kind: str | None = None) -> int | float:
         """Read an address: bits 0/1, bytes unsigned, words/dwords signed,
-        ``T37``/``C5`` their current value; ``kind="REAL"`` reads a float,
-        ``kind="BIT"`` the timer or counter bit of ``T37``/``C5``."""
-        a = self._addr(address)
-        if kind and kind.upper() == "BIT":
-            if a.area not in ("T", "C"):
-                raise PlcAddressError(f"{address}: kind BIT is for timers and counters")
-            a = Addr(a.area, a.offset, 0, 0, a.text)
-        buf, off, width, bit = self._locate(a)
+        ``T37``/``C5`` their current value; ``kind="REAL"`` (or the suffix
+        ``"VD4:REAL"``) reads a float, ``kind="BIT"`` the timer or counter
+        bit of ``T37``/``C5`` (the formats of :data:`plcrt.engine.values.FORMATS`).
+
+        Raises:
+            PlcAddressError: a bad address, or an unknown or unfitting format.
+        """
+        text, fmt = split_format(address, kind)
+        buf, off, width, bit, k = self._where(text, fmt, f"{text}:{fmt}" if fmt else text)
+        if k == "real":
+            return CODECS["_rf"](buf, off)[0]
         if width == 0:
             return buf[off] >> bit & 1
-        if kind and kind.upper() in ("REAL", "R"):
-            if width != 4 or a.area in ("T", "C"):
-                raise PlcAddressError(f"{address}: a REAL needs a double word")
-            return CODECS["_rf"](buf, off)[0]
         if width == 1:
             return buf[off]
-        raw = int.from_bytes(buf[off:off + width], "big", signed=True)
-        return raw
+        return _SIGNED[width](buf, off)[0]
 
     def write(self, address: str, value: int | float | bool) -> None:
         """Write an address.  Writing an input sets the physical input too,
-        so it keeps its value over the next scans (a switch left on)."""
-        a = self._addr(address)
-        buf, off, width, bit = self._locate(a)
-        value = _check_value(address, width, value)
+        so it keeps its value over the next scans (a switch left on).
+
+        Raises:
+            PlcAddressError: a bad address, a value the location cannot hold
+                (:func:`plcrt.engine.values.check_value`), or SMB0, which the
+                CPU sets at every scan.
+        """
+        a, (buf, off, width, bit), value = self._writable(address, value)
         _store(buf, off, width, bit, value)
         if a.area == "I":
             _store(self.mem.areas["PI"], off, width, bit, value)
+
+    def _writable(self, address: str, value: Any
+                  ) -> tuple[Addr, tuple[bytearray, int, int, int], int | float]:
+        """The address, location and checked value of a write or force.
+
+        SMB0 (SM0.0 to SM0.7) is refused: the CPU sets it at the start of
+        every scan (System Manual, "Special memory bits", SMB0), so a written
+        value would be lost unseen by the program.
+        """
+        a = self._addr(address)
+        loc = self._locate(a)
+        if loc[0] is self.mem.areas["SM"] and loc[1] == 0:
+            raise PlcAddressError(
+                f"{printable(address.strip())}: SMB0 (SM0.0 always on, SM0.1 first scan, "
+                f"SM0.4/SM0.5 clocks, SM0.6 scan clock, SM0.7 RUN switch) is set by the "
+                f"CPU at the start of every scan and cannot be written or forced")
+        return a, loc, check_value(printable(address.strip()), loc[2], value)
 
     # -- forcing (System Manual, "Forcing specific values") ----------------
     def force(self, address: str, value: int | float | bool) -> None:
@@ -393,14 +436,12 @@ class Plc:
         (``QB0`` and ``Q0.0``) are separate forces, applied in the order
         they were made.
         """
-        a = self._addr(address)
-        loc = self._locate(a)
+        _, loc, value = self._writable(address, value)
         buf, off, width, bit = loc
-        value = _check_value(address, width, value)
         old = self._forced_key(loc)
         if old is not None:
             del self.forces[old]
-        self.forces[address.strip()] = value
+        self.forces[check_address(address)] = value
         self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
         self._force_slots.append((buf, off, width, bit, value))
         _store(buf, off, width, bit, value)
@@ -421,7 +462,7 @@ class Plc:
         loc = self._locate(self._addr(address))
         key = self._forced_key(loc)
         if key is None:
-            raise PlcAddressError(f"{address.strip()} is not forced")
+            raise PlcAddressError(f"{printable(address.strip())} is not forced")
         del self.forces[key]
         self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
         return key
@@ -539,46 +580,6 @@ class Plc:
 _SIGNED = {2: struct.Struct(">h").unpack_from, 4: struct.Struct(">i").unpack_from}
 
 
-def _check_value(address: str, width: int, value: int | float | bool) -> int | float:
-    """Validate a value for a location of ``width`` bytes (0 = a bit).
-
-    A bit takes 0, 1, False or True; a double word takes a float as a REAL
-    if single precision can hold it (infinities included, as on the CPU).
-    """
-    if not isinstance(value, (int, float)):
-        # numpy scalars, Decimal, Fraction ...: as the Python number they are
-        if isinstance(value, numbers.Integral):
-            value = int(value)
-        elif isinstance(value, numbers.Real):
-            value = float(value)
-        elif hasattr(value, "item") and isinstance(getattr(value, "shape", None), tuple) \
-                and value.shape == ():
-            value = value.item()          # numpy.bool_
-        if not isinstance(value, (int, float)):
-            raise PlcAddressError(f"{address}: {value!r} is not a number")
-    if width == 0:
-        if value not in (0, 1):
-            raise PlcAddressError(f"{address}: a bit takes 0 or 1, got {value!r}")
-        return 1 if value else 0
-    if isinstance(value, float) and width == 4:
-        try:
-            _F32.pack(value)
-        except OverflowError:
-            raise PlcAddressError(f"{address}: {value!r} is out of the range of a REAL "
-                                  f"(about -3.4e38 to 3.4e38)") from None
-        return value
-    if isinstance(value, float) and not value.is_integer():
-        raise PlcAddressError(f"{address}: a real value needs a double word")
-    v = int(value)
-    lo, hi = -(1 << (8 * width - 1)), (1 << (8 * width)) - 1
-    if not lo <= v <= hi:
-        raise PlcAddressError(f"{address}: value {v} does not fit in {width} byte(s)")
-    return v
-
-
-_F32 = struct.Struct(">f")
-
-
 def _same_loc(a: Sequence[Any], b: Sequence[Any]) -> bool:
     """Whether two (buffer, offset, width, bit) locations are the same: the
     buffers must be the same object (``==`` on bytearrays compares their
@@ -619,7 +620,7 @@ def parse_sources(sources: str | Path | Sequence[str | Path], *,
     """Parse one program file or text, or several (their blocks are merged,
     as Micro/WIN keeps OB1 and its subroutines in one project)."""
     from ..lang.sources import read_program
-    return read_program(sources, encoding=encoding)[0]
+    return read_program(source_items(sources), encoding=encoding)[0]
 
 
 def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
@@ -641,12 +642,14 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     Raises:
         PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
     """
+    check_load_options(symbols=symbols, data=data, plant=kw.get("plant"), options=kw)
     plant = kw.pop("plant", None)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
     from ..lang.sources import read_program
-    program, symbols, data = read_program(source, symbols, data, encoding=encoding)
+    program, symbols, data = read_program(source_items(source), symbols, data,
+                                          encoding=encoding)
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 

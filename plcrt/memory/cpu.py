@@ -58,6 +58,10 @@ def cpu_model(name: str | None) -> CpuModel:
     """Look up a model by name (case and blanks ignored)."""
     from ..errors import PlcConfigError
 
+    if name is not None and not isinstance(name, str):
+        raise PlcConfigError(f"the CPU model is a name such as 'CPU226' (known: "
+                             f"{', '.join(CPU_MODELS)}), got {type(name).__name__} "
+                             f"{name!r:.40}")
     key = (name or DEFAULT_CPU).upper().replace(" ", "").replace("-", "")
     if not key.startswith("CPU"):
         key = "CPU" + key
@@ -65,4 +69,4 @@ def cpu_model(name: str | None) -> CpuModel:
         return CPU_MODELS[key]
     except KeyError:
         known = ", ".join(CPU_MODELS)
-        raise PlcConfigError(f"unknown CPU model {name!r} (known: {known})") from None
+        raise PlcConfigError(f"unknown CPU model {name!r:.40} (known: {known})") from None

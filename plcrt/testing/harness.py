@@ -7,7 +7,11 @@ condition costs only the scans it needs, and gives the same result on every
 machine.
 
 It is not a second engine: every scan is :meth:`plcrt.engine.Plc.scan`, and
-every read and write goes through the PLC's memory image.
+every read and write goes through the PLC's memory image.  A harness has
+every public method and property of :class:`~plcrt.engine.Plc` with the same
+parameters (a test written against ``plcrt.load(...)`` runs unchanged on the
+``plc`` fixture); methods that return nothing on the PLC return the harness
+here, so calls chain.
 """
 
 from __future__ import annotations
@@ -16,19 +20,17 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Union
 
-from ..engine.runtime import Plc, _check_value, load
-from ..errors import PlcAddressError, PlcConfigError, PlcError
+from ..devices import AxisState
+from ..engine.runtime import Plc, load
+from ..engine.values import Duration, check_address, parse_number, scan_number
+from ..engine.values import duration as parse_duration
+from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
 
 Value = Union[int, float, bool]
-Duration = Union[int, float, str]
 Condition = Union[str, Callable[[], Any], Callable[["Harness"], Any]]
-
-_UNITS = {"us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0}
-_DURATION_RE = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(us|µs|ms|s|sec|min|h)?\s*$")
 
 
 class PlcTimeout(AssertionError):
@@ -40,19 +42,9 @@ class PlcTimeout(AssertionError):
 
 
 def seconds(d: Duration) -> float:
-    """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``, ``"2min"``."""
-    if isinstance(d, bool):
-        raise PlcConfigError(f"not a duration: {d!r}")
-    if isinstance(d, (int, float)):
-        value = float(d)
-    else:
-        m = _DURATION_RE.match(str(d))
-        if m is None:
-            raise PlcConfigError(f"not a duration: {d!r} (write e.g. 2, '1.5s', '200ms', '2min')")
-        value = float(m.group(1)) * _UNITS[m.group(2) or "s"]
-    if not value >= 0 or value == float("inf"):
-        raise PlcConfigError(f"a duration must be a non-negative number, got {d!r}")
-    return value
+    """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``, ``"2min"``
+    (:func:`plcrt.engine.values.duration`, as ``Plc.run`` reads it)."""
+    return parse_duration(d)
 
 
 # ---------------------------------------------------------------------------
@@ -99,31 +91,14 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
     rd = reader(h.plc, addr)
     if op is None:
         return ((lambda: not rd()) if neg else (lambda: bool(rd()))), str(cond).strip()
-    from ..cli import parse_value
     try:
-        v = parse_value(value)
+        v = parse_number(value)
     except PlcConfigError:
         raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
     fn = _OPS[op]
     if neg:
         return (lambda: not fn(rd(), v)), str(cond).strip()
     return (lambda: fn(rd(), v)), str(cond).strip()
-
-
-@dataclass(frozen=True)
-class AxisState:
-    """One EM253 axis at a moment of simulated time."""
-
-    slot: int
-    axis: int
-    position: int       #: the module's position counter (pulses)
-    mechanical: int     #: where the machine really is (pulses from the plant origin)
-    speed: int          #: pulse frequency in Hz, signed by direction
-    status: str         #: "stopped", "moving", ...
-
-    @property
-    def moving(self) -> bool:
-        return self.status == "moving"
 
 
 class Harness:
@@ -136,6 +111,13 @@ class Harness:
 
     def __init__(self, plc: Plc, *, watch: Sequence[str] = (), history: int = 20,
                  name: str = "", max_time: Duration | None = None) -> None:
+        if not isinstance(plc, Plc):
+            raise PlcConfigError(f"Harness() wraps a plcrt.Plc (or use Harness.load(program, "
+                                 f"...)), got {type(plc).__name__}")
+        if isinstance(watch, str) or not isinstance(watch, (list, tuple)):
+            raise PlcConfigError(f"watch is a list of addresses such as ['Q0.0', 'VW10'], "
+                                 f"got {type(watch).__name__} {watch!r:.40}")
+        history = scan_number(history, "history (a number of scans)")
         self.plc = plc
         self.name = name or str(plc.program.file)
         self.history: deque[tuple[int, float, tuple[Value, ...]]] = deque(maxlen=max(1, history))
@@ -182,9 +164,11 @@ class Harness:
         the files (detected by default, as in :func:`plcrt.load`).
         """
         from ..lang import ir
-        symbols = Path(symbols) if isinstance(symbols, str) and "\n" not in symbols else symbols
-        data = Path(data) if isinstance(data, str) and "\n" not in data else data
-        plant = Path(plant) if isinstance(plant, str) and "\n" not in plant else plant
+
+        def path(x: Any) -> Any:   # a one-line string names a file ("" is refused by load)
+            return Path(x) if isinstance(x, str) and x.strip() and "\n" not in x else x
+
+        symbols, data, plant = path(symbols), path(data), path(plant)
         if isinstance(program, ir.Program):
             # already parsed (the pytest plugin parses each file once per
             # session and compiles it per test)
@@ -192,8 +176,7 @@ class Harness:
                                    scan_ms=scan_ms, cpu=cpu, instrument=instrument,
                                    encoding=encoding)
             return cls(plc, watch=watch, history=history, max_time=max_time)
-        if isinstance(program, str) and "\n" not in program:
-            program = Path(program)
+        program = path(program)
         plc = load(program, symbols=symbols, data=data, plant=plant,
                    scan_ms=scan_ms, cpu=cpu, instrument=instrument, encoding=encoding)
         return cls(plc, watch=watch, history=history, max_time=max_time)
@@ -219,9 +202,13 @@ class Harness:
         self.history.append((plc.scans, plc.time, tuple(r() for r in self._readers)))
 
     def history_rows(self, n: int | None = None) -> list[tuple[int, float, tuple[Value, ...]]]:
-        """The last ``n`` recorded scans: (scan number, time after it, values)."""
+        """The last ``n`` recorded scans (all with None): (scan number, time
+        after it, values)."""
         rows = list(self.history)
-        return rows if n is None else rows[-n:]
+        if n is None:
+            return rows
+        n = scan_number(n, "the number of rows")
+        return rows[len(rows) - n:] if n < len(rows) else rows
 
     def history_table(self, n: int | None = None) -> str:
         """The watched values over the last scans as a plain text table."""
@@ -245,23 +232,24 @@ class Harness:
         return self.plc.time
 
     @property
+    def now_us(self) -> int:
+        """Simulated time in µs (as :attr:`Plc.now_us`)."""
+        return self.plc.now_us
+
+    @property
     def scans(self) -> int:
+        """Scans run since power-up."""
         return self.plc.scans
 
     def scan(self, n: int = 1) -> Harness:
-        """Run ``n`` scans."""
-        if n < 0:
-            raise PlcConfigError(f"cannot run {n} scans")
+        """Run ``n`` scans (a non-negative int)."""
         self.plc.scan(n)
         return self
 
-    def run(self, duration: Duration | None = None, *, scans: int | None = None) -> Harness:
-        """Run for a simulated duration (``2``, ``"1.5s"``, ``"200ms"``) or ``scans``."""
-        if (duration is None) == (scans is None):
-            raise PlcConfigError("give a duration or scans=, not both")
-        if scans is not None:
-            return self.scan(scans)
-        self.plc.run(seconds=seconds(duration))  # type: ignore[arg-type]
+    def run(self, seconds: Duration | None = None, scans: int | None = None) -> Harness:
+        """Run for a simulated duration (``2``, ``"1.5s"``, ``"200ms"``,
+        ``seconds=1.5``) or a number of ``scans``, as :meth:`Plc.run`."""
+        self.plc.run(seconds, scans)
         return self
 
     def _scans_for(self, d: Duration) -> int:
@@ -338,9 +326,7 @@ class Harness:
 
     def read(self, address: str, kind: str | None = None) -> Value:
         """Read an address or symbol (``kind`` "REAL" or "BIT"; or ``VD4:REAL``)."""
-        if kind is None and ":" in address:
-            address, _, kind = address.partition(":")
-        return self.plc.read(address, kind or None)
+        return self.plc.read(address, kind)
 
     def write(self, address: str, value: Value) -> None:
         """Write an address or symbol; an input keeps its value (a switch left on)."""
@@ -348,7 +334,7 @@ class Harness:
 
     def set(self, values: Mapping[str, Value]) -> Harness:
         """Write several addresses at once (they hold until changed)."""
-        for a, v in values.items():
+        for a, v in _mapping(values, "set").items():
             self.write(a, v)
         return self
 
@@ -359,6 +345,10 @@ class Harness:
     def patch(self, values: Mapping[str, Value], scans: int = 1) -> Harness:
         """Hold values for ``scans`` scans (default one), then put the old
         values back: a push button pressed for exactly one scan."""
+        values = _mapping(values, "patch")
+        scan_number(scans, "scans")
+        for a, v in values.items():
+            self.plc._writable(a, v)   # all checked before any is written
         old = {a: self.read(a) for a in values}
         for a, v in values.items():
             self.write(a, v)
@@ -369,16 +359,22 @@ class Harness:
 
     def pulse(self, address: str, scans: int = 1, value: Value = 1) -> Harness:
         """Set ``address`` to ``value`` for ``scans`` scans, then back."""
-        return self.patch({address: value}, scans)
+        return self.patch({check_address(address): value}, scans)
 
     def force(self, address: str, value: Value) -> _Forced:
-        """Force an address until :meth:`unforce` (or the end of a ``with``)."""
+        """Force an address until :meth:`unforce` (or the end of a ``with``).
+
+        Returns an object that is also a context manager:
+        ``with h.force("I0.1", 0): ...`` releases the force at the end."""
         self.plc.force(address, value)
         return _Forced(self, [address])
 
     @contextmanager
     def forced(self, values: Mapping[str, Value]) -> Iterator[Harness]:
         """``with h.forced({"I0.1": 0, "VW10": 5}):`` forces inside the block only."""
+        values = _mapping(values, "forced")
+        for a, v in values.items():
+            self.plc._writable(a, v)   # all checked before any is forced
         for a, v in values.items():
             self.plc.force(a, v)
         try:
@@ -401,6 +397,9 @@ class Harness:
         its inputs).  After the last row the PLC runs on to ``until`` if it
         is given.
         """
+        if not isinstance(table, Iterable) or isinstance(table, (str, bytes, Mapping)):
+            raise PlcConfigError(f"a stimulus is a list of (time, address, value) rows, got "
+                                 f"{type(table).__name__}")
         rows = []
         for i, row in enumerate(table):
             try:
@@ -413,11 +412,10 @@ class Harness:
             except PlcConfigError as e:
                 raise PlcConfigError(f"stimulus row {i + 1} {row!r}: {e.message}") from None
             try:   # every row is checked before the first scan runs
-                _, _, width, _, _ = self.plc.locate(str(addr))
-                _check_value(str(addr), width, value)
+                self.plc._writable(addr, value)
             except PlcError as e:
-                raise type(e)(f"stimulus row {i + 1} {row!r}: {e.message}") from None
-            rows.append((int(round(t_s * 1e6)), i, str(addr), value))
+                raise type(e)(f"stimulus row {i + 1} {row!r:.80}: {e.message}") from None
+            rows.append((int(round(t_s * 1e6)), i, addr, value))
         rows.sort()
         plc = self.plc
         t0 = plc.now_us
@@ -436,9 +434,9 @@ class Harness:
         """The whole PLC state now (memory, timers, devices, time)."""
         return self.plc.snapshot()
 
-    def restore(self, snap: Plc) -> Harness:
+    def restore(self, snapshot: Plc) -> Harness:
         """Go back to a :meth:`snapshot`."""
-        self.plc.restore(snap)
+        self.plc.restore(snapshot)
         return self
 
     def fork(self) -> Harness:
@@ -451,10 +449,17 @@ class Harness:
 
     # -- motion -----------------------------------------------------------
     def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
-        """State of one EM253 axis (needs a plant)."""
-        e = self.plc.axis(slot, axis)
-        return AxisState(e["slot"], e["axis"], e["position"], e["mechanical"],
-                         e["speed"], str(e["status"]))
+        """State of one EM253 axis (needs a plant): ``a.position`` or
+        ``a["position"]``, as :meth:`Plc.axis`."""
+        return self.plc.axis(slot, axis)
+
+    def axes(self) -> list[AxisState]:
+        """State of every configured axis."""
+        return self.plc.axes()
+
+    def module(self, slot: int) -> Any:
+        """The simulated module in expansion slot ``slot``, or None."""
+        return self.plc.module(slot)
 
     def wait_axis_moving(self, slot: int = 0, axis: int = 0, *,
                          timeout: Duration = 1.0) -> float:
@@ -474,6 +479,7 @@ class Harness:
         """Assert a move that is running (or about to start within a few
         scans) ends within ``limit`` simulated seconds; returns its time."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        seconds(limit)   # a bad limit is reported before anything runs
         t0 = self.time
         if not self.axis(slot, axis).moving:
             self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))
@@ -490,6 +496,9 @@ class Harness:
 
     def warnings(self, contains: str = "") -> list[str]:
         """Messages of the warnings so far (optionally containing a text)."""
+        if not isinstance(contains, str):
+            raise PlcConfigError(f"warnings(contains=...) takes a str, got "
+                                 f"{type(contains).__name__}")
         return [d.message for d in self.plc.diagnostics
                 if d.severity == "warning" and contains in d.message]
 
@@ -497,6 +506,55 @@ class Harness:
     def coverage(self) -> Any:
         """Network/output coverage (``instrument=True`` only, else None)."""
         return self.plc.coverage
+
+    # -- the rest of the Plc interface, delegated -----------------------------
+    @property
+    def mode(self) -> str:
+        """``"RUN"`` or ``"STOP"``."""
+        return self.plc.mode
+
+    @property
+    def fault(self) -> PlcError | None:
+        """The fault that put the CPU in STOP, if any."""
+        return self.plc.fault
+
+    @property
+    def source(self) -> str:
+        """The generated Python."""
+        return self.plc.source
+
+    @property
+    def program(self) -> Any:
+        """The parsed program (:class:`plcrt.lang.ir.Program`)."""
+        return self.plc.program
+
+    @property
+    def symbols(self) -> Any:
+        """The symbol table, or None."""
+        return self.plc.symbols
+
+    @property
+    def forces(self) -> dict[str, int | float]:
+        """Forced addresses and their values."""
+        return self.plc.forces
+
+    def locate(self, spec: str) -> tuple[bytearray, int, int, int, str]:
+        """Where an address spec lives (see :meth:`Plc.locate`)."""
+        return self.plc.locate(spec)
+
+    def reader(self, spec: str) -> tuple[str, Callable[[], int | float]]:
+        """``(kind, read)`` of an address spec (see :meth:`Plc.reader`)."""
+        return self.plc.reader(spec)
+
+    def request_stop(self) -> Harness:
+        """Go to STOP at the end of the next scan, as the STOP instruction."""
+        self.plc.request_stop()
+        return self
+
+    def warn(self, message: str, loc: SourceLoc | None, key: str) -> Harness:
+        """Add a run-time warning (reported once per ``key``), as :meth:`Plc.warn`."""
+        self.plc.warn(message, loc, key)
+        return self
 
     def trace(self, *signals: str, every: int = 1, limit: int | None = None) -> Any:
         """Start recording ``signals`` (addresses, ``VD4:REAL``, ``T37:BIT``,
@@ -550,6 +608,13 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
         data = parse_datablock(*_text_or_path(data, encoding))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                instrument=instrument)
+
+
+def _mapping(values: Any, method: str) -> Mapping[str, Any]:
+    if not isinstance(values, Mapping):
+        raise PlcConfigError(f"{method}() takes a dict of address -> value, got "
+                             f"{type(values).__name__}")
+    return values
 
 
 def _fmt(v: Value) -> str:

@@ -509,14 +509,14 @@ def pytest_sessionfinish(session: pytest.Session) -> None:
         # an xdist worker: hand the coverage to the controller, which
         # merges it in pytest_testnodedown and reports once
         import json
-        config.workeroutput[WORKEROUTPUT_KEY] = json.dumps(sess.store)
+        config.workeroutput[WORKEROUTPUT_KEY] = json.dumps(sess.store, allow_nan=False)
         return
     if sess.coverage_report is not None:
         import json
         from .coverage_report import to_json
         sess.coverage_report.parent.mkdir(parents=True, exist_ok=True)
-        sess.coverage_report.write_text(json.dumps(to_json(sess.store), indent=1) + "\n",
-                                        encoding="utf-8")
+        text = json.dumps(to_json(sess.store), indent=1, allow_nan=False)   # strict JSON
+        sess.coverage_report.write_text(text + "\n", encoding="utf-8")
 
 
 @pytest.hookimpl(optionalhook=True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 from typing import Any, TextIO
 
-from ..errors import PlcConfigError
+from ..engine.values import scan_total
 
 #: runs of at most this many scans never show a bar (they end too soon)
 MIN_SCANS_FOR_BAR = 2000
@@ -23,15 +23,7 @@ MIN_SCANS_FOR_BAR = 2000
 def scan_count(plc: Any, seconds: float | None = None, scans: int | None = None) -> int:
     """The number of scans ``plc.run(seconds=..., scans=...)`` runs
     (a partial last scan counts as a scan, as in the engine)."""
-    if (seconds is None) == (scans is None):
-        raise PlcConfigError("give exactly one of seconds= or scans=")
-    if scans is not None:
-        if scans < 0:
-            raise PlcConfigError("scans must not be negative")
-        return int(scans)
-    if seconds < 0:
-        raise PlcConfigError("seconds must not be negative")
-    return -(-int(round(seconds * 1e6)) // plc.scan_us)
+    return scan_total(plc.scan_us, seconds, scans)
 
 
 def _is_terminal(stream: Any) -> bool:

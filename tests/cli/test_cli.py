@@ -175,6 +175,31 @@ def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert isinstance(values["VD20:REAL"], float)
 
 
+def _strict_json(text: str) -> object:
+    """json.loads that refuses the NaN/Infinity tokens Python's json writes by default."""
+    def refuse(token: str) -> object:
+        raise AssertionError(f"non-standard JSON token {token}")
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_run_json_is_strict_and_spells_non_finite_reals(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """NaN and the infinities are the strings "NaN", "Infinity", "-Infinity"
+    (JSON has no token for them), and --set takes the same spellings back."""
+    watches = ["--watch", "VD0:REAL", "--watch", "VD4:REAL", "--watch", "VD8:REAL",
+               "--watch", "VD12:REAL"]
+    sets = ["--set", "VD0=NaN", "--set", "VD4=Infinity", "--set", "VD8=-Infinity",
+            "--set", "VD12=1.5"]
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", "--json", *sets, *watches)
+    assert code == 0, err
+    assert _strict_json(out)["values"] == {  # type: ignore[index]
+        "VD0:REAL": "NaN", "VD4:REAL": "Infinity", "VD8:REAL": "-Infinity", "VD12:REAL": 1.5}
+    code, out, err = run_cli(capsys, "run", SEAL_IN, "--scans", "1", *sets, *watches)
+    assert code == 0, err
+    assert out.splitlines()[2:] == ["VD0:REAL   NaN", "VD4:REAL   Infinity",
+                                    "VD8:REAL   -Infinity", "VD12:REAL  1.5"]
+
+
 @pytest.mark.parametrize(("setting", "watch", "expected"), [
     ("VW0=16#FF", "VW0", 255),
     ("VW0=2#1010_0101", "VW0", 0xA5),
@@ -183,6 +208,10 @@ def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     ("VD0=2.5", "VD0:REAL", 2.5),
     ("VD0=-1e3", "VD0:REAL", -1000.0),
     ("M0.3=1", "M0.3", 1),
+    ("VW0=65535", "VW0", -1),           # a WORD and an INT are the same word
+    ("VW0=2.0", "VW0", 2),              # a whole real is its integer, as in plc.write
+    ("VD0=3.4e38", "VD0:REAL", pytest.approx(3.4e38, rel=1e-7)),
+    ("VD0=Infinity", "VD0:REAL", "Infinity"),
 ])
 def test_run_set_values(setting: str, watch: str, expected: float,
                         capsys: pytest.CaptureFixture[str]) -> None:
@@ -266,13 +295,24 @@ def test_run_compile_error_json(tmp_path: Path, capsys: pytest.CaptureFixture[st
     (["--set", "VB99999=1"], "VB99999"),
     (["--watch", "XQ9"], "not an address"),
     (["--watch", "VW0:REAL"], "double word"),
-    (["--watch", "VW0:BCD"], "unknown format ':BCD'"),
+    (["--watch", "VW0:BCD"], "--watch VW0:BCD: unknown suffix ':BCD' (:REAL reads"),
     (["--scan-ms", "0"], "scan time"),
     (["--scans", "-1"], "must not be negative"),
     # used to set the bit to 1 silently
     (["--set", "I0.0=5"], "--set I0.0=5: I0.0: a bit takes 0 or 1, got 5"),
     # used to end in "internal error: OverflowError"
-    (["--set", "VD0=-1e39"], "--set VD0=-1e39: VD0: -1e+39 is out of the range of a REAL"),
+    (["--set", "VD0=-1e39"], "--set VD0=-1e39: -1e39 is out of the range of a REAL"),
+    # used to store infinity, while 3.5e38 was refused
+    (["--set", "VD0=1e999"], "--set VD0=1e999: 1e999 is out of the range of a REAL"),
+    # used to store 255: the S7-200 byte is unsigned
+    (["--set", "VB0=-1"], "--set VB0=-1: VB0: -1 does not fit in a byte (BYTE), which takes "
+                          "0 to 255; an S7-200 byte is unsigned"),
+    # used to be ignored silently: the CPU rewrites SMB0 at every scan
+    (["--set", "SM0.0=0"], "--set SM0.0=0: SM0.0: SMB0 (SM0.0 always on"),
+    (["--set", "SMB0=1"], "is set by the CPU at the start of every scan"),
+    # used to end in "internal error: ValueError" (more digits than int() converts)
+    (["--set", "VW0=" + "9" * 5000], "too long for a number"),
+    (["--set", "VW0=99999999999999999999"], "99999999999999999999 does not fit in a word"),
 ])
 def test_run_bad_options(args: list[str], message: str,
                          capsys: pytest.CaptureFixture[str]) -> None:
@@ -311,11 +351,24 @@ def test_parse_value(text: str, value: float) -> None:
     assert type(result) is type(value)
 
 
-@pytest.mark.parametrize("text", ["", "abc", "16#", "16#XYZ", "2#102", "nan", "inf", "1.2.3",
-                                  "0x10", "1e"])
+@pytest.mark.parametrize("text", ["", "abc", "16#", "16#XYZ", "2#102", "nanx", "infinit",
+                                  "1.2.3", "0x10", "1e", "1e999", "-3.5e38", "9" * 65])
 def test_parse_value_rejects(text: str) -> None:
     with pytest.raises(PlcConfigError):
         parse_value(text)
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ("NaN", "nan"), ("nan", "nan"), ("Infinity", "inf"), ("-Infinity", "-inf"),
+    ("inf", "inf"), ("-INF", "-inf"), ("+Infinity", "inf"),
+])
+def test_parse_value_non_finite_reals(text: str, expected: str) -> None:
+    """NaN and the infinities are written as JSON output writes them (and as
+    the API stores a float('nan')); a finite literal beyond the REAL range
+    is refused instead of becoming infinity."""
+    result = parse_value(text)
+    assert isinstance(result, float)
+    assert repr(result) == expected
 
 
 # ---------------------------------------------------------------------------
@@ -499,3 +552,36 @@ def test_output_that_cannot_encode_box_drawing(tmp_path: Path) -> None:
     assert result.stderr == ""
     assert "Network 2  Running lamp" in result.stdout
     assert "\\u2503" in result.stdout         # the rail, escaped, not lost
+
+
+def test_parse_value_takes_any_text_without_crashing() -> None:
+    """Any text is a number or a PlcConfigError (never ValueError or
+    OverflowError), and a float's repr within the REAL range reads back as
+    itself, as do the spellings --json writes for non-finite REALs."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    numbers = st.from_regex(r"[+-]?[0-9]{1,70}(\.[0-9]*)?(e[+-]?[0-9]{1,4})?", fullmatch=True)
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(st.one_of(st.text(max_size=80), numbers))
+    def any_text(text: str) -> None:
+        try:
+            parse_value(text)
+        except PlcConfigError as e:
+            assert e.message.startswith(("bad value", text.strip()[:10]))
+
+    @settings(max_examples=300, deadline=None, database=None)
+    @given(st.floats(min_value=-3.4e38, max_value=3.4e38))
+    def floats(x: float) -> None:
+        text = repr(x)
+        if "e" not in text and "." not in text:
+            text += ".0"
+        assert parse_value(text) == x
+
+    any_text()
+    floats()
+    from plcrt.engine.values import NONFINITE, json_number
+    for spelling, value in NONFINITE.items():
+        assert json_number(parse_value(spelling)) == spelling
+        assert json_number(value) == spelling

@@ -92,8 +92,17 @@ def test_unforce_by_symbol_releases_a_force_made_by_address(tmp_path: Path) -> N
 @pytest.mark.parametrize("command, message", [
     ("set I0.0=2", "error: I0.0: a bit takes 0 or 1, got 2"),
     ("force Q0.0 7", "error: Q0.0: a bit takes 0 or 1, got 7"),
-    ("set VD0=1e39", "error: VD0: 1e+39 is out of the range of a REAL"),
-    ("set VD0:REAL=-1e39", "error: VD0: -1e+39 is out of the range of a REAL"),
+    ("set VD0=1e39", "error: VD0: 1e39 is out of the range of a REAL"),
+    ("set VD0:REAL=-1e39", "error: VD0:REAL: -1e39 is out of the range of a REAL"),
+    # used to store infinity (the literal overflowed to inf before any check)
+    ("set VD0=1e999", "error: VD0: 1e999 is out of the range of a REAL"),
+    ("set VB0=-1", "error: VB0: -1 does not fit in a byte (BYTE), which takes 0 to 255"),
+    ("set SM0.0=0", "error: SM0.0: SMB0 (SM0.0 always on"),
+    # used to end in "internal error" (more digits than int() converts)
+    ("set VW0=" + "9" * 5000, "error: VW0: bad value '99999999999999999999...' (5000 "
+                              "characters): too long for a number"),
+    ("set VW0=" + "9" * 60, "error: VW0: 999999999999999999999999999999999999999999999999999999999999"
+                            " does not fit in a word"),
     ("run until VW0 >=", "error: cannot read the condition 'VW0 >='"),
 ])
 def test_values_and_conditions_that_cannot_be_used(command: str, message: str) -> None:

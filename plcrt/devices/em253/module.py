@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from ...errors import PlcConfigError
+from .. import AxisState
 from .axis import Axis, AxisPlant
 
 CLR_PULSE_US = 200_000  #: CLR output pulse length (manual 2.1: "about 200 ms")
@@ -125,16 +126,16 @@ class EM253Module:
             o |= 8
         return b, o
 
-    def snapshot(self, t: int) -> list[dict[str, Any]]:
+    def snapshot(self, t: int) -> list[AxisState]:
         out = []
         for i, ax in enumerate(self.axes):
             if i not in self.configured:
                 continue
-            out.append({
-                "slot": self.slot, "axis": i,
-                "position": ax.position(t), "mechanical": ax.mechanical(t),
-                "speed": ax.speed(t),
-                "status": "moving" if ax.moving else "stopped",
-                "masked": ax.masked, "stf": ax.stf,
-            })
+            out.append(AxisState(
+                slot=self.slot, axis=i,
+                position=ax.position(t), mechanical=ax.mechanical(t),
+                speed=ax.speed(t),
+                status="moving" if ax.moving else "stopped",
+                masked=ax.masked, stf=ax.stf,
+            ))
         return out

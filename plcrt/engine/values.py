@@ -1,0 +1,428 @@
+"""The values that cross plcrt's public boundary, and the one check of each.
+
+``plcrt.load``'s :class:`~plcrt.engine.Plc`, the test harness, the command
+line (``--set``, ``--watch``, ``--seconds``) and the debugger all take
+values from a user: a number for an address, a read format (``VD4:REAL``),
+a duration, a number of scans, a number written as text.  Each kind has
+exactly one table or function here, so every entry point accepts and
+refuses the same things with the same words:
+
+* :func:`check_value` -- a Python number for a location of a given width
+  (the S7-200 data types: bit; BYTE unsigned; INT/WORD and DINT/DWORD
+  either signed or unsigned; REAL in a double word);
+* :data:`FORMATS` and :func:`split_format` -- the ``:FORMAT`` suffixes of
+  an address;
+* :func:`parse_number` -- a number written as text (``12``, ``-3``,
+  ``16#FF``, ``2#1010``, ``1.5``, ``2e3``, ``NaN``, ``Infinity``);
+* :func:`duration` and :func:`scan_total` -- how long to run;
+* :data:`NONFINITE` -- how a non-finite REAL is spelled in text and JSON;
+* :func:`source_items`, :func:`check_load_options` and
+  :func:`check_parsed_inputs` -- the program, files and options of
+  :func:`plcrt.load`.
+
+Every refusal is a :class:`~plcrt.errors.PlcAddressError` (a value for an
+address) or :class:`~plcrt.errors.PlcConfigError` (an option) that says
+what was expected.  This module does not know where addresses live; the
+engine locates them and passes the width.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import re
+import struct
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any, Union
+
+from ..errors import PlcAddressError, PlcConfigError
+from ..safetext import printable
+
+Number = Union[int, float]
+Duration = Union[int, float, str]
+
+# ---------------------------------------------------------------------------
+# Values for addresses
+# ---------------------------------------------------------------------------
+
+#: accepted integers by width in bytes (System Manual, "Data types"): a
+#: byte is BYTE only, 0..255 -- the S7-200 has no signed byte -- while a
+#: word may hold an INT or a WORD and a double word a DINT or a DWORD, so
+#: both the signed and the unsigned range are accepted (-1 and 65535 are
+#: the same word).
+INT_RANGES: dict[int, tuple[int, int]] = {
+    1: (0, 0xFF),
+    2: (-0x8000, 0xFFFF),
+    4: (-0x8000_0000, 0xFFFF_FFFF),
+}
+_TYPE_NAMES = {1: "a byte (BYTE)", 2: "a word (INT or WORD)", 4: "a double word (DINT or DWORD)"}
+
+_F32 = struct.Struct(">f")
+REAL_RANGE = "about -3.4e38 to 3.4e38"
+
+
+def _shown(value: Any) -> str:
+    """``repr(value)`` short enough for one line of a message."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 200:
+        # str() of a huge int is slow, and refused above 4300 digits
+        return f"{'-' if value < 0 else ''}a {value.bit_length()}-bit integer"
+    text = printable(repr(value))
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def as_number(address: str, value: Any) -> Number:
+    """``value`` as a Python int or float: bools, numpy scalars, Decimal and
+    Fraction are taken as the number they are.
+
+    Raises:
+        PlcAddressError: ``value`` is not a number.
+    """
+    if isinstance(value, bool):
+        return int(value)
+    if isinstance(value, (int, float)):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    if hasattr(value, "item") and getattr(value, "shape", None) == ():
+        item = value.item()   # numpy.bool_ and other 0-d numpy values
+        if isinstance(item, (int, float)):
+            return int(item) if isinstance(item, bool) else item
+    raise PlcAddressError(f"{address}: {_shown(value)} is not a number (expected an int, "
+                          f"a float or a bool, got {type(value).__name__})")
+
+
+def check_value(address: str, width: int, value: Any) -> Number:
+    """``value`` checked for a location of ``width`` bytes (0 = a bit): the
+    value to store, an int, or a float for a REAL.
+
+    * a bit takes 0 or 1 (False, True);
+    * a byte 0..255, a word -32768..65535, a double word
+      -2147483648..4294967295 (see :data:`INT_RANGES`);
+    * a float goes to a double word as a REAL if single precision can hold
+      it: a finite value beyond about 3.4e38 is refused, while NaN and the
+      infinities are stored as such (the REAL format has them, and the
+      CPU's arithmetic produces them);
+    * elsewhere a float must be a whole number (2.0 stores 2).
+
+    Raises:
+        PlcAddressError: the value does not fit, saying what does.
+    """
+    v = as_number(address, value)
+    if width == 0:
+        if v not in (0, 1):
+            raise PlcAddressError(f"{address}: a bit takes 0 or 1, got {_shown(value)}")
+        return 1 if v else 0
+    if isinstance(v, float):
+        if width == 4:
+            try:
+                _F32.pack(v)
+            except OverflowError:
+                raise PlcAddressError(f"{address}: {_shown(value)} is out of the range of "
+                                      f"a REAL ({REAL_RANGE})") from None
+            return v
+        if not v.is_integer():
+            raise PlcAddressError(f"{address}: a real value needs a double word (VD, MD, ...), "
+                                  f"got {_shown(value)}")
+        v = int(v)
+    lo, hi = INT_RANGES[width]
+    if not lo <= v <= hi:
+        extra = "; an S7-200 byte is unsigned" if width == 1 and v < 0 else ""
+        raise PlcAddressError(f"{address}: {_shown(value)} does not fit in "
+                              f"{_TYPE_NAMES[width]}, which takes {lo} to {hi}{extra}")
+    return v
+
+
+# ---------------------------------------------------------------------------
+# Read formats
+# ---------------------------------------------------------------------------
+
+#: the ``:FORMAT`` suffixes of an address (``VD4:REAL``, ``T37:BIT``) and
+#: what each reads; the API's ``read(address, format)``, ``--watch``, the
+#: harness, traces and the debugger all use this table
+FORMATS: dict[str, str] = {
+    "REAL": "a double word as a float (REAL)",
+    "BIT": "the bit of a timer or counter (T37:BIT)",
+}
+#: other spellings accepted for a format
+FORMAT_ALIASES: dict[str, str] = {"R": "REAL"}
+
+
+def check_format(fmt: Any, spec: str, *, suffix: bool = False) -> str:
+    """The canonical name of a format (``"REAL"``, ``"BIT"``, or ``""``
+    for none), case and blanks ignored; ``suffix`` says it was written
+    after the address (``VD4:REAL``), for the message.
+
+    Raises:
+        PlcAddressError: an unknown format, naming the accepted ones.
+    """
+    if fmt is None:
+        return ""
+    if not isinstance(fmt, str):
+        raise PlcAddressError(f"{spec}: a format is a string such as 'REAL', got "
+                              f"{type(fmt).__name__} {_shown(fmt)}")
+    name = fmt.strip().upper()
+    name = FORMAT_ALIASES.get(name, name)
+    if name and name not in FORMATS:
+        known = "; ".join(f":{k} reads {v}" for k, v in FORMATS.items())
+        shown = printable(fmt.strip())[:40]
+        what = f"suffix ':{shown}'" if suffix else f"format {shown!r}"
+        raise PlcAddressError(f"{spec}: unknown {what} ({known})")
+    return name
+
+
+def check_address(address: Any) -> str:
+    """``address`` as a stripped string.
+
+    Raises:
+        PlcAddressError: not a string, or empty.
+    """
+    if not isinstance(address, str):
+        raise PlcAddressError(f"an address is a string such as 'VW100', 'Q0.0' or a symbol "
+                              f"name, got {type(address).__name__} {_shown(address)}")
+    text = address.strip()
+    if not text:
+        raise PlcAddressError("an address is a string such as 'VW100', 'Q0.0' or a symbol "
+                              "name, got an empty string")
+    return text
+
+
+def split_format(spec: Any, fmt: Any = None) -> tuple[str, str]:
+    """``(address, format)`` of ``"VD4:REAL"`` or of ``("VD4", "REAL")``;
+    the format is canonical (see :func:`check_format`).
+
+    Raises:
+        PlcAddressError: a bad address or format, or a format given twice.
+    """
+    text = check_address(spec)
+    addr, sep, suffix = text.rpartition(":")
+    if sep:
+        addr = addr.strip()
+        if not addr:
+            raise PlcAddressError(f"{printable(text)[:60]!r}: an address must come before "
+                                  f"':{printable(suffix.strip())[:20]}'")
+        name = check_format(suffix, printable(text)[:60], suffix=True)
+        if fmt is not None and check_format(fmt, addr) != name:
+            raise PlcAddressError(f"{printable(text)[:60]}: the format is given twice "
+                                  f"(also as {_shown(fmt)}); give it once")
+        return addr, name
+    return text, check_format(fmt, printable(text)[:60])
+
+
+# ---------------------------------------------------------------------------
+# Numbers written as text (--set, the debugger, test conditions)
+# ---------------------------------------------------------------------------
+
+#: how non-finite REALs are written in text and JSON (JSON has no token for
+#: them); :func:`parse_number` reads the same spellings back
+NONFINITE: dict[str, float] = {"NaN": math.nan, "Infinity": math.inf,
+                               "-Infinity": -math.inf}
+_NONFINITE_IN = {k.upper(): v for k, v in NONFINITE.items()}
+_NONFINITE_IN.update({"+INFINITY": math.inf, "INF": math.inf, "+INF": math.inf,
+                      "-INF": -math.inf})
+
+# After the STL constant forms (16#FF, 2#1010) so a value can be copied
+# from a program.  Reals need a dot or an exponent.
+_DEC_RE = re.compile(r"[+-]?\d+")
+_HEX_RE = re.compile(r"16#([0-9A-Fa-f][0-9A-Fa-f_]*)")
+_BIN_RE = re.compile(r"2#([01][01_]*)")
+_REAL_RE = re.compile(r"[+-]?(\d+\.\d*|\.\d+|\d+(?=[eE]))([eE][+-]?\d+)?")
+#: longer than any value a location holds needs (a REAL's 9 significant
+#: digits and an exponent, or a 32-bit binary constant)
+MAX_NUMBER_TEXT = 64
+
+NUMBER_FORMS = ("a decimal (12, -3), 16#hex, 2#binary, a real (1.5, 2e3) "
+                "or NaN, Infinity, -Infinity")
+
+
+def parse_number(text: str) -> Number:
+    """A number written as text: decimal, ``16#hex``, ``2#binary``, a real
+    (``1.5``, ``2e3``) or a non-finite REAL (``NaN``, ``Infinity``,
+    ``-Infinity``, also ``inf``).
+
+    Raises:
+        PlcConfigError: anything else, a real literal beyond the REAL range
+            (``1e999``: it would silently become infinity) or a text too
+            long to be a value of any location.
+    """
+    t = text.strip()
+    if len(t) > MAX_NUMBER_TEXT:
+        raise PlcConfigError(f"bad value '{printable(t[:20])}...' ({len(t)} characters): "
+                             f"too long for a number; use {NUMBER_FORMS}")
+    if _DEC_RE.fullmatch(t):
+        return int(t)
+    m = _HEX_RE.fullmatch(t)
+    if m:
+        return int(m.group(1).replace("_", ""), 16)
+    m = _BIN_RE.fullmatch(t)
+    if m:
+        return int(m.group(1).replace("_", ""), 2)
+    if _REAL_RE.fullmatch(t):
+        v = float(t)
+        try:
+            _F32.pack(v)
+        except OverflowError:
+            v = math.inf
+        if math.isinf(v):
+            raise PlcConfigError(f"{t} is out of the range of a REAL ({REAL_RANGE}); "
+                                 f"write Infinity or -Infinity for an infinite REAL")
+        return v
+    special = _NONFINITE_IN.get(t.upper())
+    if special is not None:
+        return special
+    raise PlcConfigError(f"bad value '{printable(t)}': use {NUMBER_FORMS}")
+
+
+def json_number(value: Number) -> Number | str:
+    """A value for strict JSON: non-finite floats as the strings of
+    :data:`NONFINITE` (``"NaN"``, ``"Infinity"``, ``"-Infinity"``)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
+    return value
+
+
+# ---------------------------------------------------------------------------
+# How long to run
+# ---------------------------------------------------------------------------
+
+_UNITS = {"us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0}
+_DURATION_RE = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(us|µs|ms|s|sec|min|h)?\s*$")
+
+
+def duration(d: Any, what: str = "") -> float:
+    """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``,
+    ``"250us"``, ``"2min"``, ``"1h"``.
+
+    ``what`` names the argument in messages.
+
+    Raises:
+        PlcConfigError: not a finite, non-negative number of seconds.
+    """
+    where = f"{what}: " if what else ""
+    forms = "write e.g. 2, '1.5s', '200ms', '2min'"
+    if isinstance(d, str):
+        m = _DURATION_RE.match(d) if len(d) <= MAX_NUMBER_TEXT else None
+        if m is None:
+            raise PlcConfigError(f"{where}not a duration: {_shown(d)} ({forms})")
+        value = float(m.group(1)) * _UNITS[m.group(2) or "s"]
+    elif isinstance(d, numbers.Real) and not isinstance(d, bool):
+        value = float(d)
+    else:
+        raise PlcConfigError(f"{where}not a duration: {type(d).__name__} {_shown(d)} "
+                             f"(a number of seconds or a string; {forms})")
+    if not (math.isfinite(value) and value >= 0):
+        raise PlcConfigError(f"{where}a duration must be a non-negative, finite time, "
+                             f"got {_shown(d)}")
+    return value
+
+
+def scan_number(n: Any, what: str = "the number of scans") -> int:
+    """A number of scans: a non-negative whole number (numpy ints too).
+
+    Raises:
+        PlcConfigError: a negative, fractional or non-numeric count.
+    """
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral):
+        if isinstance(n, float) and n.is_integer():
+            raise PlcConfigError(f"{what} must be an int, got the float {_shown(n)}; "
+                                 f"write {int(n)}")
+        raise PlcConfigError(f"{what} must be a whole number (an int), got "
+                             f"{type(n).__name__} {_shown(n)}")
+    n = int(n)
+    if n < 0:
+        raise PlcConfigError(f"{what} must not be negative, got {n}")
+    return n
+
+
+def scan_total(scan_us: int, seconds: Any = None, scans: Any = None) -> int:
+    """How many scans ``run(seconds=...)`` or ``run(scans=...)`` runs: a
+    duration is rounded up to whole scans (a partial last scan is a scan).
+
+    Raises:
+        PlcConfigError: neither or both given, or a bad value.
+    """
+    if (seconds is None) == (scans is None):
+        raise PlcConfigError("give exactly one of seconds (a duration such as 1.5 or '1.5s') "
+                             "or scans=")
+    if scans is not None:
+        return scan_number(scans, "scans")
+    us = int(round(duration(seconds, "seconds") * 1e6))
+    return -(-us // scan_us)
+
+
+# ---------------------------------------------------------------------------
+# The arguments of plcrt.load() and Plc()
+# ---------------------------------------------------------------------------
+
+#: the keyword options of load() besides symbols, data, scan_ms and cpu
+LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols")
+
+_SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
+
+
+def source_items(sources: Any) -> list[str | Path]:
+    """The program sources of load() as a list, each checked.
+
+    ``bytes`` are refused rather than guessed at: a file's path lets plcrt
+    read and decode it as Micro/WIN wrote it (see docs/decisions.md).
+    """
+    if isinstance(sources, (str, Path, bytes, bytearray, Mapping)) \
+            or not isinstance(sources, Iterable):
+        items = [sources]
+    else:
+        items = list(sources)
+        if not items:
+            raise PlcConfigError("no program given: the list of program files is empty")
+    for x in items:
+        _check_text_or_path(x, "the program", _SOURCE_FORMS + ", or a list of them")
+    return items
+
+
+def _check_text_or_path(x: Any, what: str, forms: str) -> None:
+    if isinstance(x, (bytes, bytearray)):
+        raise PlcConfigError(f"{what} is {type(x).__name__}; give {forms} -- to load a file "
+                             f"pass its path, which plcrt reads and decodes as Micro/WIN "
+                             f"wrote it, or decode the bytes to str first")
+    if isinstance(x, str) and not x.strip():
+        raise PlcConfigError(f"{what} is an empty string; give {forms}")
+    if not isinstance(x, (str, Path)):
+        raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
+
+
+def check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str, Any]) -> None:
+    """load()'s file arguments given as text or paths, and its options."""
+    unknown = sorted(k for k in options if k not in LOAD_OPTIONS)
+    if unknown:
+        raise PlcConfigError(f"load() got unknown option(s) {', '.join(map(repr, unknown))}; "
+                             f"the options are symbols, data, scan_ms, cpu, encoding, "
+                             f"{', '.join(LOAD_OPTIONS)}")
+    for what, x in (("symbols", symbols), ("data", data), ("plant", plant)):
+        if isinstance(x, (str, bytes, bytearray)):
+            _check_text_or_path(x, what, "a file path or the file's text")
+
+
+def check_parsed_inputs(symbols: Any, data: Any, plant: Any) -> None:
+    """Plc()'s symbols, data and plant: parsed, or None."""
+    from ..devices.plant import Plant
+    from ..lang import DataBlock, SymbolTable
+    for what, x, kind, forms in (
+            ("symbols", symbols, SymbolTable, "a symbol table's path or text, or a "
+                                              "plcrt.lang.SymbolTable"),
+            ("data", data, DataBlock, "a data block's path or text, or a plcrt.lang.DataBlock"),
+            ("plant", plant, Plant, "a plant file's path or TOML text, a dict, or a "
+                                    "plcrt.devices.plant.Plant")):
+        if x is not None and not isinstance(x, kind):
+            raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
+
+
+def _typed(x: Any) -> str:
+    return f"{type(x).__name__} {_shown(x)[:40]}"
+
+
+__all__ = ["FORMATS", "FORMAT_ALIASES", "INT_RANGES", "LOAD_OPTIONS", "NONFINITE",
+           "NUMBER_FORMS", "as_number", "check_address", "check_format",
+           "check_load_options", "check_parsed_inputs", "check_value", "duration",
+           "json_number", "parse_number", "scan_number", "scan_total", "source_items",
+           "split_format"]

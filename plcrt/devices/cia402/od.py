@@ -67,6 +67,9 @@ ABORT_CODES: dict[int, str] = {
     0x08000022: "data cannot be transferred or stored because of the present device state",
 }
 
+#: Dictionaries already read, by (path, mtime, size); they are not changed after loading.
+_LOADED: dict[tuple[str, int, int], "ObjectDictionary"] = {}
+
 _KEYS_REQUIRED = ("index", "sub", "name", "type", "access", "default", "source")
 _KEYS_OPTIONAL = ("pdo", "min", "max", "unit", "effect", "when", "values")
 
@@ -198,7 +201,11 @@ class ObjectDictionary:
         for d in library_dirs():
             path = d / f"{model}.toml"
             if path.is_file():
-                return cls.from_file(path)
+                stat = path.stat()
+                key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+                if key not in _LOADED:
+                    _LOADED[key] = cls.from_file(path)
+                return _LOADED[key]
         known = ", ".join(cls.models()) or "none"
         raise PlcConfigError(f"unknown CiA 402 drive model {model!r}; known models: {known}")
 

@@ -217,15 +217,15 @@ class ObjectDictionary:
             text = path.read_text(encoding="utf-8")
             data = tomllib.loads(text)
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
-            raise PlcConfigError(f"{path}: cannot read object dictionary: {e}",
+            raise PlcConfigError(f"cannot read object dictionary: {e}",
                                  SourceLoc(str(path), 1, 1)) from None
         info = data.get("model")
         if not isinstance(info, dict) or not isinstance(info.get("name"), str):
-            raise PlcConfigError(f"{path}: missing [model] table with a name",
+            raise PlcConfigError("missing [model] table with a name",
                                  SourceLoc(str(path), 1, 1))
         rows = data.get("dictionary", {}).get("entries")
         if not isinstance(rows, list) or not rows:
-            raise PlcConfigError(f"{path}: missing [dictionary] table with an 'entries' array",
+            raise PlcConfigError("missing [dictionary] table with an 'entries' array",
                                  SourceLoc(str(path), 1, 1))
         lines = [n for n, line in enumerate(text.splitlines(), 1) if line.lstrip().startswith("{")]
         entries: list[Entry] = []
@@ -233,9 +233,9 @@ class ObjectDictionary:
         for i, row in enumerate(rows):
             line = lines[i] if len(lines) == len(rows) else 1
             loc = SourceLoc(str(path), line, 1)
-            entry = _entry(row, i, loc, path)
+            entry = _entry(row, i, loc)
             if (entry.index, entry.sub) in seen:
-                raise PlcConfigError(f"{path}:{line}: {entry.label}: duplicate entry", loc)
+                raise PlcConfigError(f"entry #{i + 1} {entry.label}: duplicate entry", loc)
             seen.add((entry.index, entry.sub))
             entries.append(entry)
         od = cls(info["name"], info, entries, path)
@@ -248,7 +248,7 @@ class ObjectDictionary:
         def fail(e: Entry, msg: str) -> None:
             where = {(r.get("index"), r.get("sub")): n for r, n in zip(rows, lines or [])}
             line = where.get((e.index, e.sub), 1)
-            raise PlcConfigError(f"{self.path}:{line}: {e.label}: {msg}",
+            raise PlcConfigError(f"{e.label}: {msg}",
                                  SourceLoc(str(self.path), line, 1))
         for index, subs in self._subs.items():
             if len(subs) > 1 or subs[0].sub != 0:
@@ -362,10 +362,10 @@ class ObjectDictionary:
                                        f"({self.info.get('pdo_source', head.source)})")
 
 
-def _entry(row: Any, i: int, loc: SourceLoc, path: Path) -> Entry:
+def _entry(row: Any, i: int, loc: SourceLoc) -> Entry:
     """Check one TOML row and make its :class:`Entry`."""
     name = row.get("name", f"entry #{i + 1}") if isinstance(row, dict) else f"entry #{i + 1}"
-    where = f"{path}:{loc.line}: entry #{i + 1}"
+    where = f"entry #{i + 1}"
 
     def bad(msg: str) -> PlcConfigError:
         label = name

@@ -231,7 +231,7 @@ def test_invalid_default_mapping_is_located(tmp_path: Path) -> None:
         '  { index = 0x1600, sub = 1, name = "e", type = "U32", access = "rw", default = 0x60410010, source = "x" },\n'
         '  { index = 0x6041, sub = 0, name = "S", type = "U16", access = "ro", pdo = "tx", default = 0, source = "x" },\n'
         ']\n', encoding="utf-8")
-    with pytest.raises(PlcConfigError, match=r"map\.toml:6: 1600h:01 .*default mapping is invalid.*TXPDO"):
+    with pytest.raises(PlcConfigError, match=r"map\.toml:6:1: error: 1600h:01 .*default mapping is invalid.*TXPDO"):
         ObjectDictionary.from_file(path)
 
 

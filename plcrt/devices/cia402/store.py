@@ -128,6 +128,28 @@ class Store:
             self.events.extend(done)
             return done
 
+    def mapped(self, map_index: int) -> list[Entry]:
+        """The objects a PDO mapping object (16xxh/1Axxh) maps now, in order.
+
+        Raises:
+            SdoAbort: the object is not a mapping object (0x06020000), or an
+                entry within the count is invalid (the mapping codes).
+        """
+        if not is_map(map_index):
+            raise SdoAbort(0x06020000, f"{map_index:04X}h is not a PDO mapping object "
+                                       f"(1600h-17FFh, 1A00h-1BFFh)")
+        with self.lock:
+            count = int(self.get(map_index, 0))
+            out = []
+            for k in range(1, count + 1):
+                target = self.od.check_mapping(self.od.entry(map_index, k),
+                                               int(self._active[(map_index, k)]))
+                if target is None:
+                    raise SdoAbort(0x06040041, f"{obj(map_index, k)} is empty but "
+                                               f"{obj(map_index, 0)} counts {count}")
+                out.append(target)
+            return out
+
     # -- hooks -------------------------------------------------------------
     def on_check(self, callback: Hook) -> Callable[[], None]:
         """Call ``callback(write)`` before a master's write is stored; it may

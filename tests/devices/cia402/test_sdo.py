@@ -271,6 +271,7 @@ def test_hcfa_mapping_procedure() -> None:
     w(0x1C12, 0, u(2, 1))                       # G
     w(0x1C13, 0, u(1, 1))
     assert [store.get(0x1601, k) for k in range(1, 9)] == entries
+    assert [(e.index, e.sub) for e in store.mapped(0x1601)] == [(v >> 16, (v >> 8) & 0xFF) for v in entries]
     assert (store.get(0x1C12, 0), store.get(0x1C12, 1), store.get(0x1C12, 2)) == (2, 0x1601, 0x1603)
 
 
@@ -285,6 +286,17 @@ def test_hcfa_pdo_of_exactly_32_bytes() -> None:
     store.sdo_write(0x1A01, 0, u(8, 1))
     assert store.get(0x1A01, 0) == 8
     assert max(e.bits for e in store.od if e.pdo) <= 32
+
+
+@pytest.mark.parametrize("model", ["hcfa-am0520b", "kinco-servo"])
+def test_default_maps_resolve(model: str) -> None:
+    """Every default map resolves to its objects; a non-map index is refused."""
+    store = Store(ObjectDictionary.load(model))
+    assert [e.index for e in store.mapped(0x1600)][0] == 0x6040
+    assert [e.index for e in store.mapped(0x1A00)][0] == 0x6041
+    with pytest.raises(SdoAbort) as info:
+        store.mapped(0x6040)
+    assert info.value.code == 0x06020000
 
 
 def test_kinco_can_pdo_of_8_bytes() -> None:

@@ -18,6 +18,7 @@ The canopen ``ObjectDictionary``/EDS view of the same data is in
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,6 +67,8 @@ ABORT_CODES: dict[int, str] = {
     0x08000000: "general error",
     0x08000022: "data cannot be transferred or stored because of the present device state",
 }
+
+_MODEL_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 #: Dictionaries already read, by (path, mtime, size); they are not changed after loading.
 _LOADED: dict[tuple[str, int, int], "ObjectDictionary"] = {}
@@ -198,7 +201,7 @@ class ObjectDictionary:
             PlcConfigError: unknown model (naming the known ones), or a
                 malformed file (naming the file, line and entry).
         """
-        for d in library_dirs():
+        for d in library_dirs() if _MODEL_NAME.fullmatch(model) else ():
             path = d / f"{model}.toml"
             if path.is_file():
                 stat = path.stat()
@@ -223,7 +226,8 @@ class ObjectDictionary:
         if not isinstance(info, dict) or not isinstance(info.get("name"), str):
             raise PlcConfigError("missing [model] table with a name",
                                  SourceLoc(str(path), 1, 1))
-        rows = data.get("dictionary", {}).get("entries")
+        table = data.get("dictionary")
+        rows = table.get("entries") if isinstance(table, dict) else None
         if not isinstance(rows, list) or not rows:
             raise PlcConfigError("missing [dictionary] table with an 'entries' array",
                                  SourceLoc(str(path), 1, 1))

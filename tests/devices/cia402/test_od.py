@@ -29,6 +29,8 @@ def test_unknown_model_names_the_known_ones() -> None:
     assert "hcfa-am0520b, kinco-servo" in str(info.value)
     with pytest.raises(PlcConfigError, match="known models"):
         object_dictionary("nope")
+    with pytest.raises(PlcConfigError, match="known models"):
+        ObjectDictionary.load("../cia402/hcfa-am0520b")
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -239,6 +241,7 @@ def test_invalid_default_mapping_is_located(tmp_path: Path) -> None:
     ("[model\n", "cannot read object dictionary"),
     ('[dictionary]\nentries = []\n', "missing [model] table"),
     ('[model]\nname = "x"\n', "missing [dictionary] table"),
+    ('[model]\nname = "x"\ndictionary = 5\n', "missing [dictionary] table"),
 ])
 def test_malformed_file(tmp_path: Path, text: str, message: str) -> None:
     path = tmp_path / "f.toml"

@@ -363,3 +363,31 @@ def test_set_checks_the_type() -> None:
         store.set(0x6042, 0, 1)
     store.set(0x6064, 0, -(1 << 31))
     assert store.sdo_read(0x6064, 0) == bytes.fromhex("00000080")
+
+
+def test_range_limits_of_every_entry(od: ObjectDictionary) -> None:
+    """For every writable entry: its min and max are accepted, one beyond
+    aborts with 0x06090032 / 0x06090031 (when the type can carry it), and a
+    value outside ``values`` aborts with 0x06090030."""
+    from plcrt.devices.cia402.od import DTYPES
+    store = Store(od)
+    for e in od:
+        if e.access != "rw" or e.dtype == "STR" or e.when == "preop":
+            continue
+        lo, hi = DTYPES[e.dtype][1:]
+        if e.values is not None:
+            for v in e.values:
+                store.sdo_write(e.index, e.sub, e.encode(v))
+            outside = next(v for v in range(lo, hi + 1) if v not in e.values)
+            with pytest.raises(SdoAbort) as info:
+                store.sdo_write(e.index, e.sub, e.encode(outside))
+            assert info.value.code == 0x06090030, e.label
+            continue
+        for v in (e.low, e.high):
+            store.sdo_write(e.index, e.sub, e.encode(v))
+            assert store.stored(e.index, e.sub) == v
+        for v, code in ((e.low - 1, 0x06090032), (e.high + 1, 0x06090031)):
+            if lo <= v <= hi:
+                with pytest.raises(SdoAbort) as info:
+                    store.sdo_write(e.index, e.sub, e.encode(v))
+                assert info.value.code == code, e.label

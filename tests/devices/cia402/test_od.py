@@ -184,39 +184,37 @@ def test_kinco_homing_objects() -> None:
 
 # -- malformed files -------------------------------------------------------------
 
-GOOD = '{ index = 0x6040, sub = 0, name = "Controlword", type = "U16", access = "rw", default = 0, source = "x" }'
+def row(**keys: str | None) -> str:
+    """A one-line TOML entry: a valid controlword row with some keys
+    replaced (value None drops the key)."""
+    base = {"index": "0x6040", "sub": "0", "name": '"Controlword"', "type": '"U16"',
+            "access": '"rw"', "default": "0", "source": '"x"'}
+    base.update(keys)
+    return "{ " + ", ".join(f"{k} = {v}" for k, v in base.items() if v is not None) + " }"
 
 
-@pytest.mark.parametrize("row, message", [
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U17", access = "rw", default = 0, source = "x" }',
-     "type = 'U17'"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rx", default = 0, source = "x" }',
-     "access = 'rx'"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rw", source = "x" }',
-     "missing key 'default'"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rw", default = 70000, source = "x" }',
-     "default = 70000 is outside the range of U16"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rw", default = 5, min = 6, source = "x" }',
-     "default 5 is outside 6..65535"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rw", default = 0, colour = 1, source = "x" }',
-     "unknown key 'colour'"),
-    ('{ index = 0x6040, sub = 0, name = "C", type = "U16", access = "rw", default = 0, when = "later", source = "x" }',
-     "when = 'later'"),
-    ('{ index = "6040", sub = 0, name = "C", type = "U16", access = "rw", default = 0, source = "x" }',
-     "index must be an integer"),
-    ('{ index = 0x6041, sub = 0, name = "S", type = "U16", access = "ro", default = 0, min = 9, max = 3, source = "x" }',
-     "min 9 is above max 3"),
-    ('{ index = 0x6060, sub = 0, name = "M", type = "I8", access = "rw", default = 2, values = [1, 3], source = "x" }',
-     "default 2 is not one of the values"),
+GOOD = row()
+
+
+@pytest.mark.parametrize("bad, message", [
+    (row(type='"U17"'), "type = 'U17'"),
+    (row(access='"rx"'), "access = 'rx'"),
+    (row(default=None), "missing key 'default'"),
+    (row(default="70000"), "default = 70000 is outside the range of U16"),
+    (row(default="5", min="6"), "default 5 is outside 6..65535"),
+    (row(colour="1"), "unknown key 'colour'"),
+    (row(when='"later"'), "when = 'later'"),
+    (row(index='"6040"'), "index must be an integer"),
+    (row(index="0x6041", min="9", max="3"), "min 9 is above max 3"),
+    (row(index="0x6060", type='"I8"', default="2", values="[1, 3]"), "default 2 is not one of the values"),
     (GOOD, "duplicate entry"),
-    ('{ index = 0x1600, sub = 1, name = "E", type = "U32", access = "rw", default = 0x60400010, source = "x" }',
-     "has subindexes but no U8 subindex 0"),
+    (row(index="0x1600", sub="1", type='"U32"', default="0x60400010"), "has subindexes but no U8 subindex 0"),
 ])
-def test_malformed_row_is_located(tmp_path: Path, row: str, message: str) -> None:
+def test_malformed_row_is_located(tmp_path: Path, bad: str, message: str) -> None:
     """A bad row is a PlcConfigError naming the file, the row's line and the
     entry, never a traceback."""
     path = tmp_path / "bad.toml"
-    path.write_text(f'[model]\nname = "bad"\n[dictionary]\nentries = [\n  {GOOD},\n  {row},\n]\n',
+    path.write_text(f'[model]\nname = "bad"\n[dictionary]\nentries = [\n  {GOOD},\n  {bad},\n]\n',
                     encoding="utf-8")
     with pytest.raises(PlcConfigError) as info:
         ObjectDictionary.from_file(path)
@@ -227,14 +225,15 @@ def test_malformed_row_is_located(tmp_path: Path, row: str, message: str) -> Non
 
 
 def test_invalid_default_mapping_is_located(tmp_path: Path) -> None:
+    """A default map naming a TxPDO object in an RxPDO is refused at load."""
     path = tmp_path / "map.toml"
-    path.write_text(
-        '[model]\nname = "map"\n[dictionary]\nentries = [\n'
-        '  { index = 0x1600, sub = 0, name = "n", type = "U8", access = "rw", default = 1, source = "x" },\n'
-        '  { index = 0x1600, sub = 1, name = "e", type = "U32", access = "rw", default = 0x60410010, source = "x" },\n'
-        '  { index = 0x6041, sub = 0, name = "S", type = "U16", access = "ro", pdo = "tx", default = 0, source = "x" },\n'
-        ']\n', encoding="utf-8")
-    with pytest.raises(PlcConfigError, match=r"map\.toml:6:1: error: 1600h:01 .*default mapping is invalid.*TXPDO"):
+    rows = [row(index="0x1600", name='"n"', type='"U8"', default="1"),
+            row(index="0x1600", sub="1", name='"e"', type='"U32"', default="0x60410010"),
+            row(index="0x6041", name='"S"', access='"ro"', pdo='"tx"')]
+    path.write_text('[model]\nname = "map"\n[dictionary]\nentries = [\n'
+                    + "".join(f"  {r},\n" for r in rows) + "]\n", encoding="utf-8")
+    with pytest.raises(PlcConfigError,
+                       match=r"map\.toml:6:1: error: 1600h:01 .*default mapping is invalid.*TXPDO"):
         ObjectDictionary.from_file(path)
 
 

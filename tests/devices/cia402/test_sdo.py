@@ -6,6 +6,8 @@ write hooks."""
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from plcrt.devices.cia402.od import ObjectDictionary, SdoAbort, Store, Write
 from plcrt.errors import PlcConfigError, PlcError
@@ -391,3 +393,19 @@ def test_range_limits_of_every_entry(od: ObjectDictionary) -> None:
                 with pytest.raises(SdoAbort) as info:
                     store.sdo_write(e.index, e.sub, e.encode(v))
                 assert info.value.code == code, e.label
+
+
+@given(data=st.data())
+@settings(max_examples=60, deadline=None)
+def test_sdo_bytes_round_trip(data: st.DataObject) -> None:
+    """Any in-range value of any writable entry goes down and up the SDO path
+    unchanged, as little-endian bytes of the entry's size."""
+    od = ObjectDictionary.load(data.draw(st.sampled_from(["hcfa-am0520b", "kinco-servo"])))
+    entries = [e for e in od if e.access == "rw" and e.dtype != "STR" and e.when != "preop"]
+    e = data.draw(st.sampled_from(entries))
+    value = data.draw(st.sampled_from(e.values) if e.values else st.integers(e.low, e.high))
+    store = Store(od)
+    store.sdo_write(e.index, e.sub, e.encode(value))
+    raw = store.sdo_read(e.index, e.sub)
+    assert len(raw) == e.size
+    assert int.from_bytes(raw, "little", signed=e.dtype.startswith("I")) == value

@@ -1,7 +1,12 @@
 """Simulated CiA 402 bus drives: the HCFA AM0520B EtherCAT stepper and a Kinco
-servo (HCFA manual, Kinco homing slides; digest in docs/cia402.md).
+servo (HCFA manual, Kinco homing slides; the model and its decisions are in
+docs/cia402.md).
 
-The package holds the drive's object dictionary, its state machines (CiA 402
-power states in :mod:`.statemachine` over the tables of :mod:`.states` and
-:mod:`.reactions`, EtherCAT states in :mod:`.esm`) and its PDO mapping rules
-(:mod:`.pdo`); the modes, homing and the bus ports build on them."""
+:mod:`.od` holds the object dictionary (loaded from ``library/cia402/*.toml``)
+and :mod:`.store` the live values with their SDO rules; the CiA 402 power
+states are in :mod:`.statemachine` over the tables of :mod:`.states` and
+:mod:`.reactions`, the EtherCAT states in :mod:`.esm`, the PDO mapping rules
+in :mod:`.pdo`; :mod:`.cli` is the ``plcrt cia402`` command.  The modes,
+homing and the bus ports build on them.  The public facade is
+:mod:`plcrt.cia402`.
+"""

@@ -13,6 +13,9 @@ of the rendered Markdown does not see it:
     A ``console`` block without ``$`` lines that shows a debugger session:
     the commands after its ``(plcrt...)`` prompts are fed to the command
     on stdin, and the whole output must equal the block.
+``<!-- pytest module -->``
+    A ``python`` block that is a test module: pytest runs it and its tests
+    must pass.
 
 This module only reads and splits the files; it runs nothing.
 """
@@ -32,7 +35,8 @@ MARKDOWN = sorted([ROOT / "README.md", *(ROOT / "docs").glob("*.md"),
                    *(ROOT / "examples").rglob("README.md")])
 
 _FENCE = re.compile(r"^(?P<indent>\s*)```(?P<lang>[\w-]*)\s*$")
-_MARKER = re.compile(r"^<!--\s*(?P<kind>not run|debug transcript):(?P<arg>.*?)-->\s*$")
+_MARKER = re.compile(
+    r"^<!--\s*(?P<kind>not run|debug transcript|pytest module):?(?P<arg>.*?)-->\s*$")
 
 
 @dataclass(frozen=True)
@@ -44,7 +48,7 @@ class Block:
     line: int                 # 1-based line of the opening fence
     lang: str
     lines: tuple[str, ...]
-    marker: str | None        # "not run" or "debug transcript"
+    marker: str | None        # "not run", "debug transcript" or "pytest module"
     marker_arg: str           # the reason, or the debugger command line
 
     @property
@@ -81,6 +85,16 @@ def _marker_before(lines: list[str], fence: int) -> tuple[str | None, str]:
         j -= 1
     m = _MARKER.match(lines[j].strip()) if j >= 0 else None
     return (m["kind"], m["arg"].strip()) if m else (None, "")
+
+
+def mirror(folder: Path) -> Path:
+    """``folder`` with a link to every top-level entry of the repository
+    (but .git and .venv): relative paths of examples work there, and files
+    an example writes land in ``folder``, not in the clone."""
+    for entry in ROOT.iterdir():
+        if entry.name not in (".git", ".venv"):
+            (folder / entry.name).symlink_to(entry)
+    return folder
 
 
 def all_blocks(*langs: str) -> list[Block]:

@@ -30,8 +30,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from doc_blocks import (ROOT, Block, all_blocks, console_steps, matches,
-                        normalise_output)
+from doc_blocks import Block, all_blocks, console_steps, matches, mirror, normalise_output
 
 RUN = [b for b in all_blocks("console", "sh") if b.marker != "not run"]
 TIMEOUT = 300
@@ -47,9 +46,7 @@ def workdir(tmp_path: Path) -> tuple[Path, dict[str, str]]:
     an environment whose ``plcrt`` and ``python`` are this interpreter."""
     work = tmp_path / "repo"
     work.mkdir()
-    for entry in ROOT.iterdir():
-        if entry.name not in (".git", ".venv"):
-            (work / entry.name).symlink_to(entry)
+    mirror(work)
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
     for name, args in (("plcrt", '-m plcrt "$@"'), ("python", '"$@"')):

@@ -7,10 +7,11 @@ BIN     = $(VENV)/bin
 
 .PHONY: demo test bench setup clean
 
+# pip -qq: only errors, so that `make demo` starts with the demo
 $(BIN)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install -qq --upgrade pip
+	$(BIN)/python -m pip install -qq -e '.[test]'
 	touch $@
 
 setup: $(BIN)/.installed

@@ -169,7 +169,7 @@ def _build_parser() -> _Parser:
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",
                        description="Print the Python the program compiles to, network by "
                                    "network, each instruction's code under its STL line.")
-    common(p, data=False, plant=False)
+    common(p)
     p.set_defaults(func=cmd_dump)
     for name in _COMMAND_MODULES:
         try:

@@ -1,11 +1,50 @@
 """Shared test set-up: makes the helper modules in ``tests/`` importable
-(``stl_helpers``, ``reference_interp``) from the mirrored sub-folders."""
+(``stl_helpers``, ``reference_interp``) from the mirrored sub-folders, and
+says in the report header and the summary when the tests of the shared
+real-file corpus were skipped because the corpus is not there."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
+import pytest
+
 _TESTS = str(Path(__file__).resolve().parent)
 if _TESTS not in sys.path:
     sys.path.insert(0, _TESTS)
+
+# The corpus of real Micro/WIN exports is read where the test modules look for
+# it: ../shared/corpus beside the repository (read-only, never copied in).
+CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
+
+
+def corpus_note() -> str | None:
+    """Why corpus tests skip, or None when the corpus is there."""
+    if CORPUS.is_dir():
+        return None
+    return (f"the real-file corpus is not at {CORPUS} "
+            f"(README.md, 'Running the tests', says how to get them run)")
+
+
+def pytest_report_header(config: pytest.Config) -> str | None:
+    note = corpus_note()
+    return None if note is None else f"corpus tests will skip: {note}"
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus: int,  # noqa: ANN001
+                            config: pytest.Config) -> None:
+    note = corpus_note()
+    if note is None:
+        return
+    skipped = [rep for rep in terminalreporter.stats.get("skipped", [])
+               if "corpus" in _skip_reason(rep)]
+    if skipped:
+        terminalreporter.write_line(f"{len(skipped)} corpus tests skipped: {note}")
+
+
+def _skip_reason(report: pytest.TestReport) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2])
+    return str(longrepr)

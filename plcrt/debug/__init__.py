@@ -4,7 +4,8 @@
 breakpoints on networks and the paused mode inside a scan);
 :mod:`plcrt.debug.commands` holds its commands (scan, run, break, watch,
 set, force, show, axes, ...) and :mod:`plcrt.debug.panels` the tables and
-the ladder view with live values they print; :mod:`plcrt.debug.cli` is the
+the ladder view with live values they print; :mod:`plcrt.debug.complete`
+is Tab completion at the prompt; :mod:`plcrt.debug.cli` is the
 ``plcrt debug`` subcommand that wires a session to a terminal, a script file
 or a pipe.
 

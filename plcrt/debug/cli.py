@@ -5,7 +5,8 @@ outside world: it loads the program with instrumentation, applies
 ``--break`` and ``--watch``, and chooses how commands arrive:
 
 * stdin is a terminal (and no ``--script``): a ``(plcrt)`` prompt with
-  readline editing and history when Python has readline, colours in the
+  readline editing, history and Tab completion
+  (:mod:`plcrt.debug.complete`) when Python has readline, colours in the
   ladder view, Ctrl-C stops a run between two scans;
 * ``--script FILE`` or a pipe: no prompt, each command is echoed as
   ``(plcrt) <command>`` before its output so the transcript reads well,
@@ -99,7 +100,7 @@ def cmd_debug(args: argparse.Namespace) -> int:
     if not interactive:
         return session.run(sys.stdin)
     print(session.banner())
-    with _history():
+    with _history(session):
         return session.run(readline=_ask)
 
 
@@ -134,8 +135,12 @@ def _isatty(stream: Any) -> bool:
 
 
 class _history:
-    """readline editing and a history kept between sessions, when Python
-    has readline; nothing otherwise (the session works without it)."""
+    """readline editing, Tab completion and a history kept between sessions,
+    when Python has readline; nothing otherwise (the session works without
+    it)."""
+
+    def __init__(self, session: Any) -> None:
+        self._session = session
 
     def __enter__(self) -> None:
         try:
@@ -144,6 +149,7 @@ class _history:
             self._readline: Any = None
             return
         self._readline = readline
+        install_completion(readline, self._session)
         self._path = os.path.expanduser(HISTORY_FILE)
         try:
             readline.read_history_file(self._path)
@@ -160,4 +166,17 @@ class _history:
             pass  # a read-only home: the history is lost, the session was not
 
 
-__all__ = ["cmd_debug", "register"]
+def install_completion(readline: Any, session: Any) -> None:
+    """Tab completes commands, networks, addresses and symbols of the
+    session (:func:`plcrt.debug.complete.complete`)."""
+    from .complete import ReadlineCompleter
+    readline.set_completer(ReadlineCompleter(session, readline))
+    readline.set_completer_delims(ReadlineCompleter.DELIMITERS)
+    # macOS Pythons may link libedit, which takes its own binding syntax
+    if "libedit" in (getattr(readline, "__doc__", "") or ""):
+        readline.parse_and_bind("bind ^I rl_complete")
+    else:
+        readline.parse_and_bind("tab: complete")
+
+
+__all__ = ["cmd_debug", "install_completion", "register"]

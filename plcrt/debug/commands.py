@@ -143,6 +143,19 @@ def _cmd_delete(s: Session, args: list[str]) -> None:
         s._print(f"deleted the breakpoint before {net.name}")
 
 
+def _cmd_clear(s: Session, args: list[str]) -> None:
+    if args:
+        # gdb's `clear LOCATION`: the breakpoints at these networks go
+        _cmd_delete(s, args)
+        return
+    if s.color:
+        # A terminal: home the cursor and erase the screen (ECMA-48 CUP, ED 2),
+        # as the shell's `clear` and Ctrl-L do.  A script or pipe has no
+        # screen, and its transcript keeps everything.
+        s.out.write("\x1b[H\x1b[2J")
+        s.out.flush()
+
+
 def _cmd_breaks(s: Session, args: list[str]) -> None:
     _no_args(args, "breaks")
     if not s._breaks:
@@ -432,6 +445,12 @@ _TABLE = (
             "or 'finish'.", aliases=("b",)),
     Command("delete", _cmd_delete, "delete NET|all", "remove breakpoints"),
     Command("breaks", _cmd_breaks, "breaks", "list the breakpoints"),
+    Command("clear", _cmd_clear, "clear [NET...]",
+            "clear the screen; with NET, remove the breakpoints there",
+            "Alone it clears the terminal's screen (as Ctrl-L) and changes nothing\n"
+            "else; in a script or pipe it does nothing.  'clear NET' is gdb's\n"
+            "'clear LOCATION', the same as 'delete NET'.  What else can be cleared:\n"
+            "'delete all' (breakpoints), 'unwatch all', 'unforce all', 'trace clear'."),
     Command("watch", _cmd_watch, "watch [ADDR...]",
             "add addresses to the watch table (alone: print it)",
             "The table (address, value, 'forced' marker) is printed after every\n"

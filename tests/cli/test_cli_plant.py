@@ -201,6 +201,14 @@ def test_check_validates_the_plant_file(tmp_path: Path,
     assert code == 1 and "limit_neg must be below limit_pos" in err
 
 
-def test_dump_has_no_plant_option(capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run_cli(capsys, "dump", POS_GOTO_R, "--plant", PLANT)
-    assert code == 1 and "unrecognized arguments: --plant" in err
+def test_dump_takes_and_validates_the_plant_file(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """dump reads a program with the options of check and run: a good plant
+    file leaves the dump unchanged, a broken one is an input error."""
+    code, plain, _ = run_cli(capsys, "dump", POS_GOTO_R)
+    assert code == 0
+    code, out, err = run_cli(capsys, "dump", POS_GOTO_R, "--plant", PLANT)
+    assert (code, out, err) == (0, plain, "")
+    plant = write(tmp_path, "bad.toml", "[module.0.axis.0]\nlimit_neg = 5\nlimit_pos = 5\n")
+    code, out, err = run_cli(capsys, "dump", POS_GOTO_R, "--plant", plant)
+    assert code == 1 and out == "" and "limit_neg must be below limit_pos" in err

@@ -128,6 +128,9 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
         p.add_argument("--plant", metavar="F",
                        help="plant file (TOML): EM253 modules and the machine around "
                             "their axes")
+    p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
+                   help="refuse program, symbol and data files larger than this "
+                        "(default 1 MB, far above any S7-200 program)")
 
 
 #: Subcommands defined beside the feature they present; each module has
@@ -200,7 +203,8 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
-                plant=Path(plant) if plant else None, instrument=instrument)
+                plant=Path(plant) if plant else None, instrument=instrument,
+                max_file_mb=getattr(args, "max_file_mb", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -11,6 +11,7 @@ from typing import Any
 
 from ..errors import DiagnosticSink, PlcCompileError
 from ..lang import ir
+from ..lang.limits import MAX_INSTRUCTIONS
 from ..memory.cpu import CpuModel
 from .codegen import Compiled, Unit, build_unit, generate
 
@@ -31,6 +32,7 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
     Raises:
         PlcCompileError: with every error found (warnings ride along).
     """
+    _check_size(program)
     diag = DiagnosticSink()
     unit = build_unit(program, model, symbols, system_symbols or {}, diag)
     unit.probes = probes
@@ -39,6 +41,25 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
     source, line_locs = generate(unit)
     diag.raise_if_errors(PlcCompileError)
     return unit, source, line_locs
+
+
+def _check_size(program: ir.Program) -> None:
+    """Refuse a program too big to compile in bounded memory (compiling
+    costs several kilobytes per instruction), at its first instruction past
+    :data:`~plcrt.lang.limits.MAX_INSTRUCTIONS`."""
+    if program.instruction_count() <= MAX_INSTRUCTIONS:
+        return
+    count = 0
+    for pou in program.pous:
+        for net in pou.networks:
+            count += len(net.insns)
+            if count > MAX_INSTRUCTIONS:
+                loc = net.insns[len(net.insns) - (count - MAX_INSTRUCTIONS)].loc
+                raise PlcCompileError(
+                    f"the program has {program.instruction_count()} instructions, more "
+                    f"than plcrt compiles ({MAX_INSTRUCTIONS}); the largest S7-200 holds "
+                    f"a few thousand", loc)
+    raise AssertionError("unreachable")
 
 
 __all__ = ["compile_program", "Compiled", "Unit"]

@@ -603,25 +603,36 @@ def _system_symbols() -> dict[str, str]:
     return dict(SYSTEM_SYMBOLS)
 
 
-def _text_or_path(x: Any) -> tuple[str, str]:
-    """(text, file name) for a path or literal text argument."""
+def _text_or_path(x: Any, limit: int | None = None) -> tuple[str, str]:
+    """(text, file name) for a path or literal text argument; a file is
+    read, and text accepted, up to ``limit`` bytes/characters (default:
+    :mod:`plcrt.lang.limits`)."""
     from ..lang import read_source
+    from ..lang.limits import check_text_size, file_limit
+    if limit is None:
+        limit = file_limit()
     if isinstance(x, Path):
-        return read_source(x), str(x)
+        return read_source(x, limit), str(x)
     s = str(x)
     if "\n" not in s and len(s) < 4096:
-        return read_source(s), s
+        return read_source(s, limit), s
+    check_text_size(s, "<string>", limit)
     return s, "<string>"
 
 
-def parse_sources(sources: str | Path | Sequence[str | Path]) -> ir.Program:
+def parse_sources(sources: str | Path | Sequence[str | Path], *,
+                  max_file_mb: float | None = None) -> ir.Program:
     """Parse one program file or text, or several (their blocks are merged,
-    as Micro/WIN keeps OB1 and its subroutines in one project)."""
+    as Micro/WIN keeps OB1 and its subroutines in one project).  Files
+    larger than ``max_file_mb`` (default: :mod:`plcrt.lang.limits`) are
+    refused."""
     from ..lang import parse_program
+    from ..lang.limits import file_limit
+    limit = file_limit(max_file_mb)
     items = [sources] if isinstance(sources, (str, Path)) else list(sources)
     if not items:
         raise PlcConfigError("no program given")
-    programs = [parse_program(*_text_or_path(x)) for x in items]
+    programs = [parse_program(*_text_or_path(x, limit)) for x in items]
     if len(programs) == 1:
         return programs[0]
     pous = tuple(p for prog in programs for p in prog.pous)
@@ -642,21 +653,27 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
         data: path or text of a data block, or a parsed one.
         scan_ms: simulated scan time in milliseconds.
         cpu: CPU model name (default CPU 226).
+        max_file_mb: the largest program, symbol or data file read, in MB
+            (default 1; see :mod:`plcrt.lang.limits`).
 
     Raises:
         PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
     """
     from ..lang import parse_datablock, parse_symbols
 
+    from ..lang.limits import file_limit
+
     plant = kw.pop("plant", None)
+    max_file_mb = kw.pop("max_file_mb", None)
+    limit = file_limit(max_file_mb)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
-    program = parse_sources(source)
+    program = parse_sources(source, max_file_mb=max_file_mb)
     if isinstance(symbols, (str, Path)):
-        symbols = parse_symbols(*_text_or_path(symbols))
+        symbols = parse_symbols(*_text_or_path(symbols, limit))
     if isinstance(data, (str, Path)):
-        data = parse_datablock(*_text_or_path(data))
+        data = parse_datablock(*_text_or_path(data, limit))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 

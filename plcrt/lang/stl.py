@@ -28,6 +28,7 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from ..errors import DiagnosticSink, PlcSyntaxError, SourceLoc
+from .limits import file_limit, read_capped
 from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl, VarSection
 
 __all__ = ["parse_program", "read_source"]
@@ -41,29 +42,18 @@ _MAX_SYNTAX_ERRORS = 20
 # Reading files
 # --------------------------------------------------------------------------
 
-def read_source(path: str | Path) -> str:
+def read_source(path: str | Path, max_bytes: int | None = None) -> str:
     """Read a program, symbol or data-block file and return its text.
 
     Real Micro/WIN exports are written in the Windows ANSI code page, not
     UTF-8, so the bytes are decoded by trying, in order: UTF-8 (strict, after
     dropping a UTF-8 byte-order mark), GBK (Chinese Micro/WIN SMART) and
     CP1252 (western Micro/WIN).  A UTF-16 byte-order mark is honoured too.
+    At most ``max_bytes`` are read (default: the limit of
+    :mod:`plcrt.lang.limits`); only regular files are read.
     Raises :class:`PlcSyntaxError` naming the file if it cannot be read.
     """
-    name = str(path)
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise PlcSyntaxError("cannot read file: no such file",
-                             SourceLoc(name, 1, 1)) from None
-    except IsADirectoryError:
-        raise PlcSyntaxError("cannot read file: it is a directory",
-                             SourceLoc(name, 1, 1)) from None
-    except OSError as exc:
-        reason = exc.strerror or exc.__class__.__name__
-        raise PlcSyntaxError(f"cannot read file: {reason}",
-                             SourceLoc(name, 1, 1)) from None
-    return _decode(data)
+    return _decode(read_capped(path, file_limit() if max_bytes is None else max_bytes))
 
 
 def _decode(data: bytes) -> str:

@@ -43,7 +43,7 @@ from typing import Any, NamedTuple, NoReturn, TextIO
 
 from . import __version__
 from .engine.runtime import Plc, load
-from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError, capped
 from .dump import render_dump
 from .safetext import printable
 
@@ -557,16 +557,15 @@ def _print_rich_axes(rows: list[list[str]]) -> bool:
 # ---------------------------------------------------------------------------
 
 def print_diagnostics(diags: Sequence[Diagnostic], stream: TextIO | None = None) -> None:
-    """GNU-style lines, in source order (stable for equal positions)."""
+    """GNU-style lines, in source order (stable for equal positions); at
+    most :data:`~plcrt.errors.MAX_LISTED` of them (errors first), then one
+    line counting the rest."""
     stream = stream or sys.stderr
-
-    def key(d: Diagnostic) -> tuple[int, str, int, int]:
-        if d.loc is None:
-            return (0, "", 0, 0)
-        return (1, d.loc.file, d.loc.line, d.loc.column)
-
-    for d in sorted(diags, key=key):
+    kept, more = capped(diags, ordered=True)
+    for d in kept:
         print(str(d) if d.loc is not None else f"{PROG}: {d}", file=stream)
+    if more is not None:
+        print(f"{PROG}: {more}", file=stream)
 
 
 def _count(diags: Sequence[Diagnostic]) -> str:

@@ -22,6 +22,7 @@ from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
 from ..memory.cpu import CpuModel
+from ..safetext import excerpt
 from .emit import CodegenError, Gen
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
@@ -216,7 +217,7 @@ def _label_number(insn: ir.Insn) -> int | None:
     if len(insn.operands) != 1:
         return None
     t = insn.operands[0].text.strip()
-    return int(t) if t.isdigit() and int(t) <= 255 else None
+    return int(t) if t.isdigit() and len(t) <= 3 and int(t) <= 255 else None
 
 
 def check_calls(unit: Unit) -> None:
@@ -416,7 +417,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 unit.diag.error(f"instruction {insn.mnemonic} is not implemented yet",
                                 loc, "unimplemented")
             else:
-                unit.diag.error(f"unknown instruction '{insn.mnemonic}'", loc, "unknown")
+                unit.diag.error(f"unknown instruction '{excerpt(insn.mnemonic)}'", loc, "unknown")
             broken = True
             continue
         ops = _resolve_ops(unit, spec, insn, resolver, loc)
@@ -512,7 +513,7 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
         unit.pous[ident] = info
         if p.name and p.name.upper() != ident:
             if p.name.upper() in unit.by_name:
-                diag.error(f"block name '{p.name}' is used twice", p.loc.within(ident, None))
+                diag.error(f"block name '{excerpt(p.name)}' is used twice", p.loc.within(ident, None))
             unit.by_name[p.name.upper()] = info
     if ob_count == 0 and program.pous:
         diag.warning("the program has no main program block (ORGANIZATION_BLOCK OB1); "

@@ -16,6 +16,7 @@ from ..compiler.emit import Gen
 from ..compiler.operands import Addr, Const
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role, insn
+from ..safetext import excerpt
 
 F = "control"
 
@@ -255,7 +256,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         hook = g.unit.hooks.get("library_call")
         if hook is not None and hook(g, insn_ir, resolver):
             return
-        g.fail(f"no subroutine named '{name}' in the program")
+        g.fail(f"no subroutine named '{excerpt(name)}' in the program")
     if callee.pou.kind != "SBR":
         g.fail(f"{callee.pou.ident} is not a subroutine")
     params = [v.decl for v in callee.local_vars.values() if v.decl.section != "TEMP"]
@@ -275,7 +276,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
             ops = {s: check_role(resolver.parse(op_ir.text), _PARAM_ROLE[(s, width)],
                                  op_ir.text, g.unit.model) for s in sections}
         except ResolveError as e:
-            g.fail(f"parameter #{decl.name} ({decl.type}, {decl.section}): {e}")
+            g.fail(f"parameter #{excerpt(decl.name)} ({decl.type}, {decl.section}): {e}")
         if "IN" in ops:
             copy_in.append((lv.addr, ops["IN"], width))
         if "OUT" in ops:

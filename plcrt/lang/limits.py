@@ -11,7 +11,8 @@ build, since compiling costs several kilobytes per instruction.
 
 The limits are far above any real S7-200 program: the largest CPU holds
 24 KB of program, a few thousand instructions, and its STL export is
-well under a megabyte.  ``plcrt.load(..., max_file_mb=...)`` and the
+well under a megabyte.  :func:`too_many_digits` keeps a number of
+thousands of digits from reaching ``int()``.  ``plcrt.load(..., max_file_mb=...)`` and the
 command line's ``--max-file-mb`` raise the file limit.
 
 This module decodes nothing (see :func:`plcrt.lang.read_source`).
@@ -20,6 +21,7 @@ This module decodes nothing (see :func:`plcrt.lang.read_source`).
 from __future__ import annotations
 
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -31,7 +33,19 @@ MAX_FILE_MB = 1.0
 #: largest number of instructions compiled in one program
 MAX_INSTRUCTIONS = 32_768
 
+#: longest run of digits read as a number.  Python refuses to convert more
+#: than 4300 (a ValueError); no S7-200 number needs more than a few dozen
+#: (a REAL written out in full).
+MAX_DIGITS = 100
+
 _MIB = 1024 * 1024
+_LONG_DIGITS = re.compile(r"[0-9]{%d}" % (MAX_DIGITS + 1))
+
+
+def too_many_digits(text: str) -> bool:
+    """Whether ``text`` holds a run of more than :data:`MAX_DIGITS` digits
+    (callers refuse it as out of range instead of converting it)."""
+    return _LONG_DIGITS.search(text) is not None
 
 
 def file_limit(max_file_mb: float | None = None) -> int:
@@ -119,5 +133,5 @@ def check_text_size(text: str, name: str, limit: int) -> None:
                              f"load(..., max_file_mb=...))", SourceLoc(name, 1, 1))
 
 
-__all__ = ["MAX_FILE_MB", "MAX_INSTRUCTIONS", "check_text_size", "describe_limit",
-           "file_limit", "read_capped"]
+__all__ = ["MAX_DIGITS", "MAX_FILE_MB", "MAX_INSTRUCTIONS", "check_text_size",
+           "describe_limit", "file_limit", "read_capped", "too_many_digits"]

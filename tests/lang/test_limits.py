@@ -121,3 +121,91 @@ def test_cli_max_file_mb(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert f"{path}:1:1: error: cannot read file: it is larger than the limit of " \
            f"9.537e-06 MB (10 bytes)" in err
     assert main(["check", str(path), "--max-file-mb", "2"]) == 0
+
+
+# -- long program text in messages -------------------------------------------------
+LONG = "X" * 200_000
+
+
+@pytest.mark.parametrize("network", [
+    f"LD {LONG}",                       # unknown symbol
+    f"{LONG} I0.0",                     # unknown instruction
+    f"LD I0.0\nJMP {LONG}",             # bad label
+    f"LD '{LONG}'\n= Q0.0",             # literal where a bit is needed
+    f"LD I0.0\n= #{LONG}",              # unknown local variable
+    f"LD I0.0\nCALL {LONG}",            # unknown subroutine
+    f"LD I0.0\nMOVW 16#{'F' * 5000}, VW0",   # a constant of thousands of digits
+    f"LD V{'9' * 5000}.0\n= Q0.0",      # an address of thousands of digits
+    f"LD I0.0 {LONG}\n= Q0.0",          # a syntax error
+])
+def test_messages_quote_at_most_40_characters_of_program_text(network: str) -> None:
+    """Every message quoting program text shows 40 characters and an ellipsis."""
+    with pytest.raises(plcrt.PlcError) as info:
+        plcrt.load(ob1_text(network))
+    text = str(info.value)
+    assert "\u2026" in text
+    assert len(text) < 300, text[:300]
+
+
+def test_numbers_of_thousands_of_digits_are_range_errors_not_crashes(tmp_path: Path) -> None:
+    """Python refuses int() of more than 4300 digits; plcrt reports an
+    out-of-range number instead (operands, network and block numbers, data)."""
+    digits = "9" * 5000
+    text = (f"ORGANIZATION_BLOCK OB{digits}\nBEGIN\nNetwork {digits}\nLD I0.0\n"
+            f"END_ORGANIZATION_BLOCK\n")
+    with pytest.raises(PlcSyntaxError) as info:
+        plcrt.load(text)
+    messages = [d.message for d in info.value.diagnostics]
+    assert any(m.startswith("block number of 'OB9999") and "out of range" in m
+               for m in messages)
+    assert any(m.startswith("network number '9999") and "out of range" in m for m in messages)
+    data = tmp_path / "d.txt"
+    data.write_text(f"VB0 {digits}\nVB{digits} 1\n", encoding="utf-8")
+    with pytest.raises(PlcSyntaxError) as info:
+        plcrt.load(ob1_text("LD I0.0\n= Q0.0"), data=data)
+    messages = [d.message for d in info.value.diagnostics]
+    assert messages[0].startswith("value 9999") and messages[0].endswith("out of range for VB")
+    assert messages[1].startswith("address VB9999") and "out of range" in messages[1]
+
+
+# -- many errors --------------------------------------------------------------------
+def _many_errors(tmp_path: Path, n: int = 250) -> Path:
+    path = tmp_path / "many.awl"
+    path.write_text(ob1_text(*["LDX I0.0"] * n), encoding="utf-8")
+    return path
+
+
+def test_plc_error_str_lists_the_first_100_and_counts_the_rest(tmp_path: Path) -> None:
+    with pytest.raises(PlcCompileError) as info:
+        plcrt.load(_many_errors(tmp_path))
+    lines = str(info.value).splitlines()
+    assert len(lines) == 101
+    assert lines[-1] == "... and 150 more errors not listed (the first 100 are shown)"
+    assert len(info.value.diagnostics) == 250   # all of them are still there
+
+
+def test_check_prints_the_first_100_errors_and_a_summary(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _many_errors(tmp_path)
+    assert main(["check", str(path)]) == 1
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 102
+    assert lines[99].startswith(f"{path}:202:1: error: unknown instruction 'LDX'")
+    assert lines[100] == "plcrt: ... and 150 more errors not listed (the first 100 are shown)"
+    assert lines[101] == f"{path}: 250 errors, 0 warnings"
+
+
+def test_run_caps_the_list_too(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", str(_many_errors(tmp_path)), "--scans", "1"]) == 1
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 101 and lines[-1].startswith("plcrt: ... and 150 more errors")
+
+
+def test_errors_are_listed_before_a_flood_of_warnings() -> None:
+    """With more diagnostics than the cap, errors are kept first."""
+    from plcrt.errors import Diagnostic, SourceLoc, capped
+    diags = [Diagnostic("warning", f"w{i}", SourceLoc("f", i, 1)) for i in range(1, 150)]
+    diags.append(Diagnostic("error", "the one error", SourceLoc("f", 500, 1)))
+    kept, more = capped(diags, ordered=True)
+    assert len(kept) == 100 and kept[-1].message == "the one error"
+    assert more == "... and 50 more warnings not listed (the first 100 are shown)"

@@ -192,9 +192,10 @@ def _build_parser() -> _Parser:
 # ---------------------------------------------------------------------------
 
 def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
-                   instrument: bool = False) -> Plc:
+                   instrument: bool = False, library: bool = False) -> Plc:
     """Load the program named on the command line (raises PlcError);
-    ``instrument`` compiles the network probes breakpoints use."""
+    ``instrument`` compiles the network probes breakpoints use, ``library``
+    accepts a program without OB1 (for ``check`` and ``dump``)."""
     data = getattr(args, "data", None)
     plant = getattr(args, "plant", None)
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
@@ -203,15 +204,18 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
-                plant=Path(plant) if plant else None, instrument=instrument,
+                plant=Path(plant) if plant else None, instrument=instrument, library=library,
                 max_file_mb=getattr(args, "max_file_mb", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors."""
+    """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors.
+
+    A subroutine library (blocks, no OB1) passes with a note saying it
+    cannot run on its own; a file without any block is an error."""
     name = ", ".join(args.programs)
     try:
-        plc = load_from_args(args)
+        plc = load_from_args(args, library=True)
     except PlcError as e:
         diags = e.diagnostics
         print_diagnostics(diags)
@@ -275,9 +279,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_dump(args: argparse.Namespace) -> int:
-    """``plcrt dump``: the generated module with STL lines as comments."""
+    """``plcrt dump``: the generated module with STL lines as comments
+    (of a subroutine library too)."""
     try:
-        plc = load_from_args(args)
+        plc = load_from_args(args, library=True)
     except PlcError as e:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR
@@ -293,11 +298,6 @@ def cmd_dump(args: argparse.Namespace) -> int:
 #: help of ``--set`` (``show`` says when it applies first)
 SET_HELP = ("write before the first scan (inputs keep their value); "
             "VALUE: 12, -3, 16#FF, 2#1010, 1.5")
-
-#: why a program without OB1 cannot run
-NO_OB1 = ("the program has no main program block (OB1), so there is nothing to run; "
-          "give the file with OB1 as well")
-
 
 def add_scan_ms_arg(p: argparse.ArgumentParser) -> None:
     """``--scan-ms MS``, the simulated scan time (``args.scan_ms``, default 10)."""
@@ -383,19 +383,17 @@ def apply_sets(plc: Plc, sets: Sequence[SetItem]) -> None:
 
 def load_for_run(args: argparse.Namespace, sets: Sequence[SetItem] = (), *,
                  report: Callable[[Sequence[Diagnostic]], None] | None = None,
-                 instrument: bool = False, no_ob1: str = NO_OB1) -> Plc:
+                 instrument: bool = False) -> Plc:
     """Load the program of a command that runs it (``--scan-ms`` and the
     program options), report the load-time warnings (``report``, default
-    :func:`print_diagnostics`), require OB1 (else ``no_ob1``) and write the
-    ``--set`` values.
+    :func:`print_diagnostics`) and write the ``--set`` values.
 
     Raises:
-        PlcError: the program does not load, has no OB1, or a write fails.
+        PlcError: the program does not load (a program without OB1 is a
+            compile error), or a write fails.
     """
     plc = load_from_args(args, args.scan_ms, instrument=instrument)
     (report or print_diagnostics)(plc.diagnostics)  # warnings
-    if "OB1" not in plc.unit.pous:
-        raise PlcConfigError(no_ob1)
     apply_sets(plc, sets)
     return plc
 
@@ -606,7 +604,7 @@ def _silence_stdout() -> None:
         pass
 
 
-__all__ = ["NO_OB1", "SET_HELP", "SetItem", "add_program_args", "add_run_length_args",
+__all__ = ["SET_HELP", "SetItem", "add_program_args", "add_run_length_args",
            "add_scan_ms_arg", "add_set_args", "apply_sets", "check_run_length",
            "load_for_run", "load_from_args", "main", "parse_sets", "parse_value",
            "print_diagnostics", "render_dump"]

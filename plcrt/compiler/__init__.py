@@ -19,7 +19,8 @@ from .codegen import Compiled, Unit, build_unit, generate
 def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None,
                     system_symbols: dict[str, str] | None = None,
                     bindings: dict[str, Any] | None = None,
-                    setup: Any = None, probes: Any = None) -> tuple[Unit, str, dict]:
+                    setup: Any = None, probes: Any = None,
+                    library: bool = False) -> tuple[Unit, str, dict]:
     """Check and generate code; returns the unit, module source and line map.
 
     Args:
@@ -28,13 +29,15 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
             emitters bind.
         probes: a :class:`plcrt.engine.coverage.CoverageMap` to instrument
             the code for (network and output coverage, breakpoints).
+        library: accept a program without OB1 (a subroutine library, for
+            checking only); otherwise that is an error.
 
     Raises:
         PlcCompileError: with every error found (warnings ride along).
     """
     _check_size(program)
     diag = DiagnosticSink()
-    unit = build_unit(program, model, symbols, system_symbols or {}, diag)
+    unit = build_unit(program, model, symbols, system_symbols or {}, diag, library=library)
     unit.probes = probes
     if setup is not None:
         setup(unit)

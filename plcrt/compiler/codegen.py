@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from ..errors import DiagnosticSink, SourceLoc
+from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
@@ -394,7 +394,7 @@ def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
         "            return",
         "        else:",
         "            if r <= pc and WD[0] > WD[1]:",
-        f"                _watchdog({info.pou.kind!r}, {info.pou.number})",
+        f"                _watchdog({info.pou.kind!r}, {int(info.pou.number)}, pc, r)",
         "            pc = r",
     ]
 
@@ -446,7 +446,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 spec.emit(gen, *ops)
         except (CodegenError, ResolveError) as e:
             gen.lines, gen.depth, gen.indent, gen.pending = saved
-            if not (broken and "logic stack" in str(e)):
+            if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):
                 unit.diag.error(f"{insn.mnemonic}: {e}", getattr(e, "loc", None) or loc)
             broken = True
             _assume_stack_effect(gen, insn.mnemonic)
@@ -490,8 +490,15 @@ def _resolve_ops(unit: Unit, spec: InsnSpec, insn: ir.Insn, resolver: Resolver,
 
 
 def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
-               system_symbols: dict[str, str], diag: DiagnosticSink) -> Unit:
-    """Index POUs, lay out locals, split pieces and check the call graph."""
+               system_symbols: dict[str, str], diag: DiagnosticSink, *,
+               library: bool = False) -> Unit:
+    """Index POUs, lay out locals, split pieces and check the call graph.
+
+    A program without OB1 cannot run, so it is an error, unless
+    ``library`` (``plcrt check`` of a subroutine library): then a note says
+    it was checked as one.  A program without any block is an error either
+    way: there is nothing to check.
+    """
     unit = Unit(program, model, symbols, system_symbols, diag)
     ob_count = 0
     for p in program.pous:
@@ -515,10 +522,20 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
             if p.name.upper() in unit.by_name:
                 diag.error(f"block name '{excerpt(p.name)}' is used twice", p.loc.within(ident, None))
             unit.by_name[p.name.upper()] = info
-    if ob_count == 0 and program.pous:
-        diag.warning("the program has no main program block (ORGANIZATION_BLOCK OB1); "
-                     "it can be checked but not run", program.pous[0].loc.within(
-                         program.pous[0].ident, None), "no-ob1")
+    if not program.pous:
+        diag.error("the file holds no program block (it is empty, or only comments), so "
+                   "there is nothing to check or run", SourceLoc(program.file, 1, 1),
+                   "no-blocks")
+    elif "OB1" not in unit.pous:
+        where = program.pous[0].loc.within(program.pous[0].ident, None)
+        if library:
+            diag.items.append(Diagnostic(
+                "note", "no main program block (OB1): checked as a subroutine library, "
+                        "which cannot run on its own", where, "no-ob1"))
+        else:
+            diag.error("the program has no main program block (OB1), so there is nothing "
+                       "to run; give the file with OB1 as well (plcrt check accepts a "
+                       "subroutine library on its own)", where, "no-ob1")
     for info in unit.pous.values():
         split_pieces(info, diag)
         for net in info.pou.networks:

@@ -34,11 +34,15 @@ VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
 
 class CodegenError(Exception):
     """An instruction cannot be generated; becomes a diagnostic at its
-    location, or at ``loc`` (an operand's) when given."""
+    location, or at ``loc`` (an operand's) when given.  ``reported``: the
+    problem is already a diagnostic (an unmatched FOR/NEXT or LSCR/SCRE
+    found while splitting the block), so it is not listed twice."""
 
-    def __init__(self, message: str, loc: SourceLoc | None = None) -> None:
+    def __init__(self, message: str, loc: SourceLoc | None = None, *,
+                 reported: bool = False) -> None:
         super().__init__(message)
         self.loc = loc
+        self.reported = reported
 
 
 class Gen:
@@ -116,8 +120,9 @@ class Gen:
     def warn(self, message: str, code: str = "") -> None:
         self.unit.diag.warning(message, self.loc, code)
 
-    def fail(self, message: str, loc: SourceLoc | None = None) -> None:
-        raise CodegenError(message, loc)
+    def fail(self, message: str, loc: SourceLoc | None = None, *,
+             reported: bool = False) -> None:
+        raise CodegenError(message, loc, reported=reported)
 
     # -- logic stack ----------------------------------------------------
     @property

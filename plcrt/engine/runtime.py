@@ -54,7 +54,7 @@ class Plc:
                  scan_ms: float = 10.0, cpu: str | None = None,
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
-                 plant: Any = None, instrument: bool = False) -> None:
+                 plant: Any = None, instrument: bool = False, library: bool = False) -> None:
         if not (isinstance(scan_ms, (int, float)) and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
         if pace not in ("simulated", "realtime"):
@@ -64,7 +64,7 @@ class Plc:
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
-                            pace=pace, plant=plant, instrument=instrument)
+                            pace=pace, plant=plant, instrument=instrument, library=library)
         #: network/output coverage and breakpoints (``instrument=True`` only)
         self.coverage: CoverageMap | None = CoverageMap() if instrument else None
         #: callables ``fn(plc)`` run after every scan (traces, test harness)
@@ -107,14 +107,14 @@ class Plc:
 
         self.unit, self.source, self.line_locs = compile_program(
             program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup,
-            probes=self.coverage)
+            probes=self.coverage, library=library)
         self.diagnostics = list(self.unit.diag.items) + self.diagnostics
         self._filename = f"<plcrt {program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)
         ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
         ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
-                  _watchdog=self._watchdog)
+                  _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
         ns.update(self.unit.bindings)
         try:
             code = compile(self.source, self._filename, "exec")
@@ -236,11 +236,39 @@ class Plc:
             tb = tb.tb_next
         return loc
 
-    def _watchdog(self, kind: str, number: int) -> None:
+    def _watchdog(self, kind: str, number: int, pc: int, target: int) -> None:
+        """The scan's loops ran past the watchdog time; ``pc`` is the piece
+        of block ``kind``+``number`` that jumped back to piece ``target``."""
+        info = self.unit.pous[f"{kind}{number}"]
+        back = info.pieces[pc].insns[-1] if info.pieces[pc].insns else None
+        start = next((f for _b, (body, _e, f) in info.loops.items() if body == target), None)
+        if start is None and info.pieces[target].insns:
+            start = info.pieces[target].insns[0]    # the LBL a JMP goes back to
+        where = ""
+        if start is not None and back is not None:
+            where = (f" in the loop from {start.mnemonic} at line {start.loc.line} to "
+                     f"{back.mnemonic} at line {back.loc.line}")
+        loc = start.loc.within(info.pou.ident, _network_of(info, start)) if start else None
         raise PlcRuntimeError(
-            f"watchdog: the scan ran longer than {WATCHDOG_MS} ms "
-            f"(about {self.wd[0]} instructions in loops of {kind}{number}); "
-            f"the CPU goes to STOP", None)
+            f"watchdog: the scan ran longer than {WATCHDOG_MS} ms{where} of {kind}{number} "
+            f"({self._loop_work()}); the CPU goes to STOP", loc)
+
+    def _watchdog_wdr(self, insn_id: int) -> None:
+        """A loop that retriggers the watchdog with WDR ran ten times the
+        watchdog time in one scan (the limit plcrt puts on it)."""
+        loc = self.unit.locs[insn_id] if 0 <= insn_id < len(self.unit.locs) else None
+        line = f" at line {loc.line}" if loc is not None else ""
+        raise PlcRuntimeError(
+            f"watchdog: the loop around WDR{line} ran ten times the {WATCHDOG_MS} ms watchdog "
+            f"time in one scan ({self._loop_work()}); WDR retriggers the watchdog, but plcrt "
+            f"stops a scan that never ends; the CPU goes to STOP", loc)
+
+    def _loop_work(self) -> str:
+        """``about N instructions in loops, about T s`` of this scan (WDR
+        resets included)."""
+        n = self.wd[0] + self.wd[2]
+        return (f"about {n} instructions in loops, about {n * WATCHDOG_US_PER_INSN / 1e6:.2g} s "
+                f"at {WATCHDOG_US_PER_INSN} \u00b5s each")
 
     @property
     def now_us(self) -> int:
@@ -535,6 +563,14 @@ class Plc:
         return m[a.area], a.offset, a.width or 0, a.bit
 
 
+def _network_of(info: Any, insn: ir.Insn) -> int | None:
+    """The number of the network of ``info``'s block that holds ``insn``."""
+    for piece in info.pieces:
+        if any(i is insn for i in piece.insns):
+            return piece.network.number
+    return None
+
+
 #: big-endian signed decoders of words and double words
 _SIGNED = {2: struct.Struct(">h").unpack_from, 4: struct.Struct(">i").unpack_from}
 
@@ -653,6 +689,9 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
         data: path or text of a data block, or a parsed one.
         scan_ms: simulated scan time in milliseconds.
         cpu: CPU model name (default CPU 226).
+        library: accept a program without OB1 (a subroutine library: it
+            compiles, a scan runs nothing); without it such a program, or an
+            empty one, is a :class:`PlcCompileError`.
         max_file_mb: the largest program, symbol or data file read, in MB
             (default 1; see :mod:`plcrt.lang.limits`).
 
@@ -673,7 +712,9 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     if isinstance(symbols, (str, Path)):
         symbols = parse_symbols(*_text_or_path(symbols, limit))
     if isinstance(data, (str, Path)):
-        data = parse_datablock(*_text_or_path(data, limit))
+        # the CPU's V size, so that entries past its end are reported in the
+        # same run as the syntax errors
+        data = parse_datablock(*_text_or_path(data, limit), v_bytes=cpu_model(cpu).v_bytes)
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 

@@ -77,8 +77,8 @@ def _wdr(g: Gen) -> None:
         g.line(f"{g.use('WD')}[2] += {g.use('WD')}[0]")
         g.line(f"{g.use('WD')}[0] = 0")
         with g.block(f"if {g.use('WD')}[2] > 10 * {g.use('WD')}[1]:"):
-            info = _info(g)
-            g.line(f"{g.use('_watchdog')}({info.pou.kind!r}, {int(info.pou.number)})")
+            # the WDR's own instruction id: the fault names its line
+            g.line(f"{g.use('_watchdog_wdr')}({int(g.insn_id)})")
 
 
 @insn("LBL", Role.LABEL, family=F, summary="jump target", flow="label")
@@ -110,7 +110,7 @@ def _for(g: Gen, indx, init, final) -> None:
     here = _piece(g).index
     body, exit_, _ = info.loops.get(here, (None, None, None))
     if body is None:
-        g.fail("FOR without a matching NEXT")
+        g.fail("FOR without a matching NEXT", reported=True)   # by split_pieces
     with g.box():
         g.wr(indx, "W", g.rd(init, "W"))
         with g.block(f"if {g.rd(indx, 'W')} > {g.rd(final, 'W')}:"):
@@ -125,7 +125,7 @@ def _next(g: Gen) -> None:
     info = _info(g)
     fp = info.next_of.get(_piece(g).index)
     if fp is None:
-        g.fail("NEXT without a matching FOR")
+        g.fail("NEXT without a matching FOR", reported=True)
     body, _exit, for_insn = info.loops[fp]
     from ..compiler.resolve import Resolver
     res = Resolver(g.unit.model, g.unit.symbols, g.unit.system_symbols, info.local_vars)
@@ -175,7 +175,7 @@ def _lscr(g: Gen, bit: Addr) -> None:
     here = _piece(g).index
     exit_ = info.scr_exit.get(here)
     if exit_ is None:
-        g.fail("LSCR without a matching SCRE")
+        g.fail("LSCR without a matching SCRE", reported=True)
     info.scr_bit[here] = bit
     # The segment's S bit for SCRT in later pieces of the same segment.
     for p in info.scr_pieces.get(here, [here]):
@@ -228,7 +228,7 @@ def _cscre(g: Gen) -> None:
     info = _info(g)
     exit_ = info.scr_exit.get(_piece(g).index)
     if exit_ is None:
-        g.fail("CSCRE outside an SCR segment")
+        g.fail("CSCRE outside an SCR segment", reported=True)
     with g.box():
         g.line(f"return {int(exit_)}")
 

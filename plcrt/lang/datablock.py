@@ -88,13 +88,7 @@ class DataBlock:
         :class:`PlcSyntaxError` then names every such entry.
         """
         sink = DiagnosticSink()
-        for entry in self.entries:
-            if entry.end > len(buf):
-                sink.error(
-                    f"data block entry at V{entry.offset} needs "
-                    f"{entry.end - entry.offset} byte(s) but V memory has only "
-                    f"{len(buf)} bytes (VB0..VB{len(buf) - 1})",
-                    entry.loc, code="datablock")
+        _check_extent(self.entries, len(buf), sink)
         raise_collected(sink)
         for entry in self.entries:
             if entry.bit is None:
@@ -140,11 +134,27 @@ class _Cursor:
     bit: int = 0
 
 
-def parse_datablock(text: str, file: str = "<string>") -> DataBlock:
+def _check_extent(entries: list[DataEntry], size: int, sink: DiagnosticSink) -> None:
+    """An error for every entry past the end of a V memory of ``size`` bytes."""
+    for entry in entries:
+        if entry.end > size:
+            sink.error(
+                f"data block entry at V{entry.offset} needs "
+                f"{entry.end - entry.offset} byte(s) but V memory has only "
+                f"{size} bytes (VB0..VB{size - 1})",
+                entry.loc, code="datablock")
+
+
+def parse_datablock(text: str, file: str = "<string>", *,
+                    v_bytes: int | None = None) -> DataBlock:
     """Parse data block text and return its :class:`DataBlock`.
 
+    With ``v_bytes`` (the V memory size of the CPU) entries past its end
+    are reported together with the syntax errors, so one run lists both.
+
     Raises :class:`PlcSyntaxError` listing every error (bad address, bad or
-    out-of-range value, missing comma) with file:line:column.
+    out-of-range value, missing comma, entry past the end of V memory)
+    with file:line:column.
     """
     if text.startswith("\ufeff"):
         text = text[1:]
@@ -153,6 +163,8 @@ def parse_datablock(text: str, file: str = "<string>") -> DataBlock:
     cursor: _Cursor | None = None
     for number, line in enumerate(text.splitlines(), start=1):
         cursor = _parse_line(line, number, file, cursor, block, sink)
+    if v_bytes is not None:
+        _check_extent(block.entries, v_bytes, sink)
     _note_overlaps(block)
     raise_collected(sink)
     return block

@@ -56,9 +56,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         check_run_length(args)
         if args.status:
             writes = parse_sets(args.set)
-            plc = load_for_run(args, writes,
-                               no_ob1="--status needs the main program block (OB1) to run; "
-                                      "give the file with OB1 as well")
+            plc = load_for_run(args, writes)
             program = plc.program
         else:
             program = parse_sources([Path(p) for p in args.programs])

@@ -16,7 +16,7 @@ address is spelled and what a diagnostic says are decided by the core.
 
 Exit status: 0 success, 1 a problem with the input (missing file, syntax or
 compile error, bad option or address, internal error), 2 a run-time fault of
-the PLC program (the CPU went to STOP).  No path prints a Python traceback;
+the PLC program (the CPU went to STOP), 3 a run stopped by ``--max-wall``.  No path prints a Python traceback;
 an unexpected exception is reported as an internal error, and the traceback
 is shown only when the environment variable ``PLCRT_TRACEBACK`` is set.
 
@@ -50,6 +50,7 @@ from .safetext import printable
 EXIT_OK = 0
 EXIT_ERROR = 1
 EXIT_FAULT = 2
+EXIT_WALL = 3   #: the run reached --max-wall
 
 PROG = "plcrt"
 
@@ -143,7 +144,7 @@ def _build_parser() -> _Parser:
         prog=PROG,
         description="Run Siemens S7-200 (STEP 7-Micro/WIN) STL programs in Python.",
         epilog="Exit status: 0 ok, 1 error in the input or options, "
-               "2 run-time fault of the PLC program.")
+               "2 run-time fault of the PLC program, 3 run stopped by --max-wall.")
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
@@ -160,6 +161,7 @@ def _build_parser() -> _Parser:
     common(p)
     add_scan_ms_arg(p)
     add_run_length_args(p)
+    add_long_run_args(p)
     add_set_args(p)
     p.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="print this address at the end; ADDR:REAL reads a float")
@@ -234,7 +236,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     """``plcrt run``: load, apply --set, run, print --watch values (and the
     axes of a --plant).  A long run on a terminal shows a progress bar on
     stderr; ``--quiet`` prints nothing but errors (and the --json object)."""
-    from .trace.progress import run_with_progress
+    from .trace.progress import WallTimeExceeded, run_with_progress
 
     program = args.programs[0]
     quiet = getattr(args, "quiet", False)
@@ -256,18 +258,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     fault: PlcError | None = None
+    stopped: PlcError | None = None
     loaded = len(plc.diagnostics)
     try:
         # same scans and results as plc.run(); only the bar differs
-        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=quiet)
+        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=quiet,
+                          max_wall=args.max_wall, progress=args.progress)
     except PlcRuntimeError as e:
         fault = e
+    except WallTimeExceeded as e:
+        stopped = e
     # Warnings raised while running (library blocks such as the EM253's
     # report bad parameters only when they execute) go to stderr as well.
     report(plc.diagnostics[loaded:])
     values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
     if args.json:
-        _emit_json(args, plc, values, str(fault) if fault else None)
+        _emit_json(args, plc, values, str(fault or stopped) if fault or stopped else None)
     elif not quiet:
         _print_values(program, plc, values)
         if args.plant:
@@ -275,6 +281,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if stopped is not None:
+        print_diagnostics(stopped.diagnostics)
+        return EXIT_WALL
     return EXIT_OK
 
 
@@ -315,6 +324,18 @@ def add_run_length_args(p: argparse.ArgumentParser, *, required: bool = True,
     length.add_argument("--scans", type=int, metavar="N", help=scans_help)
 
 
+def add_long_run_args(p: argparse.ArgumentParser) -> None:
+    """``--max-wall SECONDS`` (stop a run after that much wall-clock time,
+    exit status 3) and ``--progress`` (progress lines on stderr when it is
+    not a terminal; a terminal gets the bar)."""
+    p.add_argument("--max-wall", type=float, metavar="SECONDS",
+                   help="stop the run after this many wall-clock seconds (exit status 3), "
+                        "reporting the simulated time reached")
+    p.add_argument("--progress", action="store_true",
+                   help="show progress on stderr: a line every few seconds when stderr is "
+                        "not a terminal (CI logs), the bar on a terminal")
+
+
 def add_set_args(p: argparse.ArgumentParser, *, help: str = SET_HELP) -> None:
     """``--set ADDR=VALUE``, repeatable (``args.set``, a list of strings for
     :func:`parse_sets`)."""
@@ -331,6 +352,8 @@ def check_run_length(args: argparse.Namespace) -> None:
         raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
     if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
         raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+    from .trace.progress import check_max_wall
+    check_max_wall(getattr(args, "max_wall", None))
 
 
 class SetItem(NamedTuple):
@@ -604,7 +627,8 @@ def _silence_stdout() -> None:
         pass
 
 
-__all__ = ["SET_HELP", "SetItem", "add_program_args", "add_run_length_args",
+__all__ = ["EXIT_WALL", "SET_HELP", "SetItem", "add_long_run_args", "add_program_args",
+           "add_run_length_args",
            "add_scan_ms_arg", "add_set_args", "apply_sets", "check_run_length",
            "load_for_run", "load_from_args", "main", "parse_sets", "parse_value",
            "print_diagnostics", "render_dump"]

@@ -171,5 +171,9 @@ class DiagnosticSink:
     def raise_if_errors(self, kind: type[PlcError] = PlcCompileError) -> None:
         errors = self.errors
         if errors:
-            head = f"{len(errors)} error(s)"
+            # the first error is the message (what a one-line report shows);
+            # str() of the exception lists them all
+            head = errors[0].message
+            if len(errors) > 1:
+                head += f" (and {len(errors) - 1} more error(s))"
             raise kind(head, errors[0].loc, self.items)

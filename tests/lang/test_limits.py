@@ -107,7 +107,7 @@ def test_too_many_instructions_is_a_compile_error_at_the_first_one_past(
     with pytest.raises(PlcCompileError) as info:
         plcrt.load(text)
     err = info.value
-    assert "6 instructions, more than plcrt compiles (5)" in err.message
+    assert "6 instructions, more than plcrt compiles (5)" in str(err)
     assert err.loc is not None and (err.loc.line, err.loc.block, err.loc.network) == \
         (11, "OB1", 3)
 

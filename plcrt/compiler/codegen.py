@@ -92,6 +92,11 @@ class Unit:
         #: a :class:`plcrt.engine.coverage.CoverageMap` to add probes for
         #: (coverage and breakpoints), or None for the plain fast code
         self.probes: Any = None
+        #: CALLs count nesting levels at run time (recursion, or chains
+        #: deeper than the limit; see :func:`check_calls`)
+        self.nest_check = False
+        #: (caller, callee) pairs inside a call cycle
+        self.recursive_sites: set[tuple[str, str]] = set()
 
     def fresh(self, hint: str) -> str:
         self._counter += 1
@@ -221,32 +226,38 @@ def _label_number(insn: ir.Insn) -> int | None:
 
 
 def check_calls(unit: Unit) -> None:
-    """Reject recursion and nesting deeper than the S7-200 allows.
+    """Check the call graph against the S7-200's nesting limit.
 
-    Errors point at the CALL instruction that closes a cycle or exceeds the
-    limit.
+    System Manual, CALL: subroutines nest at most eight levels deep from
+    the main program; recursion is allowed ("use caution").  So recursion
+    and call chains deeper than eight are warnings here (naming the cycle
+    or the chain), and they switch on the run-time nesting check
+    (:attr:`Unit.nest_check`): a CALL that would be the ninth level is not
+    executed, sets SM4.3 and gives ENO 0 (error 0008).  Call sites inside a
+    cycle (:attr:`Unit.recursive_sites`) get one L buffer per nesting level.
+    A program without either pays nothing at run time.
     """
-    recursive: set[str] = set()
-
-    def reaches(start: str, target: str, seen: set[str]) -> bool:
-        for c in unit.pous[start].calls:
-            if c == target:
-                return True
-            if c not in seen:
-                seen.add(c)
-                if reaches(c, target, seen):
-                    return True
-        return False
-
-    for ident, info in unit.pous.items():
-        if info.pou.kind == "SBR" and reaches(ident, ident, set()):
-            recursive.add(ident)
-            loc = next((loc for c, loc in info.calls.items() if c == ident
-                        or reaches(c, ident, set())), info.pou.loc)
-            unit.diag.error(f"subroutine {ident} ({info.pou.name}) calls itself "
-                            f"(directly or through other subroutines); recursion exceeds "
-                            f"the nesting limit of {MAX_NESTING}", loc)
-    if recursive:
+    order = list(unit.pous)
+    comp = _components(unit, order)
+    for ident in order:
+        info = unit.pous[ident]
+        for callee, loc in info.calls.items():
+            if comp[callee] == comp[ident]:
+                unit.recursive_sites.add((ident, callee))
+    reported: set[int] = set()
+    for ident in order:
+        info = unit.pous[ident]
+        cycle = _cycle(unit, ident, comp)
+        if cycle and comp[ident] not in reported:
+            reported.add(comp[ident])
+            names = " -> ".join(cycle + [cycle[0]])
+            loc = info.calls[cycle[1] if len(cycle) > 1 else ident]
+            unit.diag.warning(
+                f"recursion: {names}; the S7-200 allows it but nests subroutines at most "
+                f"{MAX_NESTING} levels deep: a deeper CALL is not executed (SM4.3 is set)",
+                loc, "recursion")
+            unit.nest_check = True
+    if unit.nest_check:
         return
     memo: dict[str, int] = {}
 
@@ -258,8 +269,78 @@ def check_calls(unit: Unit) -> None:
     for ident, info in unit.pous.items():
         if info.pou.kind != "SBR" and depth(ident) > MAX_NESTING:
             deepest = max(info.calls, key=depth)
-            unit.diag.error(f"subroutine calls from {ident} nest {depth(ident)} levels "
-                            f"deep; the S7-200 allows {MAX_NESTING}", info.calls[deepest])
+            unit.diag.warning(f"subroutine calls from {ident} nest {depth(ident)} levels "
+                              f"deep; the S7-200 allows {MAX_NESTING}: a deeper CALL is not "
+                              f"executed (SM4.3 is set)", info.calls[deepest], "nesting")
+            unit.nest_check = True
+
+
+def _components(unit: Unit, order: list[str]) -> dict[str, int]:
+    """Strongly connected components of the call graph (Tarjan), as a
+    component number per block; blocks in one cycle share a number."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    comp: dict[str, int] = {}
+
+    def visit(v: str) -> None:
+        # iterative: a hostile program may chain thousands of blocks
+        work = [(v, iter(unit.pous[v].calls))]
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        while work:
+            node, edges = work[-1]
+            for w in edges:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(unit.pous[w].calls)))
+                    break
+                if w in on:
+                    low[node] = min(low[node], index[w])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    n = len(set(comp.values()))
+                    while True:
+                        w = stack.pop()
+                        on.discard(w)
+                        comp[w] = n
+                        if w == node:
+                            break
+
+    for v in order:
+        if v not in index:
+            visit(v)
+    return comp
+
+
+def _cycle(unit: Unit, start: str, comp: dict[str, int]) -> list[str]:
+    """A call cycle through ``start`` (``[start, ..., last]``, where last
+    calls start), or [] when ``start`` is not recursive."""
+    if start in unit.pous[start].calls:
+        return [start]
+    # breadth-first inside the component, for the shortest cycle
+    prev: dict[str, str] = {}
+    queue = [start]
+    for node in queue:
+        for c in unit.pous[node].calls:
+            if comp.get(c) != comp[start]:
+                continue
+            if c == start:
+                path = [node]
+                while path[-1] != start:
+                    path.append(prev[path[-1]])
+                return list(reversed(path))
+            if c not in prev:
+                prev[c] = node
+                queue.append(c)
+    return []
 
 
 def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:

@@ -84,7 +84,9 @@ class Plc:
         self.stop_requested = False
         self.timers = TimerBank(self.mem.areas["TV"], self.mem.areas["TB"], self.model.timers)
         self.counters = CounterBank(self.mem.areas["CV"], self.mem.areas["CB"], self.model.counters)
-        self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0]
+        #: watchdog and nesting state of the scan: instructions in loops,
+        #: their limit, the count before the last WDR, active subroutines
+        self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0, 0]
         self.devices: list[Any] = []
         if system_symbols is None:
             from ..lang.symbols import SYSTEM_SYMBOLS
@@ -189,6 +191,7 @@ class Plc:
         wd = self.wd
         wd[0] = 0
         wd[2] = 0
+        wd[3] = 0
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
@@ -262,6 +265,16 @@ class Plc:
             f"watchdog: the loop around WDR{line} ran ten times the {WATCHDOG_MS} ms watchdog "
             f"time in one scan ({self._loop_work()}); WDR retriggers the watchdog, but plcrt "
             f"stops a scan that never ends; the CPU goes to STOP", loc)
+
+    def nesting_exceeded(self, insn_id: int) -> None:
+        """A CALL that would nest a ninth subroutine level: the CPU does not
+        execute it, sets SM4.3 (run-time programming error, code 0008) and
+        gives ENO 0; plcrt warns once per CALL (System Manual, CALL)."""
+        self.mem.areas["SM"][4] |= 0x08
+        loc = self.unit.locs[insn_id] if 0 <= insn_id < len(self.unit.locs) else None
+        self.warn(f"CALL not executed: it would nest subroutines deeper than the S7-200's "
+                  f"limit of 8 levels (run-time error 0008; SM4.3 set, ENO 0)", loc,
+                  f"nesting:{insn_id}")
 
     def _loop_work(self) -> str:
         """``about N instructions in loops, about T s`` of this scan (WDR
@@ -525,6 +538,10 @@ class Plc:
             if isinstance(obj, bytearray):
                 other[:] = obj
                 memo[id(obj)] = other
+            elif isinstance(obj, list) and all(isinstance(b, bytearray) for b in obj):
+                for mine, theirs in zip(obj, other):   # L buffers per nesting level
+                    theirs[:] = mine
+                    memo[id(mine)] = theirs
             elif isinstance(obj, (types.FunctionType, types.MethodType,
                                   types.BuiltinFunctionType)):
                 continue   # code and bound methods of the banks: no own state

@@ -218,3 +218,108 @@ def test_cli_max_wall_exit_status_3(tmp_path: Path, capsys: pytest.CaptureFixtur
     err = capsys.readouterr().err
     assert code == 3
     assert "plcrt: error: stopped by --max-wall after 0.3 s of wall-clock time, at " in err
+
+
+# -- recursion and nesting depth (System Manual, CALL) -----------------------------
+RECURSIVE = """\
+ORGANIZATION_BLOCK OB1
+BEGIN
+Network 1
+LD SM0.0
+MOVW +0, VW0
+MOVW +0, VW40
+MOVW +0, VW62
+CALL SBR0, 1
+AENO
+= Q0.0
+END_ORGANIZATION_BLOCK
+SUBROUTINE_BLOCK SBR_0:SBR0
+VAR_INPUT
+n:INT;
+END_VAR
+BEGIN
+Network 1
+LD SM0.0
+INCW VW0
+Network 2
+LDW< VW0, VW20
+MOVW #n, VW50
+INCW VW50
+CALL SBR0, VW50
+AENO
+INCW VW62
+Network 3
+LD SM0.0
++I #n, VW40
+END_SUBROUTINE_BLOCK
+"""
+
+
+def test_recursion_compiles_with_a_warning_naming_the_cycle() -> None:
+    plc = plcrt.load(RECURSIVE)
+    warnings = [d for d in plc.diagnostics if d.code == "recursion"]
+    assert len(warnings) == 1
+    assert warnings[0].message.startswith("recursion: SBR0 -> SBR0; the S7-200 allows it")
+    assert warnings[0].loc is not None and warnings[0].loc.line == 24
+
+
+def test_indirect_recursion_names_every_block_of_the_cycle() -> None:
+    text = (ob1_text("LD SM0.0\nCALL SBR0")
+            + "SUBROUTINE_BLOCK SBR0\nBEGIN\nNetwork 1\nLDW< VW0, +3\nINCW VW0\nCALL SBR1\n"
+              "END_SUBROUTINE_BLOCK\n"
+            + "SUBROUTINE_BLOCK SBR1\nBEGIN\nNetwork 1\nLD SM0.0\nCALL SBR0\n"
+              "END_SUBROUTINE_BLOCK\n")
+    plc = plcrt.load(text)
+    assert [d.message.split(";")[0] for d in plc.diagnostics if d.code == "recursion"] == \
+        ["recursion: SBR0 -> SBR1 -> SBR0"]
+    plc.scan()
+    assert plc["VW0"] == 3
+
+
+def test_recursion_three_levels_deep_runs_with_its_own_locals_per_level() -> None:
+    """Each level has its own L memory: the sum of #n over the levels is
+    1 + 2 + 3, which a shared buffer would overwrite."""
+    plc = plcrt.load(RECURSIVE)
+    plc["VW20"] = 3
+    plc.scan()
+    assert (plc["VW0"], plc["VW40"], plc["SM4.3"], plc["Q0.0"]) == (3, 6, 0, 1)
+    assert plc["VW62"] == 2            # ENO 1 after the two recursive calls
+    assert not [d for d in plc.diagnostics if d.code == "runtime"]
+
+
+def test_a_ninth_nesting_level_is_not_executed_and_sets_sm4_3() -> None:
+    """As decided in docs/decisions.md: the CALL that would be the ninth
+    level is skipped with ENO 0 and SM4.3 set; the CPU keeps running."""
+    plc = plcrt.load(RECURSIVE)
+    plc["VW20"] = 20
+    plc.scan()
+    assert (plc["VW0"], plc["VW40"]) == (8, sum(range(1, 9)))
+    assert plc["SM4.3"] == 1 and plc.mode == "RUN"
+    assert plc["VW62"] == 7           # ENO 0 after the refused ninth-level call
+    assert plc["Q0.0"] == 1           # the outermost call itself succeeded
+    warnings = [d for d in plc.diagnostics if d.code == "runtime"]
+    assert len(warnings) == 1 and "deeper than the S7-200's limit of 8" in warnings[0].message
+    assert warnings[0].loc is not None and warnings[0].loc.line == 24
+    plc.scan()
+    assert plc.mode == "RUN" and plc["VW0"] == 8
+
+
+def test_a_fork_of_a_recursive_program_keeps_its_locals() -> None:
+    plc = plcrt.load(RECURSIVE)
+    plc["VW20"] = 3
+    plc.scan()
+    twin = plc.fork()
+    twin.scan()
+    assert (twin["VW0"], twin["VW40"]) == (3, 6)
+
+
+def test_a_nine_level_chain_warns_at_compile_time_and_stops_at_run_time() -> None:
+    blocks = "".join(
+        f"SUBROUTINE_BLOCK SBR{i}\nBEGIN\nNetwork 1\nLD SM0.0\n"
+        + (f"INCW VW0\nCALL SBR{i + 1}\n" if i < 8 else "INCW VW0\n")
+        + "END_SUBROUTINE_BLOCK\n" for i in range(9))
+    plc = plcrt.load(ob1_text("LD SM0.0\nCALL SBR0") + blocks)
+    assert any(d.code == "nesting" and "nest 9 levels deep" in d.message
+               for d in plc.diagnostics)
+    plc.scan()
+    assert plc["VW0"] == 8 and plc["SM4.3"] == 1

@@ -100,8 +100,7 @@ def read_capped(path: str | Path, limit: int) -> bytes:
         if stat.S_ISDIR(mode):
             raise fail("it is a directory")
         if not stat.S_ISREG(mode):
-            raise fail("it is not a regular file (a device, a pipe or a socket); "
-                       "give a program file")
+            raise fail("it is not a regular file (a device, a pipe or a socket)")
         chunks: list[bytes] = []
         size = 0
         while size <= limit:

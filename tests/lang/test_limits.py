@@ -209,3 +209,11 @@ def test_errors_are_listed_before_a_flood_of_warnings() -> None:
     kept, more = capped(diags, ordered=True)
     assert len(kept) == 100 and kept[-1].message == "the one error"
     assert more == "... and 50 more warnings not listed (the first 100 are shown)"
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero")
+def test_a_plant_file_has_the_same_limits() -> None:
+    """--plant /dev/zero is refused, not read for ever."""
+    with pytest.raises(PlcConfigError, match="/dev/zero: cannot read plant file: it is not "
+                                             "a regular file"):
+        plcrt.load(ob1_text("LD I0.0\n= Q0.0"), plant=Path("/dev/zero"))

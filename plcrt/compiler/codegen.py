@@ -247,10 +247,13 @@ def check_calls(unit: Unit) -> None:
     reported: set[int] = set()
     for ident in order:
         info = unit.pous[ident]
-        cycle = _cycle(unit, ident, comp)
-        if cycle and comp[ident] not in reported:
+        cycle = [] if comp[ident] in reported else _cycle(unit, ident, comp)
+        if cycle:
             reported.add(comp[ident])
-            names = " -> ".join(cycle + [cycle[0]])
+            shown = cycle + [cycle[0]]
+            if len(shown) > 7:   # a hostile program's cycle of thousands of blocks
+                shown = shown[:3] + [f"... ({len(cycle)} blocks) ..."] + shown[-2:]
+            names = " -> ".join(shown)
             loc = info.calls[cycle[1] if len(cycle) > 1 else ident]
             unit.diag.warning(
                 f"recursion: {names}; the S7-200 allows it but nests subroutines at most "
@@ -259,20 +262,34 @@ def check_calls(unit: Unit) -> None:
             unit.nest_check = True
     if unit.nest_check:
         return
-    memo: dict[str, int] = {}
-
-    def depth(ident: str) -> int:
-        if ident not in memo:
-            memo[ident] = max((1 + depth(c) for c in unit.pous[ident].calls), default=0)
-        return memo[ident]
-
+    height = _heights(unit)
     for ident, info in unit.pous.items():
-        if info.pou.kind != "SBR" and depth(ident) > MAX_NESTING:
-            deepest = max(info.calls, key=depth)
-            unit.diag.warning(f"subroutine calls from {ident} nest {depth(ident)} levels "
+        if info.pou.kind != "SBR" and height[ident] > MAX_NESTING:
+            deepest = max(info.calls, key=height.__getitem__)
+            unit.diag.warning(f"subroutine calls from {ident} nest {height[ident]} levels "
                               f"deep; the S7-200 allows {MAX_NESTING}: a deeper CALL is not "
                               f"executed (SM4.3 is set)", info.calls[deepest], "nesting")
             unit.nest_check = True
+
+
+def _heights(unit: Unit) -> dict[str, int]:
+    """How many subroutine levels each block's deepest call chain has (the
+    call graph has no cycle here).  Iterative: a hostile program may chain
+    thousands of blocks, deeper than Python's recursion limit."""
+    memo: dict[str, int] = {}
+    for root in unit.pous:
+        stack = [(root, False)]
+        while stack:
+            node, children_done = stack.pop()
+            if node in memo:
+                continue
+            calls = unit.pous[node].calls
+            if children_done:
+                memo[node] = max((1 + memo[c] for c in calls), default=0)
+            else:
+                stack.append((node, True))
+                stack.extend((c, False) for c in calls if c not in memo)
+    return memo
 
 
 def _components(unit: Unit, order: list[str]) -> dict[str, int]:

@@ -323,3 +323,25 @@ def test_a_nine_level_chain_warns_at_compile_time_and_stops_at_run_time() -> Non
                for d in plc.diagnostics)
     plc.scan()
     assert plc["VW0"] == 8 and plc["SM4.3"] == 1
+
+
+def _blocks(n: int, cyclic: bool) -> str:
+    return "".join(
+        f"SUBROUTINE_BLOCK SBR{i}\nBEGIN\nNetwork 1\nLD SM0.0\nINCW VW0\n"
+        + (f"CALL SBR{(i + 1) % n}\n" if cyclic or i < n - 1 else "")
+        + "END_SUBROUTINE_BLOCK\n" for i in range(n))
+
+
+@pytest.mark.parametrize("cyclic", [False, True])
+def test_call_graphs_deeper_than_pythons_recursion_limit(cyclic: bool) -> None:
+    """A chain or a cycle of 1200 blocks is analysed without recursion (no
+    internal error) and runs 8 levels deep; a long cycle is named shortly."""
+    plc = plcrt.load(ob1_text("LD SM0.0\nCALL SBR0") + _blocks(1200, cyclic))
+    if cyclic:
+        (warning,) = [d for d in plc.diagnostics if d.code == "recursion"]
+        assert warning.message.startswith(
+            "recursion: SBR0 -> SBR1 -> SBR2 -> ... (1200 blocks) ... -> SBR1199 -> SBR0;")
+    else:
+        assert any("nest 1200 levels deep" in d.message for d in plc.diagnostics)
+    plc.scan()
+    assert (plc["VW0"], plc["SM4.3"]) == (8, 1)

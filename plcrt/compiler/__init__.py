@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import DiagnosticSink, PlcCompileError
 from ..lang import ir
-from ..lang.limits import MAX_INSTRUCTIONS
+from ..lang.limits import MAX_INSTRUCTIONS, MAX_NETWORKS
 from ..memory.cpu import CpuModel
 from .codegen import Compiled, Unit, build_unit, generate
 
@@ -48,8 +48,14 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
 
 def _check_size(program: ir.Program) -> None:
     """Refuse a program too big to compile in bounded memory (compiling
-    costs several kilobytes per instruction), at its first instruction past
+    costs several kilobytes per instruction and network), at its first
+    network or instruction past :data:`~plcrt.lang.limits.MAX_NETWORKS` or
     :data:`~plcrt.lang.limits.MAX_INSTRUCTIONS`."""
+    networks = program.network_count()
+    if networks > MAX_NETWORKS:
+        net = [n for p in program.pous for n in p.networks][MAX_NETWORKS]
+        raise PlcCompileError(f"the program has {networks} networks, more than plcrt "
+                              f"compiles ({MAX_NETWORKS})", net.loc)
     if program.instruction_count() <= MAX_INSTRUCTIONS:
         return
     count = 0

@@ -6,8 +6,9 @@ a 50 MB program that is valid STL takes minutes and gigabytes before
 failing.  :func:`read_capped` reads at most ``limit + 1`` bytes of a
 *regular* file and refuses anything bigger (or a device, a FIFO, a
 socket) with a :class:`~plcrt.errors.PlcSyntaxError` naming the file and
-the limit.  :data:`MAX_INSTRUCTIONS` bounds what the compiler is asked to
-build, since compiling costs several kilobytes per instruction.
+the limit.  :data:`MAX_INSTRUCTIONS` and :data:`MAX_NETWORKS` bound what the compiler
+is asked to build, since compiling costs several kilobytes per instruction
+and per network.
 
 The limits are far above any real S7-200 program: the largest CPU holds
 24 KB of program, a few thousand instructions, and its STL export is
@@ -32,6 +33,10 @@ MAX_FILE_MB = 1.0
 
 #: largest number of instructions compiled in one program
 MAX_INSTRUCTIONS = 32_768
+
+#: largest number of networks compiled in one program (each becomes a
+#: generated function, even an empty one)
+MAX_NETWORKS = 16_384
 
 #: longest run of digits read as a number.  Python refuses to convert more
 #: than 4300 (a ValueError); no S7-200 number needs more than a few dozen
@@ -132,5 +137,5 @@ def check_text_size(text: str, name: str, limit: int) -> None:
                              f"load(..., max_file_mb=...))", SourceLoc(name, 1, 1))
 
 
-__all__ = ["MAX_DIGITS", "MAX_FILE_MB", "MAX_INSTRUCTIONS", "check_text_size",
+__all__ = ["MAX_DIGITS", "MAX_FILE_MB", "MAX_INSTRUCTIONS", "MAX_NETWORKS", "check_text_size",
            "describe_limit", "file_limit", "read_capped", "too_many_digits"]

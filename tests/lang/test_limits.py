@@ -217,3 +217,14 @@ def test_a_plant_file_has_the_same_limits() -> None:
     with pytest.raises(PlcConfigError, match="/dev/zero: cannot read plant file: it is not "
                                              "a regular file"):
         plcrt.load(ob1_text("LD I0.0\n= Q0.0"), plant=Path("/dev/zero"))
+
+
+def test_too_many_networks_is_a_compile_error_at_the_first_one_past(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Even empty networks cost a generated function each: they are capped too."""
+    monkeypatch.setattr("plcrt.compiler.MAX_NETWORKS", 2)
+    with pytest.raises(PlcCompileError) as info:
+        plcrt.load(ob1_text("LD I0.0\n= Q0.0", "LD I0.1\n= Q0.1", "LD I0.2\n= Q0.2"))
+    err = info.value
+    assert err.message == "the program has 3 networks, more than plcrt compiles (2)"
+    assert err.loc is not None and (err.loc.line, err.loc.network) == (9, 3)

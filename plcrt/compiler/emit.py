@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from typing import Any, Iterator
 
 from ..errors import SourceLoc
+from ..safetext import excerpt
 from .operands import Addr, Const, Indirect, Pointer
 
 MAX_STACK = 9  #: S7-200 logic stack depth (System Manual, "logic stack")
@@ -357,7 +358,7 @@ def const_expr(c: Const, kind: str) -> str:
         try:
             return repr(struct.unpack(">f", struct.pack(">f", float(v)))[0])
         except OverflowError:
-            raise CodegenError(f"real constant {c.text} is outside the REAL range") from None
+            raise CodegenError(f"real constant {excerpt(c.text)} is outside the REAL range") from None
     if isinstance(v, float):
         if kind[0] == "D" and not c.is_real:
             v = int(v)

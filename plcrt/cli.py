@@ -16,9 +16,10 @@ address is spelled and what a diagnostic says are decided by the core.
 
 Exit status: 0 success, 1 a problem with the input (missing file, syntax or
 compile error, bad option or address, internal error), 2 a run-time fault of
-the PLC program (the CPU went to STOP), 3 a run stopped by ``--max-wall``.  No path prints a Python traceback;
-an unexpected exception is reported as an internal error, and the traceback
-is shown only when the environment variable ``PLCRT_TRACEBACK`` is set.
+the PLC program (the CPU went to STOP), 3 a run stopped by ``--max-wall``.
+No path prints a Python traceback; an unexpected exception is reported as an
+internal error, and the traceback is shown only when the environment
+variable ``PLCRT_TRACEBACK`` is set.
 
 ``rich`` is imported lazily and only for the tables on a terminal.
 

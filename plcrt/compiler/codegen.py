@@ -618,7 +618,8 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
         unit.pous[ident] = info
         if p.name and p.name.upper() != ident:
             if p.name.upper() in unit.by_name:
-                diag.error(f"block name '{excerpt(p.name)}' is used twice", p.loc.within(ident, None))
+                diag.error(f"block name '{excerpt(p.name)}' is used twice",
+                           p.loc.within(ident, None))
             unit.by_name[p.name.upper()] = info
     if not program.pous:
         diag.error("the file holds no program block (it is empty, or only comments), so "

@@ -358,7 +358,8 @@ def const_expr(c: Const, kind: str) -> str:
         try:
             return repr(struct.unpack(">f", struct.pack(">f", float(v)))[0])
         except OverflowError:
-            raise CodegenError(f"real constant {excerpt(c.text)} is outside the REAL range") from None
+            raise CodegenError(f"real constant {excerpt(c.text)} is outside the REAL "
+                               f"range") from None
     if isinstance(v, float):
         if kind[0] == "D" and not c.is_real:
             v = int(v)

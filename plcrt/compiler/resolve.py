@@ -150,8 +150,8 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
     if isinstance(op, Name):
         if role in (Role.LABEL,):
             raise _bad(text, role)
-        raise ResolveError(f"unknown symbol '{excerpt(text)}': not an address or constant, and not "
-                           f"in the symbol table (give one with --symbols)")
+        raise ResolveError(f"unknown symbol '{excerpt(text)}': not an address or constant, "
+                           f"and not in the symbol table (give one with --symbols)")
     if role is Role.LABEL:
         if isinstance(op, Const) and isinstance(op.value, int) and 0 <= op.value <= 255:
             return op

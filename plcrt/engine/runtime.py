@@ -243,7 +243,12 @@ class Plc:
         """The scan's loops ran past the watchdog time; ``pc`` is the piece
         of block ``kind``+``number`` that jumped back to piece ``target``."""
         info = self.unit.pous[f"{kind}{number}"]
-        back = info.pieces[pc].insns[-1] if info.pieces[pc].insns else None
+        # the NEXT, or the JMP to the target's label (a piece may hold more
+        # instructions after its JMP)
+        back = next((i for i in reversed(info.pieces[pc].insns) if i.mnemonic == "NEXT"
+                     or i.mnemonic == "JMP" and i.operands
+                     and info.labels.get(_int_or_none(i.operands[0].text)) == target),
+                    None)
         start = next((f for _b, (body, _e, f) in info.loops.items() if body == target), None)
         if start is None and info.pieces[target].insns:
             start = info.pieces[target].insns[0]    # the LBL a JMP goes back to
@@ -578,6 +583,11 @@ class Plc:
         if a.area in ("AC", "HC"):
             return m[a.area], a.offset * 4, 4, 0
         return m[a.area], a.offset, a.width or 0, a.bit
+
+
+def _int_or_none(text: str) -> int | None:
+    t = text.strip()
+    return int(t) if t.isdigit() and len(t) <= 3 else None
 
 
 def _network_of(info: Any, insn: ir.Insn) -> int | None:

@@ -124,8 +124,10 @@ def test_watchdog_names_the_for_loop_and_its_lines() -> None:
     assert 400_000 < count < 450_000       # 500 ms at 1.2 µs per instruction
 
 
-def test_watchdog_names_the_backward_jump() -> None:
-    plc = plcrt.load(ob1_text("LBL 1", "LD SM0.0\nINCW VW2", "LD SM0.0\nJMP 1"))
+@pytest.mark.parametrize("last", ["LD SM0.0\nJMP 1", "LD SM0.0\nJMP 1\nLD I0.0\n= Q0.0"])
+def test_watchdog_names_the_backward_jump(last: str) -> None:
+    """The JMP is named even when more instructions follow it in its network."""
+    plc = plcrt.load(ob1_text("LBL 1", "LD SM0.0\nINCW VW2", last))
     with pytest.raises(PlcRuntimeError) as info:
         plc.scan()
     assert "in the loop from LBL at line 4 to JMP at line 10 of OB1" in info.value.message

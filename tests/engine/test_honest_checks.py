@@ -347,3 +347,10 @@ def test_call_graphs_deeper_than_pythons_recursion_limit(cyclic: bool) -> None:
         assert any("nest 1200 levels deep" in d.message for d in plc.diagnostics)
     plc.scan()
     assert (plc["VW0"], plc["SM4.3"]) == (8, 1)
+
+
+def test_programs_without_recursion_pay_nothing_for_the_nesting_check() -> None:
+    """The run-time nesting count is generated only where it can matter."""
+    plain = plcrt.load(ob1_text("LD SM0.0\nCALL SBR0") + SBR)
+    assert "WD[3]" not in plain.source
+    assert "WD[3] >= 8" in plcrt.load(RECURSIVE).source

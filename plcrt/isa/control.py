@@ -266,7 +266,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
     params = [v.decl for v in callee.local_vars.values() if v.decl.section != "TEMP"]
     actual = insn_ir.operands[1:]
     if len(actual) != len(params):
-        g.fail(f"{callee.pou.ident} ({callee.pou.name}) takes {len(params)} parameter(s) "
+        g.fail(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) takes {len(params)} parameter(s) "
                f"in the order IN, IN_OUT, OUT; the call passes {len(actual)}")
     copy_in: list[tuple] = []
     copy_out: list[tuple] = []

@@ -228,3 +228,14 @@ def test_too_many_networks_is_a_compile_error_at_the_first_one_past(
     err = info.value
     assert err.message == "the program has 3 networks, more than plcrt compiles (2)"
     assert err.loc is not None and (err.loc.line, err.loc.network) == (9, 3)
+
+
+def test_a_long_block_name_is_quoted_short_in_call_errors() -> None:
+    name = "Y" * 3000
+    text = (ob1_text("LD I0.0\nCALL SBR0, 1")
+            + f"SUBROUTINE_BLOCK {name}:SBR0\nBEGIN\nNetwork 1\nLD I0.0\n= Q0.0\n"
+              f"END_SUBROUTINE_BLOCK\n")
+    with pytest.raises(PlcCompileError) as info:
+        plcrt.load(text)
+    assert "SBR0 (" + "Y" * 40 + "\u2026) takes 0 parameter(s)" in str(info.value)
+    assert len(str(info.value)) < 300

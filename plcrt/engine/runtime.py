@@ -277,8 +277,8 @@ class Plc:
         gives ENO 0; plcrt warns once per CALL (System Manual, CALL)."""
         self.mem.areas["SM"][4] |= 0x08
         loc = self.unit.locs[insn_id] if 0 <= insn_id < len(self.unit.locs) else None
-        self.warn(f"CALL not executed: it would nest subroutines deeper than the S7-200's "
-                  f"limit of 8 levels (run-time error 0008; SM4.3 set, ENO 0)", loc,
+        self.warn("CALL not executed: it would nest subroutines deeper than the S7-200's "
+                  "limit of 8 levels (run-time error 0008; SM4.3 set, ENO 0)", loc,
                   f"nesting:{insn_id}")
 
     def _loop_work(self) -> str:

@@ -118,13 +118,14 @@ def _run_watched(plc: Any, total: int, out: TextIO | None, max_wall: float | Non
     stopping at ``max_wall``."""
     start = clock()
     next_line = start + PROGRESS_EVERY_S
+    first = plc.scans
     done = 0
     chunk = 100
     while done < total and plc.mode == "RUN":
         n = min(chunk, total - done)
         t0 = clock()
         plc.scan(n)
-        done += n
+        done = plc.scans - first   # fewer than asked when a STOP ended the run
         now = clock()
         took = now - t0
         # perf: chunks grow until one takes about _CHUNK_S, so the clock is

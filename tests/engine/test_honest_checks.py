@@ -354,3 +354,12 @@ def test_programs_without_recursion_pay_nothing_for_the_nesting_check() -> None:
     plain = plcrt.load(ob1_text("LD SM0.0\nCALL SBR0") + SBR)
     assert "WD[3]" not in plain.source
     assert "WD[3] >= 8" in plcrt.load(RECURSIVE).source
+
+
+def test_cli_progress_prints_plain_lines_off_a_terminal(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = _file(tmp_path, "p.awl", ob1_text("LD SM0.0\nINCW VW0"))
+    assert main(["run", str(path), "--scans", "300", "--progress", "--watch", "VW0"]) == 0
+    out, err = capsys.readouterr()
+    assert "plcrt: 300/300 scans (100.0 %), 3 s simulated, " in err
+    assert "VW0      300" in out

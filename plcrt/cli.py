@@ -16,9 +16,10 @@ address is spelled and what a diagnostic says are decided by the core.
 
 Exit status: 0 success, 1 a problem with the input (missing file, syntax or
 compile error, bad option or address, internal error), 2 a run-time fault of
-the PLC program (the CPU went to STOP).  No path prints a Python traceback;
-an unexpected exception is reported as an internal error, and the traceback
-is shown only when the environment variable ``PLCRT_TRACEBACK`` is set.
+the PLC program (the CPU went to STOP), 3 a run stopped by ``--max-wall``.
+No path prints a Python traceback; an unexpected exception is reported as an
+internal error, and the traceback is shown only when the environment
+variable ``PLCRT_TRACEBACK`` is set.
 
 ``rich`` is imported lazily and only for the tables on a terminal.
 
@@ -43,13 +44,14 @@ from typing import Any, NamedTuple, NoReturn, TextIO
 from . import __version__
 from .engine.runtime import Plc, load
 from .engine.values import json_number, parse_number, split_format
-from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError
+from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError, capped
 from .dump import render_dump
 from .safetext import printable
 
 EXIT_OK = 0
 EXIT_ERROR = 1
 EXIT_FAULT = 2
+EXIT_WALL = 3   #: the run reached --max-wall
 
 PROG = "plcrt"
 
@@ -125,6 +127,9 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
         p.add_argument("--plant", metavar="F",
                        help="plant file (TOML): EM253 modules and the machine around "
                             "their axes")
+    p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
+                   help="refuse program, symbol and data files larger than this "
+                        "(default 16 MB, far above any S7-200 program)")
 
 
 #: Subcommands defined beside the feature they present; each module has
@@ -138,7 +143,7 @@ def _build_parser() -> _Parser:
         prog=PROG,
         description="Run Siemens S7-200 (STEP 7-Micro/WIN) STL programs in Python.",
         epilog="Exit status: 0 ok, 1 error in the input or options, "
-               "2 run-time fault of the PLC program.")
+               "2 run-time fault of the PLC program, 3 run stopped by --max-wall.")
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
@@ -155,6 +160,7 @@ def _build_parser() -> _Parser:
     common(p)
     add_scan_ms_arg(p)
     add_run_length_args(p)
+    add_long_run_args(p)
     add_set_args(p)
     p.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="print this address at the end; ADDR:REAL reads a float")
@@ -187,9 +193,10 @@ def _build_parser() -> _Parser:
 # ---------------------------------------------------------------------------
 
 def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
-                   instrument: bool = False) -> Plc:
+                   instrument: bool = False, library: bool = False) -> Plc:
     """Load the program named on the command line (raises PlcError);
-    ``instrument`` compiles the network probes breakpoints use."""
+    ``instrument`` compiles the network probes breakpoints use, ``library``
+    accepts a program without OB1 (for ``check`` and ``dump``)."""
     data = getattr(args, "data", None)
     plant = getattr(args, "plant", None)
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
@@ -198,15 +205,19 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 symbols=Path(args.symbols) if args.symbols else None,
                 data=Path(data) if data else None,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
-                plant=Path(plant) if plant else None, instrument=instrument,
-                encoding=getattr(args, "encoding", None))
+                plant=Path(plant) if plant else None, instrument=instrument, library=library,
+                encoding=getattr(args, "encoding", None),
+                max_file_mb=getattr(args, "max_file_mb", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors."""
+    """``plcrt check``: diagnostics on stderr, a summary line, status 1 on errors.
+
+    A subroutine library (blocks, no OB1) passes with a note saying it
+    cannot run on its own; a file without any block is an error."""
     name = ", ".join(args.programs)
     try:
-        plc = load_from_args(args)
+        plc = load_from_args(args, library=True)
     except PlcError as e:
         diags = e.diagnostics
         print_diagnostics(diags)
@@ -225,7 +236,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     """``plcrt run``: load, apply --set, run, print --watch values (and the
     axes of a --plant).  A long run on a terminal shows a progress bar on
     stderr; ``--quiet`` prints nothing but errors (and the --json object)."""
-    from .trace.progress import run_with_progress
+    from .trace.progress import WallTimeExceeded, run_with_progress
 
     program = args.programs[0]
     quiet = getattr(args, "quiet", False)
@@ -247,18 +258,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     fault: PlcError | None = None
+    stopped: PlcError | None = None
     loaded = len(plc.diagnostics)
     try:
         # same scans and results as plc.run(); only the bar differs
-        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=quiet)
+        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=quiet,
+                          max_wall=args.max_wall, progress=args.progress)
     except PlcRuntimeError as e:
         fault = e
+    except WallTimeExceeded as e:
+        stopped = e
     # Warnings raised while running (library blocks such as the EM253's
     # report bad parameters only when they execute) go to stderr as well.
     report(plc.diagnostics[loaded:])
     values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
     if args.json:
-        _emit_json(args, plc, values, str(fault) if fault else None)
+        _emit_json(args, plc, values, str(fault or stopped) if fault or stopped else None)
     elif not quiet:
         _print_values(program, plc, values)
         if args.plant:
@@ -266,13 +281,17 @@ def cmd_run(args: argparse.Namespace) -> int:
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if stopped is not None:
+        print_diagnostics(stopped.diagnostics)
+        return EXIT_WALL
     return EXIT_OK
 
 
 def cmd_dump(args: argparse.Namespace) -> int:
-    """``plcrt dump``: the generated module with STL lines as comments."""
+    """``plcrt dump``: the generated module with STL lines as comments
+    (of a subroutine library too)."""
     try:
-        plc = load_from_args(args)
+        plc = load_from_args(args, library=True)
     except PlcError as e:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR
@@ -289,11 +308,6 @@ def cmd_dump(args: argparse.Namespace) -> int:
 SET_HELP = ("write before the first scan (inputs keep their value); "
             "VALUE: 12, -3, 16#FF, 2#1010, 1.5, NaN, Infinity")
 
-#: why a program without OB1 cannot run
-NO_OB1 = ("the program has no main program block (OB1), so there is nothing to run; "
-          "give the file with OB1 as well")
-
-
 def add_scan_ms_arg(p: argparse.ArgumentParser) -> None:
     """``--scan-ms MS``, the simulated scan time (``args.scan_ms``, default 10)."""
     p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
@@ -308,6 +322,18 @@ def add_run_length_args(p: argparse.ArgumentParser, *, required: bool = True,
     length = p.add_mutually_exclusive_group(required=required)
     length.add_argument("--seconds", type=float, metavar="S", help=seconds_help)
     length.add_argument("--scans", type=int, metavar="N", help=scans_help)
+
+
+def add_long_run_args(p: argparse.ArgumentParser) -> None:
+    """``--max-wall SECONDS`` (stop a run after that much wall-clock time,
+    exit status 3) and ``--progress`` (progress lines on stderr when it is
+    not a terminal; a terminal gets the bar)."""
+    p.add_argument("--max-wall", type=float, metavar="SECONDS",
+                   help="stop the run after this many wall-clock seconds (exit status 3), "
+                        "reporting the simulated time reached")
+    p.add_argument("--progress", action="store_true",
+                   help="show progress on stderr: a line every few seconds when stderr is "
+                        "not a terminal (CI logs), the bar on a terminal")
 
 
 def add_set_args(p: argparse.ArgumentParser, *, help: str = SET_HELP) -> None:
@@ -326,6 +352,8 @@ def check_run_length(args: argparse.Namespace) -> None:
         raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
     if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
         raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
+    from .trace.progress import check_max_wall
+    check_max_wall(getattr(args, "max_wall", None))
 
 
 class SetItem(NamedTuple):
@@ -380,19 +408,17 @@ def apply_sets(plc: Plc, sets: Sequence[SetItem]) -> None:
 
 def load_for_run(args: argparse.Namespace, sets: Sequence[SetItem] = (), *,
                  report: Callable[[Sequence[Diagnostic]], None] | None = None,
-                 instrument: bool = False, no_ob1: str = NO_OB1) -> Plc:
+                 instrument: bool = False) -> Plc:
     """Load the program of a command that runs it (``--scan-ms`` and the
     program options), report the load-time warnings (``report``, default
-    :func:`print_diagnostics`), require OB1 (else ``no_ob1``) and write the
-    ``--set`` values.
+    :func:`print_diagnostics`) and write the ``--set`` values.
 
     Raises:
-        PlcError: the program does not load, has no OB1, or a write fails.
+        PlcError: the program does not load (a program without OB1 is a
+            compile error), or a write fails.
     """
     plc = load_from_args(args, args.scan_ms, instrument=instrument)
     (report or print_diagnostics)(plc.diagnostics)  # warnings
-    if "OB1" not in plc.unit.pous:
-        raise PlcConfigError(no_ob1)
     apply_sets(plc, sets)
     return plc
 
@@ -547,16 +573,15 @@ def _print_rich_axes(rows: list[list[str]]) -> bool:
 # ---------------------------------------------------------------------------
 
 def print_diagnostics(diags: Sequence[Diagnostic], stream: TextIO | None = None) -> None:
-    """GNU-style lines, in source order (stable for equal positions)."""
+    """GNU-style lines, in source order (stable for equal positions); at
+    most :data:`~plcrt.errors.MAX_LISTED` of them (errors first), then one
+    line counting the rest."""
     stream = stream or sys.stderr
-
-    def key(d: Diagnostic) -> tuple[int, str, int, int]:
-        if d.loc is None:
-            return (0, "", 0, 0)
-        return (1, d.loc.file, d.loc.line, d.loc.column)
-
-    for d in sorted(diags, key=key):
+    kept, more = capped(diags, ordered=True)
+    for d in kept:
         print(str(d) if d.loc is not None else f"{PROG}: {d}", file=stream)
+    if more is not None:
+        print(f"{PROG}: {more}", file=stream)
 
 
 def _count(diags: Sequence[Diagnostic]) -> str:
@@ -597,7 +622,8 @@ def _silence_stdout() -> None:
         pass
 
 
-__all__ = ["NO_OB1", "SET_HELP", "SetItem", "add_program_args", "add_run_length_args",
+__all__ = ["EXIT_WALL", "SET_HELP", "SetItem", "add_long_run_args", "add_program_args",
+           "add_run_length_args",
            "add_scan_ms_arg", "add_set_args", "apply_sets", "check_run_length",
            "load_for_run", "load_from_args", "main", "parse_sets", "parse_value",
            "print_diagnostics", "render_dump"]

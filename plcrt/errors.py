@@ -13,9 +13,9 @@ This module is not a logger and does no I/O.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Iterable, Literal
+from typing import Iterable, Literal, Sequence
 
-from .safetext import printable
+from .safetext import excerpt, printable
 
 Severity = Literal["error", "warning", "note"]
 
@@ -38,9 +38,10 @@ class SourceLoc:
         """The ``[OB1 network 7]`` suffix, or an empty string."""
         if self.block is None:
             return ""
+        block = excerpt(self.block)
         if self.network is None:
-            return f" [{self.block}]"
-        return f" [{self.block} network {self.network}]"
+            return f" [{block}]"
+        return f" [{block} network {self.network}]"
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.column}"
@@ -63,6 +64,52 @@ class Diagnostic:
         return printable(f"{self.loc}: {self.severity}: {self.message}{self.loc.context()}")
 
 
+#: most diagnostics listed in one report (``plcrt check``, ``str(PlcError)``);
+#: a file with thousands of errors gets the first ones and a count of the rest
+MAX_LISTED = 100
+
+_RANK = {"error": 0, "warning": 1, "note": 2}
+
+
+def _position(d: Diagnostic) -> tuple[int, str, int, int]:
+    if d.loc is None:
+        return (0, "", 0, 0)
+    return (1, d.loc.file, d.loc.line, d.loc.column)
+
+
+def capped(diags: Sequence[Diagnostic], limit: int = MAX_LISTED, *,
+           ordered: bool = False) -> tuple[list[Diagnostic], str | None]:
+    """The diagnostics to list, at most ``limit``, and the summary line of
+    the ones left out (None when all are listed).
+
+    Errors are kept before warnings and notes, so a warning flood cannot
+    hide an error.  ``ordered`` sorts the kept ones by source position
+    (stable), as :func:`plcrt.cli.print_diagnostics` lists them.
+    """
+    if len(diags) <= limit:
+        kept = list(diags)
+        rest: list[Diagnostic] = []
+    else:
+        by_rank = sorted(range(len(diags)), key=lambda i: _RANK.get(diags[i].severity, 3))
+        keep = set(by_rank[:limit])
+        kept = [d for i, d in enumerate(diags) if i in keep]
+        rest = [d for i, d in enumerate(diags) if i not in keep]
+    if ordered:
+        kept.sort(key=_position)
+    if not rest:
+        return kept, None
+    errors = sum(d.severity == "error" for d in rest)
+    warnings = sum(d.severity == "warning" for d in rest)
+    notes = len(rest) - errors - warnings
+    parts = [f"{errors} more error{'s' if errors != 1 else ''}"] if errors else []
+    if warnings:
+        parts.append(f"{warnings} {'more ' if not errors else ''}"
+                     f"warning{'s' if warnings != 1 else ''}")
+    if notes:
+        parts.append(f"{notes} note{'s' if notes != 1 else ''}")
+    return kept, f"... and {', '.join(parts)} not listed (the first {limit} are shown)"
+
+
 class PlcError(Exception):
     """Root of all errors plcrt reports to users."""
 
@@ -76,7 +123,13 @@ class PlcError(Exception):
             self.diagnostics = [Diagnostic("error", message, loc)]
 
     def __str__(self) -> str:
-        return "\n".join(str(d) for d in self.diagnostics)
+        # at most MAX_LISTED lines and a count of the rest: a file with
+        # thousands of errors must not turn one exception into a book
+        kept, more = capped(self.diagnostics)
+        lines = [str(d) for d in kept]
+        if more is not None:
+            lines.append(more)
+        return "\n".join(lines)
 
 
 class PlcSyntaxError(PlcError):
@@ -118,5 +171,9 @@ class DiagnosticSink:
     def raise_if_errors(self, kind: type[PlcError] = PlcCompileError) -> None:
         errors = self.errors
         if errors:
-            head = f"{len(errors)} error(s)"
+            # the first error is the message (what a one-line report shows);
+            # str() of the exception lists them all
+            head = errors[0].message
+            if len(errors) > 1:
+                head += f" (and {len(errors) - 1} more error(s))"
             raise kind(head, errors[0].loc, self.items)

@@ -10,7 +10,12 @@ reaches a terminal, a transcript or a log; everything else, letters of any
 script included, is kept.  A tab becomes one space, so columns stay
 aligned.
 
-This only concerns control characters.  Rich markup (``[bold]``) is the
+:func:`excerpt` shortens program text quoted in a message (an operand,
+a symbol, a value) to :data:`EXCERPT_CHARS` characters and an ellipsis:
+a 200 000-character operand must not be echoed in full.  Every message
+that quotes program text goes through it.
+
+Escaping only concerns control characters.  Rich markup (``[bold]``) is the
 presentation layer's business: it must build ``rich.text.Text`` objects
 from program text, never markup strings.  This module has no dependency.
 """
@@ -44,4 +49,17 @@ def printable(text: str) -> str:
     return _UNSAFE.sub(_escape, text)
 
 
-__all__ = ["printable"]
+#: longest piece of program text a message quotes (see :func:`excerpt`)
+EXCERPT_CHARS = 40
+
+
+def excerpt(text: str, limit: int = EXCERPT_CHARS) -> str:
+    """``text`` as a message quotes it: at most ``limit`` characters, a cut
+    marked with ``…`` (so ``'VW1234…'`` shows both what it was and that
+    there was more)."""
+    if len(text) <= limit:
+        return text
+    return text[:limit] + "\u2026"
+
+
+__all__ = ["EXCERPT_CHARS", "excerpt", "printable"]

@@ -19,6 +19,7 @@ from typing import Any
 from ..compiler.operands import Addr, Const, Indirect
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role
+from ..safetext import excerpt
 from . import BLOCK_FACTORIES
 from .interface import interfaces
 
@@ -54,7 +55,8 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
             op = resolver.parse(op_ir.text)
             if p.dir == "OUT" or p.address:
                 if isinstance(op, Const):
-                    raise ResolveError(f"must be an address, not the constant '{op_ir.text}'")
+                    raise ResolveError(f"must be an address, not the constant "
+                                       f"'{excerpt(op_ir.text)}'")
                 op = check_role(op, _WRITE[p.type], op_ir.text, g.unit.model)
             else:
                 role = Role.D_PTR if p.pointer else _READ[p.type]

@@ -11,6 +11,7 @@ from typing import Any
 
 from ..errors import DiagnosticSink, PlcCompileError
 from ..lang import ir
+from ..lang.limits import MAX_INSTRUCTIONS, MAX_NETWORKS
 from ..memory.cpu import CpuModel
 from .codegen import Compiled, Unit, build_unit, generate
 
@@ -18,7 +19,8 @@ from .codegen import Compiled, Unit, build_unit, generate
 def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None,
                     system_symbols: dict[str, str] | None = None,
                     bindings: dict[str, Any] | None = None,
-                    setup: Any = None, probes: Any = None) -> tuple[Unit, str, dict]:
+                    setup: Any = None, probes: Any = None,
+                    library: bool = False) -> tuple[Unit, str, dict]:
     """Check and generate code; returns the unit, module source and line map.
 
     Args:
@@ -27,18 +29,46 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
             emitters bind.
         probes: a :class:`plcrt.engine.coverage.CoverageMap` to instrument
             the code for (network and output coverage, breakpoints).
+        library: accept a program without OB1 (a subroutine library, for
+            checking only); otherwise that is an error.
 
     Raises:
         PlcCompileError: with every error found (warnings ride along).
     """
+    _check_size(program)
     diag = DiagnosticSink()
-    unit = build_unit(program, model, symbols, system_symbols or {}, diag)
+    unit = build_unit(program, model, symbols, system_symbols or {}, diag, library=library)
     unit.probes = probes
     if setup is not None:
         setup(unit)
     source, line_locs = generate(unit)
     diag.raise_if_errors(PlcCompileError)
     return unit, source, line_locs
+
+
+def _check_size(program: ir.Program) -> None:
+    """Refuse a program too big to compile in bounded memory (compiling
+    costs several kilobytes per instruction and network), at its first
+    network or instruction past :data:`~plcrt.lang.limits.MAX_NETWORKS` or
+    :data:`~plcrt.lang.limits.MAX_INSTRUCTIONS`."""
+    networks = program.network_count()
+    if networks > MAX_NETWORKS:
+        net = [n for p in program.pous for n in p.networks][MAX_NETWORKS]
+        raise PlcCompileError(f"the program has {networks} networks, more than plcrt "
+                              f"compiles ({MAX_NETWORKS})", net.loc)
+    if program.instruction_count() <= MAX_INSTRUCTIONS:
+        return
+    count = 0
+    for pou in program.pous:
+        for net in pou.networks:
+            count += len(net.insns)
+            if count > MAX_INSTRUCTIONS:
+                loc = net.insns[len(net.insns) - (count - MAX_INSTRUCTIONS)].loc
+                raise PlcCompileError(
+                    f"the program has {program.instruction_count()} instructions, more "
+                    f"than plcrt compiles ({MAX_INSTRUCTIONS}); the largest S7-200 holds "
+                    f"a few thousand", loc)
+    raise AssertionError("unreachable")
 
 
 __all__ = ["compile_program", "Compiled", "Unit"]

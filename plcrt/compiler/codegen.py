@@ -17,11 +17,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from ..errors import DiagnosticSink, SourceLoc
+from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
 from ..memory.cpu import CpuModel
+from ..safetext import excerpt
 from .emit import CodegenError, Gen
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
@@ -91,6 +92,11 @@ class Unit:
         #: a :class:`plcrt.engine.coverage.CoverageMap` to add probes for
         #: (coverage and breakpoints), or None for the plain fast code
         self.probes: Any = None
+        #: CALLs count nesting levels at run time (recursion, or chains
+        #: deeper than the limit; see :func:`check_calls`)
+        self.nest_check = False
+        #: (caller, callee) pairs inside a call cycle
+        self.recursive_sites: set[tuple[str, str]] = set()
 
     def fresh(self, hint: str) -> str:
         self._counter += 1
@@ -216,49 +222,142 @@ def _label_number(insn: ir.Insn) -> int | None:
     if len(insn.operands) != 1:
         return None
     t = insn.operands[0].text.strip()
-    return int(t) if t.isdigit() and int(t) <= 255 else None
+    return int(t) if t.isdigit() and len(t) <= 3 and int(t) <= 255 else None
 
 
 def check_calls(unit: Unit) -> None:
-    """Reject recursion and nesting deeper than the S7-200 allows.
+    """Check the call graph against the S7-200's nesting limit.
 
-    Errors point at the CALL instruction that closes a cycle or exceeds the
-    limit.
+    System Manual, CALL: subroutines nest at most eight levels deep from
+    the main program; recursion is allowed ("use caution").  So recursion
+    and call chains deeper than eight are warnings here (naming the cycle
+    or the chain), and they switch on the run-time nesting check
+    (:attr:`Unit.nest_check`): a CALL that would be the ninth level is not
+    executed, sets SM4.3 and gives ENO 0 (error 0008).  Call sites inside a
+    cycle (:attr:`Unit.recursive_sites`) get one L buffer per nesting level.
+    A program without either pays nothing at run time.
     """
-    recursive: set[str] = set()
-
-    def reaches(start: str, target: str, seen: set[str]) -> bool:
-        for c in unit.pous[start].calls:
-            if c == target:
-                return True
-            if c not in seen:
-                seen.add(c)
-                if reaches(c, target, seen):
-                    return True
-        return False
-
-    for ident, info in unit.pous.items():
-        if info.pou.kind == "SBR" and reaches(ident, ident, set()):
-            recursive.add(ident)
-            loc = next((loc for c, loc in info.calls.items() if c == ident
-                        or reaches(c, ident, set())), info.pou.loc)
-            unit.diag.error(f"subroutine {ident} ({info.pou.name}) calls itself "
-                            f"(directly or through other subroutines); recursion exceeds "
-                            f"the nesting limit of {MAX_NESTING}", loc)
-    if recursive:
+    order = list(unit.pous)
+    comp = _components(unit, order)
+    for ident in order:
+        info = unit.pous[ident]
+        for callee, loc in info.calls.items():
+            if comp[callee] == comp[ident]:
+                unit.recursive_sites.add((ident, callee))
+    reported: set[int] = set()
+    for ident in order:
+        info = unit.pous[ident]
+        cycle = [] if comp[ident] in reported else _cycle(unit, ident, comp)
+        if cycle:
+            reported.add(comp[ident])
+            shown = cycle + [cycle[0]]
+            if len(shown) > 7:   # a hostile program's cycle of thousands of blocks
+                shown = shown[:3] + [f"... ({len(cycle)} blocks) ..."] + shown[-2:]
+            names = " -> ".join(shown)
+            loc = info.calls[cycle[1] if len(cycle) > 1 else ident]
+            unit.diag.warning(
+                f"recursion: {names}; the S7-200 allows it but nests subroutines at most "
+                f"{MAX_NESTING} levels deep: a deeper CALL is not executed (SM4.3 is set)",
+                loc, "recursion")
+            unit.nest_check = True
+    if unit.nest_check:
         return
-    memo: dict[str, int] = {}
-
-    def depth(ident: str) -> int:
-        if ident not in memo:
-            memo[ident] = max((1 + depth(c) for c in unit.pous[ident].calls), default=0)
-        return memo[ident]
-
+    height = _heights(unit)
     for ident, info in unit.pous.items():
-        if info.pou.kind != "SBR" and depth(ident) > MAX_NESTING:
-            deepest = max(info.calls, key=depth)
-            unit.diag.error(f"subroutine calls from {ident} nest {depth(ident)} levels "
-                            f"deep; the S7-200 allows {MAX_NESTING}", info.calls[deepest])
+        if info.pou.kind != "SBR" and height[ident] > MAX_NESTING:
+            deepest = max(info.calls, key=height.__getitem__)
+            unit.diag.warning(f"subroutine calls from {ident} nest {height[ident]} levels "
+                              f"deep; the S7-200 allows {MAX_NESTING}: a deeper CALL is not "
+                              f"executed (SM4.3 is set)", info.calls[deepest], "nesting")
+            unit.nest_check = True
+
+
+def _heights(unit: Unit) -> dict[str, int]:
+    """How many subroutine levels each block's deepest call chain has (the
+    call graph has no cycle here).  Iterative: a hostile program may chain
+    thousands of blocks, deeper than Python's recursion limit."""
+    memo: dict[str, int] = {}
+    for root in unit.pous:
+        stack = [(root, False)]
+        while stack:
+            node, children_done = stack.pop()
+            if node in memo:
+                continue
+            calls = unit.pous[node].calls
+            if children_done:
+                memo[node] = max((1 + memo[c] for c in calls), default=0)
+            else:
+                stack.append((node, True))
+                stack.extend((c, False) for c in calls if c not in memo)
+    return memo
+
+
+def _components(unit: Unit, order: list[str]) -> dict[str, int]:
+    """Strongly connected components of the call graph (Tarjan), as a
+    component number per block; blocks in one cycle share a number."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    comp: dict[str, int] = {}
+
+    def visit(v: str) -> None:
+        # iterative: a hostile program may chain thousands of blocks
+        work = [(v, iter(unit.pous[v].calls))]
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        while work:
+            node, edges = work[-1]
+            for w in edges:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(unit.pous[w].calls)))
+                    break
+                if w in on:
+                    low[node] = min(low[node], index[w])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    n = len(set(comp.values()))
+                    while True:
+                        w = stack.pop()
+                        on.discard(w)
+                        comp[w] = n
+                        if w == node:
+                            break
+
+    for v in order:
+        if v not in index:
+            visit(v)
+    return comp
+
+
+def _cycle(unit: Unit, start: str, comp: dict[str, int]) -> list[str]:
+    """A call cycle through ``start`` (``[start, ..., last]``, where last
+    calls start), or [] when ``start`` is not recursive."""
+    if start in unit.pous[start].calls:
+        return [start]
+    # breadth-first inside the component, for the shortest cycle
+    prev: dict[str, str] = {}
+    queue = [start]
+    for node in queue:
+        for c in unit.pous[node].calls:
+            if comp.get(c) != comp[start]:
+                continue
+            if c == start:
+                path = [node]
+                while path[-1] != start:
+                    path.append(prev[path[-1]])
+                return list(reversed(path))
+            if c not in prev:
+                prev[c] = node
+                queue.append(c)
+    return []
 
 
 def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
@@ -393,7 +492,7 @@ def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
         "            return",
         "        else:",
         "            if r <= pc and WD[0] > WD[1]:",
-        f"                _watchdog({info.pou.kind!r}, {info.pou.number})",
+        f"                _watchdog({info.pou.kind!r}, {int(info.pou.number)}, pc, r)",
         "            pc = r",
     ]
 
@@ -416,7 +515,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 unit.diag.error(f"instruction {insn.mnemonic} is not implemented yet",
                                 loc, "unimplemented")
             else:
-                unit.diag.error(f"unknown instruction '{insn.mnemonic}'", loc, "unknown")
+                unit.diag.error(f"unknown instruction '{excerpt(insn.mnemonic)}'", loc, "unknown")
             broken = True
             continue
         ops = _resolve_ops(unit, spec, insn, resolver, loc)
@@ -445,7 +544,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 spec.emit(gen, *ops)
         except (CodegenError, ResolveError) as e:
             gen.lines, gen.depth, gen.indent, gen.pending = saved
-            if not (broken and "logic stack" in str(e)):
+            if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):
                 unit.diag.error(f"{insn.mnemonic}: {e}", getattr(e, "loc", None) or loc)
             broken = True
             _assume_stack_effect(gen, insn.mnemonic)
@@ -489,8 +588,15 @@ def _resolve_ops(unit: Unit, spec: InsnSpec, insn: ir.Insn, resolver: Resolver,
 
 
 def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
-               system_symbols: dict[str, str], diag: DiagnosticSink) -> Unit:
-    """Index POUs, lay out locals, split pieces and check the call graph."""
+               system_symbols: dict[str, str], diag: DiagnosticSink, *,
+               library: bool = False) -> Unit:
+    """Index POUs, lay out locals, split pieces and check the call graph.
+
+    A program without OB1 cannot run, so it is an error, unless
+    ``library`` (``plcrt check`` of a subroutine library): then a note says
+    it was checked as one.  A program without any block is an error either
+    way: there is nothing to check.
+    """
     unit = Unit(program, model, symbols, system_symbols, diag)
     ob_count = 0
     for p in program.pous:
@@ -512,12 +618,23 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
         unit.pous[ident] = info
         if p.name and p.name.upper() != ident:
             if p.name.upper() in unit.by_name:
-                diag.error(f"block name '{p.name}' is used twice", p.loc.within(ident, None))
+                diag.error(f"block name '{excerpt(p.name)}' is used twice",
+                           p.loc.within(ident, None))
             unit.by_name[p.name.upper()] = info
-    if ob_count == 0 and program.pous:
-        diag.warning("the program has no main program block (ORGANIZATION_BLOCK OB1); "
-                     "it can be checked but not run", program.pous[0].loc.within(
-                         program.pous[0].ident, None), "no-ob1")
+    if not program.pous:
+        diag.error("the file holds no program block (it is empty, or only comments), so "
+                   "there is nothing to check or run", SourceLoc(program.file, 1, 1),
+                   "no-blocks")
+    elif "OB1" not in unit.pous:
+        where = program.pous[0].loc.within(program.pous[0].ident, None)
+        if library:
+            diag.items.append(Diagnostic(
+                "note", "no main program block (OB1): checked as a subroutine library, "
+                        "which cannot run on its own", where, "no-ob1"))
+        else:
+            diag.error("the program has no main program block (OB1), so there is nothing "
+                       "to run; give the file with OB1 as well (plcrt check accepts a "
+                       "subroutine library on its own)", where, "no-ob1")
     for info in unit.pous.values():
         split_pieces(info, diag)
         for net in info.pou.networks:

@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from typing import Any, Iterator
 
 from ..errors import SourceLoc
+from ..safetext import excerpt
 from .operands import Addr, Const, Indirect, Pointer
 
 MAX_STACK = 9  #: S7-200 logic stack depth (System Manual, "logic stack")
@@ -34,11 +35,15 @@ VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
 
 class CodegenError(Exception):
     """An instruction cannot be generated; becomes a diagnostic at its
-    location, or at ``loc`` (an operand's) when given."""
+    location, or at ``loc`` (an operand's) when given.  ``reported``: the
+    problem is already a diagnostic (an unmatched FOR/NEXT or LSCR/SCRE
+    found while splitting the block), so it is not listed twice."""
 
-    def __init__(self, message: str, loc: SourceLoc | None = None) -> None:
+    def __init__(self, message: str, loc: SourceLoc | None = None, *,
+                 reported: bool = False) -> None:
         super().__init__(message)
         self.loc = loc
+        self.reported = reported
 
 
 class Gen:
@@ -116,8 +121,9 @@ class Gen:
     def warn(self, message: str, code: str = "") -> None:
         self.unit.diag.warning(message, self.loc, code)
 
-    def fail(self, message: str, loc: SourceLoc | None = None) -> None:
-        raise CodegenError(message, loc)
+    def fail(self, message: str, loc: SourceLoc | None = None, *,
+             reported: bool = False) -> None:
+        raise CodegenError(message, loc, reported=reported)
 
     # -- logic stack ----------------------------------------------------
     @property
@@ -352,7 +358,8 @@ def const_expr(c: Const, kind: str) -> str:
         try:
             return repr(struct.unpack(">f", struct.pack(">f", float(v)))[0])
         except OverflowError:
-            raise CodegenError(f"real constant {c.text} is outside the REAL range") from None
+            raise CodegenError(f"real constant {excerpt(c.text)} is outside the REAL "
+                               f"range") from None
     if isinstance(v, float):
         if kind[0] == "D" and not c.is_real:
             v = int(v)

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from typing import Union
 
 from ..memory.cpu import CpuModel
+from ..lang.limits import MAX_DIGITS, too_many_digits
+from ..safetext import excerpt
 
 # Areas that can be addressed as bit / byte / word / dword, with their
 # accepted prefixes.  T and C are special: bit in bit context, current value
@@ -121,14 +123,18 @@ def parse_constant(text: str) -> Const | None:
     t = text.strip()
     if not t:
         return None
+    if too_many_digits(t) and t[0] not in "'\"":
+        raise OperandError(f"{excerpt(t)}: a number with more than {MAX_DIGITS} digits is "
+                           f"out of range")
     if t[0] == "'" or t[0] == '"':
         if len(t) < 2 or t[-1] != t[0]:
-            raise OperandError(f"unterminated literal {text!r}")
+            raise OperandError(f"unterminated literal {excerpt(text)!r}")
         body = t[1:-1]
         try:
             data = body.encode("latin-1")
         except UnicodeEncodeError:
-            raise OperandError(f"literal {text!r} holds characters outside one byte") from None
+            raise OperandError(f"literal {excerpt(text)!r} holds characters outside "
+                               f"one byte") from None
         return Const(data, text, is_string=t[0] == '"')
     m = _HEX_RE.fullmatch(t)
     if m:
@@ -141,7 +147,7 @@ def parse_constant(text: str) -> Const | None:
     if _REAL_RE.fullmatch(t):
         v = float(t)
         if not math.isfinite(v):
-            raise OperandError(f"real constant {text!r} is out of range")
+            raise OperandError(f"real constant {excerpt(text)!r} is out of range")
         return Const(v, text, is_real=True)
     up = t.upper()
     if up in ("TRUE", "ON"):
@@ -156,9 +162,9 @@ def _check_range(model: CpuModel, area: str, offset: int, width: int, text: str)
     span = max(width, 1)
     if offset < 0 or offset + span > size:
         if size == 0:
-            raise OperandError(f"{text}: the {model.name} has no {area} memory")
+            raise OperandError(f"{excerpt(text)}: the {model.name} has no {area} memory")
         last = size - span
-        raise OperandError(f"{text} is out of range for the {model.name} "
+        raise OperandError(f"{excerpt(text)} is out of range for the {model.name} "
                            f"({area} offsets 0..{last} for this size)")
 
 
@@ -179,11 +185,14 @@ def parse_address(text: str, model: CpuModel) -> Addr | None:
         OperandError: for a well-formed address that is out of range.
     """
     t = text.strip()
+    if too_many_digits(t):
+        raise OperandError(f"{excerpt(t)}: a number with more than {MAX_DIGITS} digits is "
+                           f"out of range")
     m = _BIT_RE.fullmatch(t)
     if m:
         area, byte, bit = m.group(1).upper(), int(m.group(2)), int(m.group(3))
         if bit > 7:
-            raise OperandError(f"{t}: bit number must be 0..7")
+            raise OperandError(f"{excerpt(t)}: bit number must be 0..7")
         _check_range(model, area, byte, 1, t)
         return Addr(area, byte, 0, bit, t)
     m = _SIZED_RE.fullmatch(t)
@@ -195,27 +204,27 @@ def parse_address(text: str, model: CpuModel) -> Addr | None:
     if m:
         area, byte = m.group(1).upper(), int(m.group(2))
         if byte % 2:
-            raise OperandError(f"{t}: analog words start at even addresses")
+            raise OperandError(f"{excerpt(t)}: analog words start at even addresses")
         _check_range(model, area, byte, 2, t)
         return Addr(area, byte, 2, 0, t)
     m = _AC_RE.fullmatch(t)
     if m:
         n = int(m.group(1))
         if n >= model.accumulators:
-            raise OperandError(f"{t}: accumulators are AC0..AC{model.accumulators - 1}")
+            raise OperandError(f"{excerpt(t)}: accumulators are AC0..AC{model.accumulators - 1}")
         return Addr("AC", n, None, 0, t)
     m = _HC_RE.fullmatch(t)
     if m:
         n = int(m.group(1))
         if n >= model.hsc:
-            raise OperandError(f"{t}: high-speed counters are HC0..HC{model.hsc - 1}")
+            raise OperandError(f"{excerpt(t)}: high-speed counters are HC0..HC{model.hsc - 1}")
         return Addr("HC", n, 4, 0, t)
     m = _TC_RE.fullmatch(t)
     if m:
         area, n = m.group(1).upper(), int(m.group(2))
         limit = model.timers if area == "T" else model.counters
         if n >= limit:
-            raise OperandError(f"{t}: {'timers' if area == 'T' else 'counters'} "
+            raise OperandError(f"{excerpt(t)}: {'timers' if area == 'T' else 'counters'} "
                                f"are {area}0..{area}{limit - 1}")
         return Addr(area, n, None, 0, t)
     return None
@@ -231,7 +240,7 @@ def parse_operand(text: str, model: CpuModel) -> Resolved:
     if t.startswith("&"):
         target = parse_address(t[1:], model)
         if target is None or target.width == 0 or target.area not in POINTER_AREAS:
-            raise OperandError(f"{t}: '&' needs a byte, word or dword address "
+            raise OperandError(f"{excerpt(t)}: '&' needs a byte, word or dword address "
                                f"in I, Q, M, S, SM, V, AI, AQ, T or C")
         return Pointer(target, t)
     if t.startswith("*"):
@@ -240,7 +249,8 @@ def parse_operand(text: str, model: CpuModel) -> Resolved:
             (ptr.area == "AC" and ptr.offset > 0)
             or (ptr.area in ("V", "L") and ptr.width == 4)
         ):
-            raise OperandError(f"{t}: indirect addressing needs *AC1..*AC3, *VDn or *LDn")
+            raise OperandError(f"{excerpt(t)}: indirect addressing needs *AC1..*AC3, "
+                               f"*VDn or *LDn")
         if ptr.area == "AC":
             ptr = Addr("AC", ptr.offset, 4, 0, ptr.text)
         return Indirect(ptr, t)

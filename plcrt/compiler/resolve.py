@@ -15,6 +15,7 @@ from typing import Any, Mapping
 from ..isa.registry import Role
 from ..lang import ir
 from ..memory.cpu import CpuModel
+from ..safetext import excerpt
 from .operands import (Addr, Const, Indirect, Name, OperandError, Pointer,
                        Resolved, parse_operand)
 
@@ -51,10 +52,11 @@ def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
         for d in (v for v in pou.variables if v.section == section):
             key = d.name.upper()
             if key in out:
-                raise ResolveError(f"variable '#{d.name}' declared twice")
+                raise ResolveError(f"variable '#{excerpt(d.name)}' declared twice")
             width = TYPE_WIDTH.get(d.type.upper())
             if width is None:
-                raise ResolveError(f"variable '#{d.name}': type {d.type} is not supported")
+                raise ResolveError(f"variable '#{excerpt(d.name)}': type {excerpt(d.type)} "
+                                   f"is not supported")
             if width == 0:
                 addr = Addr("L", byte, 0, bit, f"L{byte}.{bit}")
                 bit += 1
@@ -89,7 +91,7 @@ class Resolver:
         if t.startswith("#"):
             var = self.locals.get(t[1:].upper())
             if var is None:
-                raise ResolveError(f"unknown local variable '{t}'")
+                raise ResolveError(f"unknown local variable '{excerpt(t)}'")
             return var.addr
         try:
             op = parse_operand(t, self.model)
@@ -112,9 +114,11 @@ class Resolver:
         try:
             res = parse_operand(target, self.model)
         except OperandError as e:
-            raise ResolveError(f"symbol '{text}' stands for {target!r}: {e}") from None
+            raise ResolveError(f"symbol '{excerpt(text)}' stands for {excerpt(target)!r}: "
+                               f"{e}") from None
         if isinstance(res, Name):
-            raise ResolveError(f"symbol '{text}' stands for {target!r}, which is not an address")
+            raise ResolveError(f"symbol '{excerpt(text)}' stands for {excerpt(target)!r}, "
+                               f"which is not an address")
         return res
 
     # -- role checks ----------------------------------------------------
@@ -137,7 +141,7 @@ _WRITE_ROLES = (Role.B_W, Role.W_W, Role.D_W, Role.R_W, Role.B_QB)
 
 def _bad(text: str, role: Role, why: str = "") -> ResolveError:
     extra = f" ({why})" if why else ""
-    return ResolveError(f"operand '{text}' is not a valid {role.value}{extra}")
+    return ResolveError(f"operand '{excerpt(text)}' is not a valid {role.value}{extra}")
 
 
 def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved:
@@ -146,8 +150,8 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
     if isinstance(op, Name):
         if role in (Role.LABEL,):
             raise _bad(text, role)
-        raise ResolveError(f"unknown symbol '{text}': not an address or constant, and not "
-                           f"in the symbol table (give one with --symbols)")
+        raise ResolveError(f"unknown symbol '{excerpt(text)}': not an address or constant, "
+                           f"and not in the symbol table (give one with --symbols)")
     if role is Role.LABEL:
         if isinstance(op, Const) and isinstance(op.value, int) and 0 <= op.value <= 255:
             return op

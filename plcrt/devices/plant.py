@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import PlcConfigError
+from ..errors import PlcConfigError, PlcError
+from ..lang.limits import file_limit, read_capped
 from .em253.axis import AxisPlant
 
 KINDS = ("EM253",)
@@ -54,9 +55,11 @@ def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
     if isinstance(source, Path) or ("\n" not in str(source) and "=" not in str(source)):
         path = Path(source)
         try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as e:
-            raise PlcConfigError(f"{path}: cannot read plant file: {e.strerror}") from None
+            # regular files of at most the input limit only (not /dev/zero)
+            text = read_capped(path, file_limit()).decode("utf-8")
+        except PlcError as e:
+            reason = e.message.removeprefix("cannot read file: ")
+            raise PlcConfigError(f"{path}: cannot read plant file: {reason}") from None
         except UnicodeDecodeError:
             raise PlcConfigError(f"{path}: the plant file is not UTF-8 text (TOML)") from None
         file = str(path)

@@ -59,7 +59,7 @@ class Plc:
                  scan_ms: float = 10.0, cpu: str | None = None,
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
-                 plant: Any = None, instrument: bool = False) -> None:
+                 plant: Any = None, instrument: bool = False, library: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
@@ -81,7 +81,7 @@ class Plc:
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
-                            pace=pace, plant=plant, instrument=instrument)
+                            pace=pace, plant=plant, instrument=instrument, library=library)
         #: network/output coverage and breakpoints (``instrument=True`` only)
         self.coverage: CoverageMap | None = CoverageMap() if instrument else None
         #: callables ``fn(plc)`` run after every scan (traces, test harness)
@@ -101,7 +101,9 @@ class Plc:
         self.stop_requested = False
         self.timers = TimerBank(self.mem.areas["TV"], self.mem.areas["TB"], self.model.timers)
         self.counters = CounterBank(self.mem.areas["CV"], self.mem.areas["CB"], self.model.counters)
-        self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0]
+        #: watchdog and nesting state of the scan: instructions in loops,
+        #: their limit, the count before the last WDR, active subroutines
+        self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0, 0]
         self.devices: list[Any] = []
         if system_symbols is None:
             from ..lang.symbols import SYSTEM_SYMBOLS
@@ -124,14 +126,14 @@ class Plc:
 
         self.unit, self.source, self.line_locs = compile_program(
             program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup,
-            probes=self.coverage)
+            probes=self.coverage, library=library)
         self.diagnostics = list(self.unit.diag.items) + self.diagnostics
         self._filename = f"<plcrt {program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)
         ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
         ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
-                  _watchdog=self._watchdog)
+                  _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
         ns.update(self.unit.bindings)
         try:
             code = compile(self.source, self._filename, "exec")
@@ -208,6 +210,7 @@ class Plc:
         wd = self.wd
         wd[0] = 0
         wd[2] = 0
+        wd[3] = 0
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
@@ -255,11 +258,54 @@ class Plc:
             tb = tb.tb_next
         return loc
 
-    def _watchdog(self, kind: str, number: int) -> None:
+    def _watchdog(self, kind: str, number: int, pc: int, target: int) -> None:
+        """The scan's loops ran past the watchdog time; ``pc`` is the piece
+        of block ``kind``+``number`` that jumped back to piece ``target``."""
+        info = self.unit.pous[f"{kind}{number}"]
+        # the NEXT, or the JMP to the target's label (a piece may hold more
+        # instructions after its JMP)
+        back = next((i for i in reversed(info.pieces[pc].insns) if i.mnemonic == "NEXT"
+                     or i.mnemonic == "JMP" and i.operands
+                     and info.labels.get(_int_or_none(i.operands[0].text)) == target),
+                    None)
+        start = next((f for _b, (body, _e, f) in info.loops.items() if body == target), None)
+        if start is None and info.pieces[target].insns:
+            start = info.pieces[target].insns[0]    # the LBL a JMP goes back to
+        where = ""
+        if start is not None and back is not None:
+            where = (f" in the loop from {start.mnemonic} at line {start.loc.line} to "
+                     f"{back.mnemonic} at line {back.loc.line}")
+        loc = start.loc.within(info.pou.ident, _network_of(info, start)) if start else None
         raise PlcRuntimeError(
-            f"watchdog: the scan ran longer than {WATCHDOG_MS} ms "
-            f"(about {self.wd[0]} instructions in loops of {kind}{number}); "
-            f"the CPU goes to STOP", None)
+            f"watchdog: the scan ran longer than {WATCHDOG_MS} ms{where} of {kind}{number} "
+            f"({self._loop_work()}); the CPU goes to STOP", loc)
+
+    def _watchdog_wdr(self, insn_id: int) -> None:
+        """A loop that retriggers the watchdog with WDR ran ten times the
+        watchdog time in one scan (the limit plcrt puts on it)."""
+        loc = self.unit.locs[insn_id] if 0 <= insn_id < len(self.unit.locs) else None
+        line = f" at line {loc.line}" if loc is not None else ""
+        raise PlcRuntimeError(
+            f"watchdog: the loop around WDR{line} ran ten times the {WATCHDOG_MS} ms watchdog "
+            f"time in one scan ({self._loop_work()}); WDR retriggers the watchdog, but plcrt "
+            f"stops a scan that never ends; the CPU goes to STOP", loc)
+
+    def nesting_exceeded(self, insn_id: int) -> None:
+        """A CALL that would nest a ninth subroutine level: the CPU does not
+        execute it, sets SM4.3 (run-time programming error, code 0008) and
+        gives ENO 0; plcrt warns once per CALL (System Manual, CALL)."""
+        self.mem.areas["SM"][4] |= 0x08
+        loc = self.unit.locs[insn_id] if 0 <= insn_id < len(self.unit.locs) else None
+        self.warn("CALL not executed: it would nest subroutines deeper than the S7-200's "
+                  "limit of 8 levels (run-time error 0008; SM4.3 set, ENO 0)", loc,
+                  f"nesting:{insn_id}")
+
+    def _loop_work(self) -> str:
+        """``about N instructions in loops, about T s`` of this scan (WDR
+        resets included)."""
+        n = self.wd[0] + self.wd[2]
+        return (f"about {n} instructions in loops, about {n * WATCHDOG_US_PER_INSN / 1e6:.2g} s "
+                f"at {WATCHDOG_US_PER_INSN} \u00b5s each")
 
     @property
     def now_us(self) -> int:
@@ -538,6 +584,10 @@ class Plc:
             if isinstance(obj, bytearray):
                 other[:] = obj
                 memo[id(obj)] = other
+            elif isinstance(obj, list) and all(isinstance(b, bytearray) for b in obj):
+                for mine, theirs in zip(obj, other):   # L buffers per nesting level
+                    theirs[:] = mine
+                    memo[id(mine)] = theirs
             elif isinstance(obj, (types.FunctionType, types.MethodType,
                                   types.BuiltinFunctionType)):
                 continue   # code and bound methods of the banks: no own state
@@ -576,6 +626,19 @@ class Plc:
         return m[a.area], a.offset, a.width or 0, a.bit
 
 
+def _int_or_none(text: str) -> int | None:
+    t = text.strip()
+    return int(t) if t.isdigit() and len(t) <= 3 else None
+
+
+def _network_of(info: Any, insn: ir.Insn) -> int | None:
+    """The number of the network of ``info``'s block that holds ``insn``."""
+    for piece in info.pieces:
+        if any(i is insn for i in piece.insns):
+            return piece.network.number
+    return None
+
+
 #: big-endian signed decoders of words and double words
 _SIGNED = {2: struct.Struct(">h").unpack_from, 4: struct.Struct(">i").unpack_from}
 
@@ -604,23 +667,35 @@ def _system_symbols() -> dict[str, str]:
     return dict(SYSTEM_SYMBOLS)
 
 
-def _text_or_path(x: Any, encoding: str | None = None) -> tuple[str, str]:
-    """(text, file name) for a path or literal text argument."""
+def _text_or_path(x: Any, encoding: str | None = None,
+                  limit: int | None = None) -> tuple[str, str]:
+    """(text, file name) for a path or literal text argument; a file is
+    read, and text accepted, up to ``limit`` bytes/characters (default:
+    :mod:`plcrt.lang.limits`)."""
     from ..lang import read_source
+    from ..lang.limits import check_text_size, file_limit
+    if limit is None:
+        limit = file_limit()
     if isinstance(x, Path):
-        return read_source(x, encoding), str(x)
+        return read_source(x, encoding, limit), str(x)
     s = str(x)
     if "\n" not in s and len(s) < 4096:
-        return read_source(s, encoding), s
+        return read_source(s, encoding, limit), s
+    check_text_size(s, "<string>", limit)
     return s, "<string>"
 
 
 def parse_sources(sources: str | Path | Sequence[str | Path], *,
-                  encoding: str | None = None) -> ir.Program:
+                  encoding: str | None = None,
+                  max_file_mb: float | None = None) -> ir.Program:
     """Parse one program file or text, or several (their blocks are merged,
-    as Micro/WIN keeps OB1 and its subroutines in one project)."""
+    as Micro/WIN keeps OB1 and its subroutines in one project).  Files
+    larger than ``max_file_mb`` (default: :mod:`plcrt.lang.limits`) are
+    refused."""
+    from ..lang.limits import file_limit
     from ..lang.sources import read_program
-    return read_program(source_items(sources), encoding=encoding)[0]
+    return read_program(source_items(sources), encoding=encoding,
+                        max_bytes=file_limit(max_file_mb))[0]
 
 
 def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
@@ -638,18 +713,30 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
         encoding: text encoding of the files (``"cp1252"``, ``"gbk"``,
             ``"utf-8"`` ...); by default it is detected, one for all files
             where one fits (:mod:`plcrt.lang.encoding`).
+        library: accept a program without OB1 (a subroutine library: it
+            compiles, a scan runs nothing); without it such a program, or an
+            empty one, is a :class:`PlcCompileError`.
+        max_file_mb: the largest program, symbol or data file read, in MB
+            (default: :data:`plcrt.lang.limits.MAX_FILE_MB`).
 
     Raises:
         PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
     """
+    from ..lang.limits import file_limit
+
     check_load_options(symbols=symbols, data=data, plant=kw.get("plant"), options=kw)
     plant = kw.pop("plant", None)
+    max_file_mb = kw.pop("max_file_mb", None)
+    limit = file_limit(max_file_mb)
     if isinstance(plant, (str, Path, dict)):
         from ..devices.plant import load_plant
         plant = load_plant(plant)
     from ..lang.sources import read_program
+    # the CPU's V size, so that data block entries past its end are
+    # reported in the same run as the syntax errors
     program, symbols, data = read_program(source_items(source), symbols, data,
-                                          encoding=encoding)
+                                          encoding=encoding, max_bytes=limit,
+                                          v_bytes=cpu_model(cpu).v_bytes)
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from ..compiler.emit import Gen
 from ..compiler.operands import Addr, Const
+from ..safetext import excerpt
 from .registry import Role, insn
 
 F = "bitlogic"
@@ -171,7 +172,7 @@ def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
         from ..compiler.operands import area_size
         size = area_size(g.unit.model, op.area) if op.area != "PQ" else g.unit.model.q_bytes
         if (end + 7) // 8 > size:
-            g.fail(f"{count} bits from {op.text} run past the end of the {op.area} area")
+            g.fail(f"{count} bits from {excerpt(op.text)} run past the end of the {op.area} area")
         areas = [op.area] + (["PQ"] if phys else [])
         for area in areas:
             buf = g.use(area)

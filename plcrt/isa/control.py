@@ -16,6 +16,7 @@ from ..compiler.emit import Gen
 from ..compiler.operands import Addr, Const
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role, insn
+from ..safetext import excerpt
 
 F = "control"
 
@@ -76,8 +77,8 @@ def _wdr(g: Gen) -> None:
         g.line(f"{g.use('WD')}[2] += {g.use('WD')}[0]")
         g.line(f"{g.use('WD')}[0] = 0")
         with g.block(f"if {g.use('WD')}[2] > 10 * {g.use('WD')}[1]:"):
-            info = _info(g)
-            g.line(f"{g.use('_watchdog')}({info.pou.kind!r}, {int(info.pou.number)})")
+            # the WDR's own instruction id: the fault names its line
+            g.line(f"{g.use('_watchdog_wdr')}({int(g.insn_id)})")
 
 
 @insn("LBL", Role.LABEL, family=F, summary="jump target", flow="label")
@@ -109,7 +110,7 @@ def _for(g: Gen, indx, init, final) -> None:
     here = _piece(g).index
     body, exit_, _ = info.loops.get(here, (None, None, None))
     if body is None:
-        g.fail("FOR without a matching NEXT")
+        g.fail("FOR without a matching NEXT", reported=True)   # by split_pieces
     with g.box():
         g.wr(indx, "W", g.rd(init, "W"))
         with g.block(f"if {g.rd(indx, 'W')} > {g.rd(final, 'W')}:"):
@@ -124,7 +125,7 @@ def _next(g: Gen) -> None:
     info = _info(g)
     fp = info.next_of.get(_piece(g).index)
     if fp is None:
-        g.fail("NEXT without a matching FOR")
+        g.fail("NEXT without a matching FOR", reported=True)
     body, _exit, for_insn = info.loops[fp]
     from ..compiler.resolve import Resolver
     res = Resolver(g.unit.model, g.unit.symbols, g.unit.system_symbols, info.local_vars)
@@ -174,7 +175,7 @@ def _lscr(g: Gen, bit: Addr) -> None:
     here = _piece(g).index
     exit_ = info.scr_exit.get(here)
     if exit_ is None:
-        g.fail("LSCR without a matching SCRE")
+        g.fail("LSCR without a matching SCRE", reported=True)
     info.scr_bit[here] = bit
     # The segment's S bit for SCRT in later pieces of the same segment.
     for p in info.scr_pieces.get(here, [here]):
@@ -227,7 +228,7 @@ def _cscre(g: Gen) -> None:
     info = _info(g)
     exit_ = info.scr_exit.get(_piece(g).index)
     if exit_ is None:
-        g.fail("CSCRE outside an SCR segment")
+        g.fail("CSCRE outside an SCR segment", reported=True)
     with g.box():
         g.line(f"return {int(exit_)}")
 
@@ -245,8 +246,12 @@ _PARAM_ROLE = {
 _KIND = {1: "B", 2: "WU", 4: "DU"}
 
 
-@insn("CALL", family=F, summary="call a subroutine with parameters", variadic=True)
+@insn("CALL", family=F, summary="call a subroutine with parameters", variadic=True,
+      may_fail=True)
 def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
+    # ENO is 0 only after a call refused for nesting (error 0008); a program
+    # without the nesting check has no such call, and AENO changes nothing
+    g.eno_valid = False
     if not insn_ir.operands:
         g.fail("CALL needs the subroutine to call")
     name = insn_ir.operands[0].text.split(":")[0]
@@ -255,15 +260,14 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         hook = g.unit.hooks.get("library_call")
         if hook is not None and hook(g, insn_ir, resolver):
             return
-        g.fail(f"no subroutine named '{name}' in the program")
+        g.fail(f"no subroutine named '{excerpt(name)}' in the program")
     if callee.pou.kind != "SBR":
         g.fail(f"{callee.pou.ident} is not a subroutine")
     params = [v.decl for v in callee.local_vars.values() if v.decl.section != "TEMP"]
     actual = insn_ir.operands[1:]
     if len(actual) != len(params):
-        g.fail(f"{callee.pou.ident} ({callee.pou.name}) takes {len(params)} parameter(s) "
+        g.fail(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) takes {len(params)} parameter(s) "
                f"in the order IN, IN_OUT, OUT; the call passes {len(actual)}")
-    lbuf = g.bind(bytearray(g.unit.model.l_bytes), "Lc")
     copy_in: list[tuple] = []
     copy_out: list[tuple] = []
     for decl, op_ir in zip(params, actual):
@@ -275,30 +279,64 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
             ops = {s: check_role(resolver.parse(op_ir.text), _PARAM_ROLE[(s, width)],
                                  op_ir.text, g.unit.model) for s in sections}
         except ResolveError as e:
-            g.fail(f"parameter #{decl.name} ({decl.type}, {decl.section}): {e}")
+            g.fail(f"parameter #{excerpt(decl.name)} ({decl.type}, {decl.section}): {e}")
         if "IN" in ops:
             copy_in.append((lv.addr, ops["IN"], width))
         if "OUT" in ops:
             copy_out.append((lv.addr, ops["OUT"], width))
+    l_bytes = g.unit.model.l_bytes
+    if not g.unit.nest_check:
+        with g.box():
+            _call_body(g, callee, g.bind(bytearray(l_bytes), "Lc"), copy_in, copy_out)
+        return
+    from ..compiler.codegen import MAX_NESTING
+    # Run-time nesting check (System Manual, CALL: eight levels from the
+    # main program; error 0008, SM4.3, ENO 0 on a deeper call).  WD[3] is
+    # the number of subroutines active in this scan.
+    wd = g.use("WD")
     with g.box():
-        for dst, src, width in copy_in:
-            if width == 0:
-                m = 1 << dst.bit
-                g.line(f"{lbuf}[{dst.offset}] = {lbuf}[{dst.offset}] & {~m & 0xFF} | "
-                       f"{g.rbit(src)} << {dst.bit}")
+        with g.block(f"if {wd}[3] >= {int(MAX_NESTING)}:"):
+            refuse = g.bind(g.unit.hooks["plc"].nesting_exceeded, "nest")
+            g.line(f"{refuse}({int(g.insn_id)})")
+            g.line("eno = 0")
+        with g.block("else:"):
+            if (_info(g).pou.ident, callee.pou.ident) in g.unit.recursive_sites:
+                # a call site inside a cycle can be active at several levels
+                # at once: one L buffer per level, as the CPU's L stack has
+                lbufs = g.bind([bytearray(l_bytes) for _ in range(MAX_NESTING)], "Ls")
+                lbuf = g.tmp("lb")
+                g.line(f"{lbuf} = {lbufs}[{wd}[3]]")
             else:
-                k = _KIND[width]
-                _wr_local(g, lbuf, dst, k, g.rd(src, k))
-        g.line(f"{callee.fname}({lbuf})")
-        for src, dst, width in copy_out:
-            if width == 0:
-                g.wbit(dst, f"({lbuf}[{src.offset}] >> {src.bit} & 1)")
-            else:
-                k = _KIND[width]
-                codec = {"B": None, "WU": "_rH", "DU": "_rI"}[k]
-                expr = f"{lbuf}[{src.offset}]" if codec is None else \
-                    f"{g.use(codec)}({lbuf}, {src.offset})[0]"
-                g.wr(dst, k, expr)
+                lbuf = g.bind(bytearray(l_bytes), "Lc")
+            g.line(f"{wd}[3] += 1")
+            _call_body(g, callee, lbuf, copy_in, copy_out, after=f"{wd}[3] -= 1")
+            g.eno("1")
+
+
+def _call_body(g: Gen, callee, lbuf: str, copy_in: list, copy_out: list,
+               after: str = "") -> None:
+    """Copy the inputs into the callee's L buffer ``lbuf``, call, copy the
+    outputs back (``after`` runs right after the call returns)."""
+    for dst, src, width in copy_in:
+        if width == 0:
+            m = 1 << dst.bit
+            g.line(f"{lbuf}[{dst.offset}] = {lbuf}[{dst.offset}] & {~m & 0xFF} | "
+                   f"{g.rbit(src)} << {dst.bit}")
+        else:
+            k = _KIND[width]
+            _wr_local(g, lbuf, dst, k, g.rd(src, k))
+    g.line(f"{callee.fname}({lbuf})")
+    if after:
+        g.line(after)
+    for src, dst, width in copy_out:
+        if width == 0:
+            g.wbit(dst, f"({lbuf}[{src.offset}] >> {src.bit} & 1)")
+        else:
+            k = _KIND[width]
+            codec = {"B": None, "WU": "_rH", "DU": "_rI"}[k]
+            expr = f"{lbuf}[{src.offset}]" if codec is None else \
+                f"{g.use(codec)}({lbuf}, {src.offset})[0]"
+            g.wr(dst, k, expr)
 
 
 def _wr_local(g: Gen, lbuf: str, dst: Addr, kind: str, expr: str) -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from ..compiler.emit import Gen
 from ..compiler.operands import Addr, Const, Indirect
+from ..safetext import excerpt
 from .registry import Role, insn
 
 F = "move"
@@ -69,7 +70,7 @@ def _block(g: Gen, src, dst, n, kind: str, width: int) -> None:
 def _check_span(g: Gen, a: Addr, nbytes: int) -> None:
     from ..compiler.operands import area_size
     if a.offset + nbytes > area_size(g.unit.model, a.area):
-        g.fail(f"the block at {a.text} runs past the end of the {a.area} area")
+        g.fail(f"the block at {excerpt(a.text)} runs past the end of the {a.area} area")
 
 
 def _elem_copy(g: Gen, src, dst, i: str, kind: str, width: int) -> None:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from ..compiler.emit import BUFFER_NAME, Gen
 from ..compiler.operands import Addr, Const, area_size
+from ..safetext import excerpt
 from .registry import Role, insn
 
 F = "wordlogic"
@@ -244,7 +245,7 @@ def _shrb(g: Gen, data: Addr, sbit: Addr, count) -> None:
             g.fail(f"SHRB length N must be -{SHRB_MAX}..-1 or 1..{SHRB_MAX}, got {n}")
         layout = _shrb_layout(start, n)
         if layout[1] > size:
-            g.fail(f"the {abs(n)}-bit shift register from {sbit.text} runs past "
+            g.fail(f"the {abs(n)}-bit shift register from {excerpt(sbit.text)} runs past "
                    f"the end of the {sbit.area} area")
         b0, b1, sh, mask, top = layout
         if b1 - b0 == 1:

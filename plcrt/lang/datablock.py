@@ -41,6 +41,8 @@ import struct
 from dataclasses import dataclass, field
 
 from ..errors import Diagnostic, DiagnosticSink, SourceLoc
+from ..safetext import excerpt
+from .limits import too_many_digits
 from .stl import raise_collected
 
 __all__ = ["DataBlock", "DataEntry", "parse_datablock"]
@@ -86,13 +88,7 @@ class DataBlock:
         :class:`PlcSyntaxError` then names every such entry.
         """
         sink = DiagnosticSink()
-        for entry in self.entries:
-            if entry.end > len(buf):
-                sink.error(
-                    f"data block entry at V{entry.offset} needs "
-                    f"{entry.end - entry.offset} byte(s) but V memory has only "
-                    f"{len(buf)} bytes (VB0..VB{len(buf) - 1})",
-                    entry.loc, code="datablock")
+        _check_extent(self.entries, len(buf), sink)
         raise_collected(sink)
         for entry in self.entries:
             if entry.bit is None:
@@ -138,11 +134,27 @@ class _Cursor:
     bit: int = 0
 
 
-def parse_datablock(text: str, file: str = "<string>") -> DataBlock:
+def _check_extent(entries: list[DataEntry], size: int, sink: DiagnosticSink) -> None:
+    """An error for every entry past the end of a V memory of ``size`` bytes."""
+    for entry in entries:
+        if entry.end > size:
+            sink.error(
+                f"data block entry at V{entry.offset} needs "
+                f"{entry.end - entry.offset} byte(s) but V memory has only "
+                f"{size} bytes (VB0..VB{size - 1})",
+                entry.loc, code="datablock")
+
+
+def parse_datablock(text: str, file: str = "<string>", *,
+                    v_bytes: int | None = None) -> DataBlock:
     """Parse data block text and return its :class:`DataBlock`.
 
+    With ``v_bytes`` (the V memory size of the CPU) entries past its end
+    are reported together with the syntax errors, so one run lists both.
+
     Raises :class:`PlcSyntaxError` listing every error (bad address, bad or
-    out-of-range value, missing comma) with file:line:column.
+    out-of-range value, missing comma, entry past the end of V memory)
+    with file:line:column.
     """
     if text.startswith("\ufeff"):
         text = text[1:]
@@ -151,6 +163,8 @@ def parse_datablock(text: str, file: str = "<string>") -> DataBlock:
     cursor: _Cursor | None = None
     for number, line in enumerate(text.splitlines(), start=1):
         cursor = _parse_line(line, number, file, cursor, block, sink)
+    if v_bytes is not None:
+        _check_extent(block.entries, v_bytes, sink)
     _note_overlaps(block)
     raise_collected(sink)
     return block
@@ -180,32 +194,35 @@ def _parse_line(line: str, number: int, file: str, cursor: _Cursor | None,
 
     kind, text, column = items[0]
     address = _ADDRESS.fullmatch(text) if kind == "word" else None
+    if address is not None and too_many_digits(text):
+        sink.error(f"address {excerpt(text)} is out of range", loc(column), code="datablock")
+        return None
     if address is not None:
         if address.group(1):
             cursor = _Cursor(int(address.group(2)), _WIDTH[address.group(1).upper()])
         else:
             bit = int(address.group(4))
             if bit > 7:
-                sink.error(f"bit number {bit} in {text} is not 0..7", loc(column),
+                sink.error(f"bit number {bit} in {excerpt(text)} is not 0..7", loc(column),
                            code="datablock")
                 return None
             cursor = _Cursor(int(address.group(3)), 0, bit)
         values = items[1:]
         if not values:
-            sink.error(f"missing value after {text}", loc(column + len(text)),
+            sink.error(f"missing value after {excerpt(text)}", loc(column + len(text)),
                        code="datablock")
             return cursor
     elif line[:1].isspace() and cursor is not None:
         values = items  # a continuation line
     else:
         if kind == "word" and _OTHER_AREA.fullmatch(text):
-            message = (f"{text}: the data block can only initialise V memory "
+            message = (f"{excerpt(text)}: the data block can only initialise V memory "
                        "(VB, VW, VD or V<byte>.<bit>)")
         elif cursor is None and line[:1].isspace():
             message = "values before the first address"
         else:
             message = (f"expected a V memory address (VB, VW, VD or "
-                       f"V<byte>.<bit>), found {text!r}")
+                       f"V<byte>.<bit>), found {excerpt(text)!r}")
         sink.error(message, loc(column), code="datablock")
         return cursor
 
@@ -217,7 +234,7 @@ def _parse_line(line: str, number: int, file: str, cursor: _Cursor | None,
             expect_value = True
             continue
         if not expect_value:
-            sink.error(f"expected ',' before {text!r}", loc(column), code="datablock")
+            sink.error(f"expected ',' before {excerpt(text)!r}", loc(column), code="datablock")
             return cursor
         expect_value = False
         if kind == "open":
@@ -234,9 +251,9 @@ def _value_entries(text: str, kind: str, cursor: _Cursor, loc: SourceLoc,
     if kind == "string":
         return _string_entry(text, cursor, loc, sink)
     if cursor.width == 0:  # bit form
-        value = _integer(text)
+        value = None if too_many_digits(text) else _integer(text)
         if value not in (0, 1):
-            sink.error(f"a bit takes 0 or 1, not {text!r}", loc, code="datablock")
+            sink.error(f"a bit takes 0 or 1, not {excerpt(text)!r}", loc, code="datablock")
             return []
         entry = DataEntry(cursor.offset, bytes((value,)), loc, cursor.bit)
         cursor.offset += (cursor.bit + 1) // 8
@@ -245,11 +262,16 @@ def _value_entries(text: str, kind: str, cursor: _Cursor, loc: SourceLoc,
 
     width = cursor.width
     data: bytes
+    if too_many_digits(text):
+        sink.error(f"value {excerpt(text)} out of range for {_NAME[width]}", loc,
+                   code="datablock")
+        cursor.offset += width
+        return []
     integer = _integer(text)
     if integer is not None:
         low, high = _RANGE[width]
         if not low <= integer <= high:
-            sink.error(f"value {text} out of range for {_NAME[width]} "
+            sink.error(f"value {excerpt(text)} out of range for {_NAME[width]} "
                        f"({low}..{high})", loc, code="datablock")
             cursor.offset += width
             return []
@@ -257,17 +279,17 @@ def _value_entries(text: str, kind: str, cursor: _Cursor, loc: SourceLoc,
     elif _REAL.fullmatch(text):
         real = float(text)
         if width != 4:
-            sink.error(f"REAL value {text} needs a VD address, not "
+            sink.error(f"REAL value {excerpt(text)} needs a VD address, not "
                        f"{_NAME[width]}", loc, code="datablock")
             cursor.offset += width
             return []
         if abs(real) > _REAL_MAX:
-            sink.error(f"REAL value {text} out of range", loc, code="datablock")
+            sink.error(f"REAL value {excerpt(text)} out of range", loc, code="datablock")
             cursor.offset += width
             return []
         data = struct.pack(">f", real)
     else:
-        sink.error(f"bad constant {text!r}", loc, code="datablock")
+        sink.error(f"bad constant {excerpt(text)!r}", loc, code="datablock")
         cursor.offset += width
         return []
     entry = DataEntry(cursor.offset, data, loc)
@@ -298,7 +320,7 @@ def _string_entry(text: str, cursor: _Cursor, loc: SourceLoc,
                    code="datablock")
         return []
     if not body.isascii():
-        sink.error(f"character constant {text} is not ASCII", loc, code="datablock")
+        sink.error(f"character constant {excerpt(text)} is not ASCII", loc, code="datablock")
         return []
     raw = body.encode("ascii")
     if quote == '"':

@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import NoReturn, Sequence
 
 from ..errors import Diagnostic, PlcConfigError, PlcSyntaxError, SourceLoc
+from .limits import file_limit, read_capped
 
 __all__ = ["Decoded", "decode_bytes", "decode_files", "decode_many", "encoding_note",
            "read_bytes", "read_decoded", "resolve_encoding"]
@@ -89,27 +90,21 @@ def resolve_encoding(name: str | None) -> str | None:
                              f"gbk, gb18030, cp1251, cp932, utf-8 or utf-16") from None
 
 
-def read_bytes(path: str | Path) -> bytes:
-    """The bytes of a file; :class:`PlcSyntaxError` naming it if unreadable."""
-    name = str(path)
-    try:
-        return Path(path).read_bytes()
-    except FileNotFoundError:
-        raise PlcSyntaxError("cannot read file: no such file", SourceLoc(name, 1, 1)) from None
-    except IsADirectoryError:
-        raise PlcSyntaxError("cannot read file: it is a directory",
-                             SourceLoc(name, 1, 1)) from None
-    except OSError as exc:
-        reason = exc.strerror or exc.__class__.__name__
-        raise PlcSyntaxError(f"cannot read file: {reason}", SourceLoc(name, 1, 1)) from None
+def read_bytes(path: str | Path, max_bytes: int | None = None) -> bytes:
+    """The bytes of a regular file, at most ``max_bytes`` (default: the
+    limit of :mod:`plcrt.lang.limits`); :class:`PlcSyntaxError` naming it
+    if it is unreadable, not a regular file or too large."""
+    return read_capped(path, file_limit() if max_bytes is None else max_bytes)
 
 
-def read_decoded(path: str | Path, encoding: str | None = None) -> Decoded:
+def read_decoded(path: str | Path, encoding: str | None = None,
+                 max_bytes: int | None = None) -> Decoded:
     """Read and decode one file (see :func:`decode_bytes`)."""
-    return decode_bytes(read_bytes(path), str(path), encoding)
+    return decode_bytes(read_bytes(path, max_bytes), str(path), encoding)
 
 
-def decode_files(paths: Sequence[str | Path], encoding: str | None = None) -> list[Decoded]:
+def decode_files(paths: Sequence[str | Path], encoding: str | None = None,
+                 max_bytes: int | None = None) -> list[Decoded]:
     """Read and decode the files of one program with one encoding where possible.
 
     Files with a byte-order mark, UTF-16, pure-ASCII and UTF-8 files are
@@ -118,7 +113,7 @@ def decode_files(paths: Sequence[str | Path], encoding: str | None = None) -> li
     encoding reads them all is each decided alone.  Either way a reading
     that has the non-ASCII words of the files decided alone scores more.
     """
-    return decode_many([(read_bytes(p), str(p)) for p in paths], encoding)
+    return decode_many([(read_bytes(p, max_bytes), str(p)) for p in paths], encoding)
 
 
 def decode_many(items: Sequence[tuple[bytes, str]],

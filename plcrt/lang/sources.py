@@ -12,6 +12,7 @@ It does not compile anything; that is :mod:`plcrt.compiler`'s job.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -19,6 +20,7 @@ from ..errors import PlcConfigError, PlcError, SourceLoc
 from . import ir
 from .datablock import parse_datablock
 from .encoding import Decoded, decode_files, encoding_note, resolve_encoding
+from .limits import check_text_size, file_limit
 from .stl import parse_program
 from .symbols import parse_symbols
 
@@ -32,7 +34,8 @@ def is_file_arg(x: Any) -> bool:
 
 
 def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
-                 data: Any = None, *, encoding: str | None = None
+                 data: Any = None, *, encoding: str | None = None,
+                 max_bytes: int | None = None, v_bytes: int | None = None
                  ) -> tuple[ir.Program, Any, Any]:
     """(program, symbols, data), parsed.
 
@@ -42,15 +45,21 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
     table (returned as it is) or None.  ``encoding`` forces the encoding of
     every file; by default it is detected.  The program's
     :attr:`~plcrt.lang.ir.Program.encoding` is the one its files were
-    decoded with.
+    decoded with.  Files and texts longer than ``max_bytes`` (default: the
+    limit of :mod:`plcrt.lang.limits`) are refused; ``v_bytes`` is the V
+    memory size the data block is checked against.
     """
     codec = resolve_encoding(encoding)
+    limit = file_limit() if max_bytes is None else max_bytes
     items = [source] if isinstance(source, (str, Path)) else list(source)
     if not items:
         raise PlcConfigError("no program given")
     tables = [x if isinstance(x, (str, Path)) else None for x in (symbols, data)]
     files = [x for x in items + tables if x is not None and is_file_arg(x)]
-    decoded = {id(x): d for x, d in zip(files, decode_files(files, codec))}
+    for x in items + tables:
+        if isinstance(x, str) and not is_file_arg(x):
+            check_text_size(x, "<string>", limit)
+    decoded = {id(x): d for x, d in zip(files, decode_files(files, codec, limit))}
     programs = [_parse(parse_program, x, decoded.get(id(x))) for x in items]
     used = {decoded[id(x)].encoding for x in items if id(x) in decoded}
     pous = tuple(p for prog in programs for p in prog.pous)
@@ -61,7 +70,8 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
     if tables[0] is not None:
         symbols = _parse(parse_symbols, tables[0], decoded.get(id(tables[0])))
     if tables[1] is not None:
-        data = _parse(parse_datablock, tables[1], decoded.get(id(tables[1])))
+        data = _parse(partial(parse_datablock, v_bytes=v_bytes) if v_bytes else parse_datablock,
+                      tables[1], decoded.get(id(tables[1])))
     return program, symbols, data
 
 

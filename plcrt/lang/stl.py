@@ -28,7 +28,9 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from ..errors import DiagnosticSink, PlcSyntaxError, SourceLoc
+from ..safetext import EXCERPT_CHARS, excerpt
 from .encoding import read_decoded
+from .limits import MAX_DIGITS, too_many_digits
 from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl, VarSection
 
 __all__ = ["parse_program", "read_source"]
@@ -42,16 +44,18 @@ _MAX_SYNTAX_ERRORS = 20
 # Reading files
 # --------------------------------------------------------------------------
 
-def read_source(path: str | Path, encoding: str | None = None) -> str:
+def read_source(path: str | Path, encoding: str | None = None,
+                max_bytes: int | None = None) -> str:
     """Read a program, symbol or data-block file and return its text.
 
     Micro/WIN writes exports in the Windows code page of the PC that made
     them; :mod:`plcrt.lang.encoding` decides which (``encoding`` overrides
-    the detection).  Raises :class:`PlcSyntaxError` naming the file if it
-    cannot be read or decoded, :class:`PlcConfigError` for an unknown
-    ``encoding``.
+    the detection).  At most ``max_bytes`` are read (default: the limit of
+    :mod:`plcrt.lang.limits`), and only from a regular file.  Raises
+    :class:`PlcSyntaxError` naming the file if it cannot be read or
+    decoded, :class:`PlcConfigError` for an unknown ``encoding``.
     """
-    return read_decoded(path, encoding).text
+    return read_decoded(path, encoding, max_bytes).text
 
 
 # --------------------------------------------------------------------------
@@ -255,7 +259,7 @@ def _describe(exc: UnexpectedInput, text: str, file: str,
             _, block, network = _open_block(lines, line)
             loc = SourceLoc(file, line, column, block, network if block else None)
             return loc, f"unterminated string literal (missing closing {char})"
-        found = repr(_word_at(text, pos))
+        found = repr(excerpt(_word_at(text, pos)))
     else:  # UnexpectedEOF and future kinds
         line, column = _end_position(lines)
         expected = set(getattr(exc, "expected", ()) or ())
@@ -286,16 +290,13 @@ def _describe(exc: UnexpectedInput, text: str, file: str,
 def _describe_found(token: Token) -> str:
     if token.type == "_NL":
         return "end of line"
-    value = str(token.value)
-    if len(value) > 30:
-        value = value[:27] + "..."
-    return repr(value)
+    return repr(excerpt(str(token.value)))
 
 
 def _word_at(text: str, pos: int) -> str:
     """The run of non-blank characters starting at ``pos`` (for messages)."""
     end = pos
-    while end < len(text) and end - pos < 30 and not text[end].isspace():
+    while end < len(text) and end - pos <= EXCERPT_CHARS and not text[end].isspace():
         end += 1
     return text[pos:end] if end > pos else text[pos:pos + 1]
 
@@ -323,7 +324,7 @@ _CTX_HEADER = re.compile(
     r"[ \t]*(ORGANIZATION_BLOCK|SUBROUTINE_BLOCK|INTERRUPT_BLOCK)[ \t]+"
     r"(?:[^:\s]*:)?[ \t]*(\w+)", re.I)
 _CTX_END = re.compile(r"[ \t]*END_(?:ORGANIZATION|SUBROUTINE|INTERRUPT)_BLOCK", re.I)
-_CTX_NETWORK = re.compile(r"[ \t]*NETWORK[ \t]*([0-9]+)", re.I)
+_CTX_NETWORK = re.compile(r"[ \t]*NETWORK[ \t]*([0-9]{1,%d})(?![0-9])" % MAX_DIGITS, re.I)
 
 
 def _open_block(lines: list[str], line: int) -> tuple[str | None, str | None, int | None]:
@@ -433,9 +434,13 @@ class _Builder:
         tokens = [t for t in ref.children if isinstance(t, Token)]
         id_token = tokens[-1]
         match = _BLOCK_ID.fullmatch(str(id_token))
+        if match is not None and too_many_digits(match.group(2)):
+            self.sink.error(f"block number of {excerpt(str(id_token))!r} is out of range",
+                            self.loc(id_token), code="syntax")
+            match = _BLOCK_ID.fullmatch(f"{match.group(1)}0")
         if match is None:
             self.sink.error(
-                f"block id {str(id_token)!r} is not of the form "
+                f"block id {excerpt(str(id_token))!r} is not of the form "
                 f"{kind}<number> expected after {_KEYWORD_OF_KIND[kind]}",
                 self.loc(id_token), code="syntax")
             ident, number = str(id_token), 0
@@ -472,7 +477,12 @@ class _Builder:
         children = tree.children
         keyword, number_token = children[0], children[1]
         assert isinstance(keyword, Token) and isinstance(number_token, Token)
-        number = int(number_token)
+        if too_many_digits(str(number_token)):
+            self.sink.error(f"network number {excerpt(str(number_token))!r} is out of range",
+                            self.loc(number_token, block), code="syntax")
+            number = 0
+        else:
+            number = int(number_token)
         title = ""
         comments: list[str] = []
         insns: list[Insn] = []

@@ -20,6 +20,7 @@ import io
 from dataclasses import dataclass, field
 
 from ..errors import Diagnostic, DiagnosticSink, PlcSyntaxError, SourceLoc
+from ..safetext import excerpt
 from .stl import raise_collected
 
 __all__ = ["SYSTEM_SYMBOLS", "Symbol", "SymbolTable", "parse_symbols",
@@ -192,15 +193,15 @@ def parse_symbols(text: str, file: str = "<string>") -> SymbolTable:
             sink.error("symbol row without a name", loc, code="symbol")
             continue
         if not address:
-            sink.error(f"symbol {name!r} has no address", loc, code="symbol")
+            sink.error(f"symbol {excerpt(name)!r} has no address", loc, code="symbol")
             continue
         previous = table.entries.get(name)
         if previous is not None:
             sink.items.append(Diagnostic(
-                "error", f"duplicate symbol {name!r} (first defined at "
+                "error", f"duplicate symbol {excerpt(name)!r} (first defined at "
                 f"{previous.loc})", loc, "symbol"))
             sink.items.append(Diagnostic(
-                "note", f"first definition of {name!r}", previous.loc, "symbol"))
+                "note", f"first definition of {excerpt(name)!r}", previous.loc, "symbol"))
             continue
         table.entries[name] = Symbol(name, address, comment, loc)
     raise_collected(sink)

@@ -313,8 +313,9 @@ def _parsed(sess: _Session, spec: _Spec) -> tuple[Any, Any, Any]:
 
 
 def _build(sess: _Session, spec: _Spec) -> Harness:
-    """A harness for ``spec``; plcrt's own errors propagate (PlcError), a
-    program without OB1 or a bad ``watch`` address is a PlcUsageError."""
+    """A harness for ``spec``; plcrt's own errors propagate (PlcError: a
+    program without OB1 is a compile error), a bad ``watch`` address is a
+    PlcUsageError."""
     from ..errors import PlcError
     from .harness import Harness
     if isinstance(spec.program, str):
@@ -328,10 +329,6 @@ def _build(sess: _Session, spec: _Spec) -> Harness:
                      instrument=sess.coverage,
                      max_time=spec.max_time if spec.max_time is not None else sess.max_time,
                      encoding=spec.encoding)
-    if "OB1" not in h.plc.unit.pous:
-        # scans would do nothing, and every assertion on "nothing changes" pass
-        raise PlcUsageError(f"{spec.label} has no main program block (OB1), so there is "
-                            f"nothing to run; name the file with OB1 as well")
     for address in spec.watch:
         try:
             h.watch(address)

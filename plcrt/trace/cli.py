@@ -6,7 +6,9 @@
         --signal SIG [--signal SIG]... [--scan-ms MS] (--seconds S | --scans N)
         [--set ADDR=VALUE]... [--every N] [--csv F] [--plot F.png|F.svg] [--quiet]
 
-The run shows a progress bar on a terminal when it is long; then the CSV
+The run shows a progress bar on a terminal when it is long (``--progress``:
+plain progress lines off a terminal; ``--max-wall S`` stops it after S
+wall-clock seconds with exit status 3, keeping the samples); then the CSV
 and the plot are written and the trend view (:func:`plcrt.trace.trend`) is
 printed on stdout.  With ``--quiet`` nothing but errors is printed.  After
 a run-time fault the samples recorded up to the fault are still written,
@@ -33,7 +35,8 @@ EXIT_INTERRUPTED = 130
 
 def register(sub: Any) -> None:
     """Add the ``trace`` subcommand to the ``plcrt`` parser."""
-    from ..cli import add_program_args, add_run_length_args, add_scan_ms_arg, add_set_args
+    from ..cli import (add_long_run_args, add_program_args, add_run_length_args,
+                       add_scan_ms_arg, add_set_args)
 
     p = sub.add_parser(
         "trace", help="run a program and record signals scan by scan (CSV, plot, sparklines)",
@@ -49,6 +52,7 @@ def register(sub: Any) -> None:
                    help="a signal to record (repeat for more)")
     add_scan_ms_arg(p)
     add_run_length_args(p)
+    add_long_run_args(p)
     add_set_args(p)
     p.add_argument("--every", type=int, default=1, metavar="N",
                    help="record after every N-th scan only (default 1: every scan)")
@@ -62,10 +66,10 @@ def register(sub: Any) -> None:
 
 def cmd_trace(args: argparse.Namespace) -> int:
     """``plcrt trace``: exit 0, 1 for bad input or options, 2 after a fault."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, check_run_length, load_for_run,
-                       parse_sets, print_diagnostics)
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
+                       load_for_run, parse_sets, print_diagnostics)
     from .plot import plot, plot_format, require_matplotlib
-    from .progress import run_with_progress
+    from .progress import WallTimeExceeded, run_with_progress
     from .recorder import Trace
     from .spark import trend
 
@@ -93,12 +97,18 @@ def cmd_trace(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     fault: PlcError | None = None
+    stopped: PlcError | None = None
     interrupted = False
     loaded = len(plc.diagnostics)
     try:
-        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=args.quiet)
+        run_with_progress(plc, seconds=args.seconds, scans=args.scans, quiet=args.quiet,
+                          max_wall=args.max_wall, progress=args.progress)
     except PlcRuntimeError as e:
         fault = e
+    except WallTimeExceeded as e:
+        # like Ctrl-C: the samples recorded up to here are written
+        stopped = e
+        trace._even_out()
     except KeyboardInterrupt:
         # Ctrl-C ends the run between two scans; the samples so far are kept
         interrupted = True
@@ -136,6 +146,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if stopped is not None:
+        print_diagnostics(stopped.diagnostics)
+        return EXIT_WALL
     if interrupted:
         return EXIT_INTERRUPTED
     return status

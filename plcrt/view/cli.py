@@ -20,7 +20,8 @@ _NET_RE = re.compile(r"(?:([^/\s]+)\s*/\s*)?(\d+)")
 
 def register(sub: Any) -> None:
     """Add ``show`` to the subparsers of the ``plcrt`` command."""
-    from ..cli import add_program_args, add_run_length_args, add_scan_ms_arg, add_set_args
+    from ..cli import (add_long_run_args, add_program_args, add_run_length_args,
+                       add_scan_ms_arg, add_set_args)
 
     p = sub.add_parser(
         "show", help="draw networks as ladder (LAD), optionally with live status",
@@ -38,6 +39,7 @@ def register(sub: Any) -> None:
     add_run_length_args(p, required=False,
                         seconds_help="with --status: simulated seconds to run",
                         scans_help="with --status: number of scans to run (default 1)")
+    add_long_run_args(p)
     add_set_args(p, help="with --status: write before the first scan (inputs keep their value)")
     p.set_defaults(func=cmd_show)
 
@@ -45,8 +47,8 @@ def register(sub: Any) -> None:
 def cmd_show(args: argparse.Namespace) -> int:
     """``plcrt show``: 0 ok, 1 an input or option error, 2 a PLC fault while
     running for --status (the drawing then shows the state at the fault)."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, check_run_length, load_for_run,
-                       parse_sets, print_diagnostics)
+    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
+                       load_for_run, parse_sets, print_diagnostics)
     from ..engine.runtime import parse_sources
     from ..errors import PlcConfigError, PlcError, PlcRuntimeError
 
@@ -56,9 +58,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         check_run_length(args)
         if args.status:
             writes = parse_sets(args.set)
-            plc = load_for_run(args, writes,
-                               no_ob1="--status needs the main program block (OB1) to run; "
-                                      "give the file with OB1 as well")
+            plc = load_for_run(args, writes)
             program = plc.program
         else:
             program = parse_sources([Path(p) for p in args.programs], encoding=args.encoding)
@@ -71,18 +71,22 @@ def cmd_show(args: argparse.Namespace) -> int:
         return EXIT_ERROR
 
     status = None
+    stopped: PlcError | None = None
     if args.status:
-        from ..trace.progress import run_with_progress
+        from ..trace.progress import WallTimeExceeded, run_with_progress
         from .status import PlcStatus
         loaded = len(plc.diagnostics)
+        watch = dict(max_wall=args.max_wall, progress=args.progress)
         try:
             # a long run shows a progress bar on a terminal (stderr only)
             if args.seconds is not None:
-                run_with_progress(plc, seconds=args.seconds)
+                run_with_progress(plc, seconds=args.seconds, **watch)
             else:
-                run_with_progress(plc, scans=1 if args.scans is None else args.scans)
+                run_with_progress(plc, scans=1 if args.scans is None else args.scans, **watch)
         except PlcRuntimeError as e:
             fault = e
+        except WallTimeExceeded as e:
+            stopped = e   # the drawing shows the state reached
         print_diagnostics(plc.diagnostics[loaded:])
         status = PlcStatus(plc)
 
@@ -105,6 +109,9 @@ def cmd_show(args: argparse.Namespace) -> int:
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if stopped is not None:
+        print_diagnostics(stopped.diagnostics)
+        return EXIT_WALL
     return EXIT_OK
 
 
@@ -113,7 +120,9 @@ def _check_options(args: argparse.Namespace, error: type) -> None:
     if not args.status:
         given = [name for name, on in (("--set", args.set),
                                        ("--seconds", args.seconds is not None),
-                                       ("--scans", args.scans is not None)) if on]
+                                       ("--scans", args.scans is not None),
+                                       ("--max-wall", args.max_wall is not None),
+                                       ("--progress", args.progress)) if on]
         if given:
             raise error(f"{', '.join(given)} only make(s) sense with --status")
 

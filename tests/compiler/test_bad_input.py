@@ -42,10 +42,6 @@ CASES = [
      ["prog.awl:6:1: error: JMP: jump to label 4, which is not defined in OB1"]),
     ("empty stack", _prog("A      I0.0\n=      Q0.0\n"),
      ["prog.awl:5:1: error: A: the logic stack is empty here"]),
-    ("recursion", _prog("LD     SM0.0\nCALL   SBR_0\n",
-                        "SUBROUTINE_BLOCK SBR_0:SBR0\nTITLE=x\nBEGIN\nNetwork 1\n"
-                        "LD     SM0.0\nCALL   SBR_0\nEND_SUBROUTINE_BLOCK\n"),
-     ["prog.awl:13:1: error: subroutine SBR0 (SBR_0) calls itself"]),
     ("missing subroutine", _prog("LD     SM0.0\nCALL   NOPE\n"),
      ["prog.awl:6:1: error: CALL: no subroutine named 'NOPE' in the program [OB1 network 1]"]),
     ("unknown symbol", _prog("LD     Start_Button\n=      Q0.0\n"),

@@ -280,20 +280,28 @@ def test_eight_nesting_levels_are_allowed() -> None:
     assert p["VW0"] == 1
 
 
-def test_nine_nesting_levels_are_a_compile_error() -> None:
-    """Subroutines nest at most eight levels deep."""
-    with pytest.raises(PlcCompileError, match="nest 9 levels deep"):
-        _load("LD SM0.0\nCALL SBR_0", extra=_chain(9))
+def test_nine_nesting_levels_run_eight_and_skip_the_ninth() -> None:
+    """Subroutines nest at most eight levels deep (System Manual, CALL): a
+    chain of nine compiles with a warning; at run time the ninth call is not
+    executed and SM4.3 is set."""
+    p = _load("LD SM0.0\nCALL SBR_0", extra=_chain(9))
+    assert any("nest 9 levels deep" in d.message and d.severity == "warning"
+               for d in p.diagnostics)
+    p.scan()
+    assert (p["VW0"], p["SM4.3"], p.mode) == (0, 1, "RUN")
 
 
 @pytest.mark.parametrize("blocks", [
-    _sbr(0, "LD SM0.0\nCALL SBR_0"),
-    _sbr(0, "LD SM0.0\nCALL SBR_1") + _sbr(1, "LD SM0.0\nCALL SBR_0"),
+    _sbr(0, "LDW< VW0, +3\nINCW VW0\nCALL SBR_0"),
+    _sbr(0, "LDW< VW0, +3\nINCW VW0\nCALL SBR_1") + _sbr(1, "LD SM0.0\nCALL SBR_0"),
 ])
-def test_recursion_is_a_compile_error(blocks: str) -> None:
-    """Direct and indirect recursion are rejected (they exceed the nesting limit)."""
-    with pytest.raises(PlcCompileError, match="calls itself"):
-        _load("LD SM0.0\nCALL SBR_0", extra=blocks)
+def test_bounded_recursion_runs(blocks: str) -> None:
+    """Direct and indirect recursion are allowed (a warning names the
+    cycle); three levels run as written."""
+    p = _load("LD SM0.0\nCALL SBR_0", extra=blocks)
+    assert any(d.code == "recursion" for d in p.diagnostics)
+    p.scan()
+    assert (p["VW0"], p["SM4.3"]) == (3, 0)
 
 
 # -- CRET / RET / END / STOP --------------------------------------------------------

@@ -466,9 +466,12 @@ def test_factory_watch(plc_factory):
         "'XX9.9' is not an address",
         "test_setup.py::test_watch_unknown_kind: @pytest.mark.plc: watch 'Q0.0:FOO': *"
         "unknown suffix ':FOO'*",
-        "test_setup.py::test_empty_program: @pytest.mark.plc: empty.awl has no main program "
-        "block (OB1), so there is nothing to run; name the file with OB1 as well",
-        "test_setup.py::test_no_ob1: @pytest.mark.plc: sbr.awl has no main program block*",
+        "test_setup.py::test_empty_program: @pytest.mark.plc: cannot load empty.awl:",
+        "*/empty.awl:1:1: error: the file holds no program block (it is empty, or only "
+        "comments), so there is nothing to check or run",
+        "test_setup.py::test_no_ob1: @pytest.mark.plc: cannot load sbr.awl:",
+        "*/sbr.awl:1:1: error: the program has no main program block (OB1), so there is "
+        "nothing to run;*",
         "test_setup.py::test_compile_error: @pytest.mark.plc: cannot load bad.awl:",
         "*/bad.awl:5:1: error: unknown instruction 'FOO' [[]OB1 network 1]",
     ])

@@ -569,7 +569,7 @@ def test_pos_goto_r_update_or_run_off_mid_move(axis: int, scan_ms: int,
         event("still moving at the end")
         return  # still moving at the bounded end
     final = samples[-1][1] * sign
-    if tr.outputs[t_cmd][0] != 1:
+    if tr.outputs[t_cmd - scan][0] != 1:
         # the move had ended before the command: nothing to update or stop
         assert final == abs(cmd.pos)
     elif update and not passed:

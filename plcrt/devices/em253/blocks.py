@@ -308,7 +308,8 @@ class PosGotoR(MotionBlock):
             segs = self.bounded_stop(t, x, v, v_ss, rd, self.target, "Update")
         else:
             self.target = Fraction(abs(pos))
-            segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra, rd)
+            segs, ok = distance_plan(t, x, v, Fraction(v_ss), Fraction(top), remaining, ra,
+                                     rd) if remaining > 0 else ([], False)
             if not ok:
                 # the new ramps cannot end at PosSet from this speed: PosSet
                 # (the number of pulses, 3.2.5) wins over DecTime

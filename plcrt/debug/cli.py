@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from pathlib import Path
 from typing import Any
 
 from ..cli import (EXIT_ERROR, PROG, add_program_args, add_scan_ms_arg, load_for_run,
@@ -62,11 +61,15 @@ def cmd_debug(args: argparse.Namespace) -> int:
 
     script: list[str] | None = None
     if args.script is not None:
+        from ..lang.limits import file_limit, read_capped
         try:
-            script = Path(args.script).read_text(encoding="utf-8").splitlines()
-        except (OSError, UnicodeDecodeError) as e:
-            reason = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
-            print(f"{PROG}: error: cannot read the script {args.script}: {reason}",
+            # a regular file of at most the file size limit (not /dev/zero)
+            raw = read_capped(args.script, file_limit(getattr(args, "max_file_mb", None)))
+            script = raw.decode("utf-8").splitlines()
+        except (PlcError, UnicodeDecodeError) as e:
+            reason = e.message.removeprefix("cannot read file: ") if isinstance(e, PlcError) \
+                else str(e)
+            print(printable(f"{PROG}: error: cannot read the script {args.script}: {reason}"),
                   file=sys.stderr)
             return EXIT_ERROR
     try:

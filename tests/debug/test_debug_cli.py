@@ -98,7 +98,7 @@ def test_exit_status_2_after_a_fault(tmp_path: Path,
      "plcrt: error: --break SBR9/1: no block 'SBR9' in the program (blocks: OB1, SBR0)"),
     (["--watch", "XYZ"], "plcrt: error: --watch XYZ: 'XYZ' is not an address"),
     (["--script", "no/such/file"],
-     "plcrt: error: cannot read the script no/such/file: No such file or directory"),
+     "plcrt: error: cannot read the script no/such/file: no such file"),
 ])
 def test_bad_options_exit_1(argv: list[str], message: str,
                             capsys: pytest.CaptureFixture[str]) -> None:
@@ -159,3 +159,14 @@ def test_terminal_session_prompts_without_echo(monkeypatch: pytest.MonkeyPatch,
     assert "(plcrt) " not in out                    # input() showed the prompts
     assert "Q0.1 = 0\n" in out
     assert "\x1b[" in out                           # the ladder view is in colour
+
+
+@pytest.mark.parametrize("bad, reason", [("/dev/zero", "not a regular file"),
+                                         ("missing.plcrt", "no such file")])
+def test_script_that_is_not_a_readable_regular_file(bad: str, reason: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """--script reads only a regular file of at most the file size limit:
+    /dev/zero is refused at once instead of being read without end."""
+    code, out, err = run_cli(capsys, "debug", STEPS, "--script", bad)
+    assert code == 1 and out == ""
+    assert f"cannot read the script {bad}: " in err and reason in err

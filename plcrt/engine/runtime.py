@@ -290,7 +290,7 @@ class Plc:
             f"time in one scan ({self._loop_work()}); WDR retriggers the watchdog, but plcrt "
             f"stops a scan that never ends; the CPU goes to STOP", loc)
 
-    def nesting_exceeded(self, insn_id: int) -> None:
+    def _nesting_exceeded(self, insn_id: int) -> None:
         """A CALL that would nest a ninth subroutine level: the CPU does not
         execute it, sets SM4.3 (run-time programming error, code 0008) and
         gives ENO 0; plcrt warns once per CALL (System Manual, CALL)."""

@@ -296,7 +296,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
     wd = g.use("WD")
     with g.box():
         with g.block(f"if {wd}[3] >= {int(MAX_NESTING)}:"):
-            refuse = g.bind(g.unit.hooks["plc"].nesting_exceeded, "nest")
+            refuse = g.bind(g.unit.hooks["plc"]._nesting_exceeded, "nest")
             g.line(f"{refuse}({int(g.insn_id)})")
             g.line("eno = 0")
         with g.block("else:"):

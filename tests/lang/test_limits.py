@@ -41,8 +41,12 @@ def test_raising_the_limit_loads_the_same_file(tmp_path: Path) -> None:
     assert plc["Q0.0"] == 1
 
 
-def test_the_default_limit_is_one_megabyte() -> None:
-    assert MAX_FILE_MB == 1.0 and file_limit() == 1024 * 1024
+def test_the_default_limits_admit_the_benchmark_programs() -> None:
+    """16 MB by default: far above any S7-200 export, and room for the
+    generated load benchmarks of 100 000 statements (about 1.3 MB)."""
+    from plcrt.lang.limits import MAX_INSTRUCTIONS
+    assert MAX_FILE_MB == 16.0 and file_limit() == 16 * 1024 * 1024
+    assert MAX_INSTRUCTIONS >= 100_000
 
 
 def test_read_capped_reads_at_most_limit_plus_one_bytes(tmp_path: Path) -> None:

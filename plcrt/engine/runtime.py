@@ -32,7 +32,7 @@ from ..errors import (PlcAddressError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
-from ..safetext import printable
+from ..safetext import excerpt, printable
 from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
@@ -361,9 +361,9 @@ class Plc:
             try:
                 op = Resolver(self.model, self.symbols, _system_symbols()).parse(text)
             except Exception as e:  # noqa: BLE001 - reported as an address error
-                raise PlcAddressError(f"{address!r}: {e}") from None
+                raise PlcAddressError(f"{excerpt(address)!r}: {e}") from None
         if not isinstance(op, Addr):
-            raise PlcAddressError(f"{address!r} is not an address")
+            raise PlcAddressError(f"{excerpt(address)!r} is not an address")
         return op
 
     def locate(self, spec: str) -> tuple[bytearray, int, int, int, str]:

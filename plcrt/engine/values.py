@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..errors import PlcAddressError, PlcConfigError
-from ..safetext import printable
+from ..safetext import excerpt, printable
 
 Number = Union[int, float]
 Duration = Union[int, float, str]
@@ -186,7 +186,16 @@ def check_address(address: Any) -> str:
     if not text:
         raise PlcAddressError("an address is a string such as 'VW100', 'Q0.0' or a symbol "
                               "name, got an empty string")
+    if len(text) > MAX_ADDRESS_CHARS:
+        # no address or symbol is this long (Micro/WIN symbols have at most
+        # 23 characters); quoting it whole would flood the terminal
+        raise PlcAddressError(f"{excerpt(text)!r} is {len(text)} characters long: no address "
+                              f"or symbol name has more than {MAX_ADDRESS_CHARS}")
     return text
+
+
+#: longest address spec accepted (a symbol with a format suffix fits easily)
+MAX_ADDRESS_CHARS = 256
 
 
 def split_format(spec: Any, fmt: Any = None) -> tuple[str, str]:

@@ -397,3 +397,17 @@ def test_load_takes_any_iterable_of_sources() -> None:
     """A list, a tuple or a generator (``Path.glob``) of files: the blocks are merged."""
     for sources in ([TIMERS], (TIMERS,), (p for p in [TIMERS])):
         assert plcrt.load(sources).program.file == str(TIMERS)
+
+
+@pytest.mark.parametrize("call", ["read", "getitem", "write", "force"])
+@pytest.mark.parametrize("length", [300, 200_000])
+def test_a_huge_address_is_not_echoed_in_full(call: str, length: int) -> None:
+    """An address of hundreds of thousands of characters ends in a
+    PlcAddressError that quotes at most 40 characters of it."""
+    plc = plcrt.load(TIMERS)
+    spec = "V" * length
+    actions = {"read": lambda: plc.read(spec), "getitem": lambda: plc[spec],
+               "write": lambda: plc.write(spec, 1), "force": lambda: plc.force(spec, 1)}
+    with pytest.raises(plcrt.PlcAddressError) as err:
+        actions[call]()
+    assert len(str(err.value)) < 200 and "V" * 41 not in str(err.value)

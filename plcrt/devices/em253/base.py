@@ -216,6 +216,35 @@ class MotionBlock:
         segs, _ = plan_distance(Fraction(t), x, v, v, vss, left, rate, need)
         return segs
 
+    def command(self, t: int, run: int, rising: bool, update: int, e_stop: int,
+                params: tuple) -> None:
+        """The rules SPD_CTRL, POS_GOTO_R and POS_RUN share (3.2.4-3.2.6):
+        E_Stop stops at once; while this block's move runs, Run = 0 ramps
+        it down (:meth:`stop_move`), Run back to 1 during that ramp is
+        reported, Update applies ``params`` (``_update``); otherwise a Run
+        edge starts a move (:meth:`start_move`).  ``params`` are the
+        block's inputs that a start or an Update applies."""
+        if e_stop:
+            self.estop()
+        elif self.running():
+            if not run:
+                self.stop_move(t, params)
+            elif self.stopping:
+                self.restart_while_stopping(rising, update)
+            elif update:
+                self.applied = params
+                self._update(t, *params)  # type: ignore[attr-defined]
+        elif rising:
+            self.start_move(t, params)
+
+    def start_move(self, t: int, params: tuple) -> None:
+        """A Run edge: start a move with ``params`` (per instruction)."""
+        raise NotImplementedError
+
+    def stop_move(self, t: int, params: tuple) -> None:
+        """Run = 0 while the move runs: ramp down (per instruction)."""
+        raise NotImplementedError
+
     def output_limit_lowered(self, t: int) -> None:
         """P_DorCCW went from differential (500 kHz) to single-ended
         (200 kHz) while this block's move runs above 200 kHz: the move's

@@ -148,31 +148,30 @@ class SpdCtrl(MotionBlock):
         assert ax is not None
         t = self.now()
         d = 1 if direction else -1
-        if e_stop:
-            self.estop()
-        elif self.running():
-            if not run:
-                v_ss = min(v_ss, self.top)
-                self.ramp_down(t, v_ss, ramp_rate(self.top, v_ss, dec))
-            elif self.stopping:
-                self.restart_while_stopping(rising, update)
-            elif update:
-                self.applied = (acc, dec, v_ss, v_set, d)
-                self._update(t, *self.applied)
-        elif rising and self.can_start(d):
-            sp = self.speeds_ok(v_ss, v_set)
-            if sp is not None:
-                self.applied = (acc, dec, v_ss, v_set, d)
-                v_ss, self.top = sp
-                top = self.top
-                self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
-                                            Fraction(top), ramp_rate(top, v_ss, acc),
-                                            ramp_rate(top, v_ss, dec)))
+        self.command(t, run, rising, update, e_stop, (acc, dec, v_ss, v_set, d))
         spd = ax.speed(t) if self.owns() else 0
         if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
         self.last_spd = spd
         return INNER_OK, 0, self.status, spd
+
+    def stop_move(self, t: int, params: tuple) -> None:
+        acc, dec, v_ss, v_set, d = params
+        v_ss = min(v_ss, self.top)
+        self.ramp_down(t, v_ss, ramp_rate(self.top, v_ss, dec))
+
+    def start_move(self, t: int, params: tuple) -> None:
+        acc, dec, v_ss, v_set, d = params
+        if not self.can_start(d):
+            return
+        sp = self.speeds_ok(v_ss, v_set)
+        if sp is not None:
+            self.applied = params
+            v_ss, self.top = sp
+            top = self.top
+            self.begin(d, velocity_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                        Fraction(top), ramp_rate(top, v_ss, acc),
+                                        ramp_rate(top, v_ss, dec)))
 
     def _update(self, t, acc, dec, v_ss, v_set, d) -> None:
         ax = self.axis
@@ -240,32 +239,7 @@ class PosGotoR(MotionBlock):
         ax = self.axis
         assert ax is not None
         t = self.now()
-        if e_stop:
-            self.estop()
-        elif self.running():
-            if not run:
-                v_ss = min(v_ss, self.top)
-                self.ramp_down(t, v_ss, ramp_rate(self.top, v_ss, dec), self.target)
-            elif self.stopping:
-                self.restart_while_stopping(rising, update)
-            elif update:
-                self.applied = (acc, dec, v_ss, v_set, pos)
-                self._update(t, *self.applied)
-        elif rising:
-            d = 1 if pos > 0 else -1
-            if pos == 0:
-                self.status = ST_STOPPED
-            elif self.can_start(d):
-                sp = self.speeds_ok(v_ss, v_set)
-                if sp is not None:
-                    self.applied = (acc, dec, v_ss, v_set, pos)
-                    v_ss, top = sp
-                    self.top = top
-                    segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
-                                            Fraction(top), Fraction(abs(pos)),
-                                            ramp_rate(top, v_ss, acc), ramp_rate(top, v_ss, dec))
-                    self.target = Fraction(abs(pos))
-                    self.begin(d, segs)
+        self.command(t, run, rising, update, e_stop, (acc, dec, v_ss, v_set, pos))
         if ax.owner is not self:
             # another instruction moves the axis: C_Pos keeps this block's
             # last move until its next start (3.2.5 "已发送脉冲数")
@@ -282,6 +256,30 @@ class PosGotoR(MotionBlock):
         assert self.axis is not None
         self.last_pos = self.axis.last_travel
         self.status = ST_STOPPED
+
+    def stop_move(self, t: int, params: tuple) -> None:
+        acc, dec, v_ss, v_set, pos = params
+        v_ss = min(v_ss, self.top)
+        self.ramp_down(t, v_ss, ramp_rate(self.top, v_ss, dec), self.target)
+
+    def start_move(self, t: int, params: tuple) -> None:
+        acc, dec, v_ss, v_set, pos = params
+        d = 1 if pos > 0 else -1
+        if pos == 0:
+            self.status = ST_STOPPED
+            return
+        if not self.can_start(d):
+            return
+        sp = self.speeds_ok(v_ss, v_set)
+        if sp is not None:
+            self.applied = params
+            v_ss, top = sp
+            self.top = top
+            segs, _ = distance_plan(t, Fraction(0), Fraction(0), Fraction(v_ss),
+                                    Fraction(top), Fraction(abs(pos)),
+                                    ramp_rate(top, v_ss, acc), ramp_rate(top, v_ss, dec))
+            self.target = Fraction(abs(pos))
+            self.begin(d, segs)
 
     def _update(self, t, acc, dec, v_ss, v_set, pos) -> None:
         ax = self.axis

@@ -22,6 +22,7 @@ MAX_STEPS = 32
 @register_block("POS_RUN")
 class PosRun(MotionBlock):
     name = "POS_RUN"
+    mode_in = 0   #: the Mode input of the current call
 
     def __call__(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
                  run) -> tuple:
@@ -33,34 +34,35 @@ class PosRun(MotionBlock):
         ax = self.axis
         assert ax is not None
         t = self.now()
-        if e_stop:
-            self.estop()
-        elif self.running():
-            if not run:
-                # the running step's DecTime (3.2.6 gives each step its own
-                # DecTime); never beyond the envelope's end
-                x = self.axis.travel(t) if self.axis is not None else 0
-                k, _ = self._step_at(x)
-                self.ramp_down(t, min(v_ss, self.module.max_hz) if self.module else v_ss,
-                               self.step_rd[max(k - 1, 0)], self.bounds[-1])
-            elif self.stopping:
-                self.restart_while_stopping(rising, update)
-            elif update:
-                self.applied = (v_ss, ptr, steps)
-                self._update(t, *self.applied)
-        elif rising and self.can_start(-1 if self._first_sign(ptr, steps) < 0 else 1):
-            if mode != 0:
-                self.warn(f"Mode {mode} is not defined (manual: 0); running as mode 0", "mode")
-            table = self._table(ptr, steps)
-            if table is not None:
-                self.applied = (v_ss, ptr, steps)
-                self._start(t, v_ss, table)
+        self.mode_in = mode
+        self.command(t, run, rising, update, e_stop, (v_ss, ptr, steps))
         step, c_pos = self._progress(t)
         if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
         spd = ax.speed(t) if self.owns() else 0
         self.last_spd = spd
         return INNER_OK, 0, self.status, c_pos, spd, step
+
+    def stop_move(self, t: int, params: tuple) -> None:
+        # the running step's DecTime (3.2.6 gives each step its own
+        # DecTime); never beyond the envelope's end
+        v_ss = params[0]
+        assert self.axis is not None and self.module is not None
+        k, _ = self._step_at(self.axis.travel(t))
+        self.ramp_down(t, min(v_ss, self.module.max_hz), self.step_rd[max(k - 1, 0)],
+                       self.bounds[-1])
+
+    def start_move(self, t: int, params: tuple) -> None:
+        v_ss, ptr, steps = params
+        if not self.can_start(-1 if self._first_sign(ptr, steps) < 0 else 1):
+            return
+        if self.mode_in != 0:
+            self.warn(f"Mode {self.mode_in} is not defined (manual: 0); running as mode 0",
+                      "mode")
+        table = self._table(ptr, steps)
+        if table is not None:
+            self.applied = params
+            self._start(t, v_ss, table)
 
     def _first_sign(self, ptr: int, steps: int) -> int:
         """Direction of the envelope in the table (without diagnostics)."""

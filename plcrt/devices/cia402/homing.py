@@ -56,11 +56,11 @@ from typing import Union
 from ...errors import PlcConfigError
 from ..homing_geometry import index_at_or_beyond
 from ..motion import US, Seg, cruise, first_time_at, plan_distance, ramp
-from .homing_methods import (HARD_STOP, HERE, HS_NEG, HS_POS, HS_ZONE, INDEX, NLS, PLS,
+from .homing_methods import (HARD_STOP, HERE, HS_NEG, HS_POS, INDEX, NLS, PLS,
                              SIGNAL_NAMES, HomingPlant, Method, method_table)
 
 __all__ = ["Done", "Failed", "HomingParams", "HomingSequence", "Phase", "Watch",
-           "power_on_homing", "run"]
+           "homing_status", "power_on_homing", "run"]
 
 F0 = Fraction(0)
 LIMIT_NAME = {NLS: "negative limit (NLS)", PLS: "positive limit (PLS)"}
@@ -195,6 +195,30 @@ def power_on_homing(setting: int) -> str:
                              f"(Kinco §2.1)") from None
 
 
+#: statusword bits 10 / 12 / 13 per homing state (HCFA §7.5.4, HM §1.3 table); bit 15 apart
+_STATUS_BITS = {"idle": 0x0400, "aborted": 0x0400, "running": 0x0000,
+                "done": 0x1400, "failed": 0x2400}
+
+
+def homing_status(model: str, state: str, homed: bool) -> int:
+    """Statusword bits 10, 12, 13 and 15 in HM for a sequence ``state``
+    (idle, running, done, failed, aborted).
+
+    Bit 15 differs by model (digest §2.2): HCFA "homing can be triggered"
+    (1 while idle or after an abort, 0 once triggered or done, §7.5.4);
+    Kinco "reference found" (§2.6): set by a successful homing and kept,
+    cleared when a new homing starts (``homed`` is the drive's flag).
+    """
+    try:
+        bits = _STATUS_BITS[state]
+    except KeyError:
+        raise PlcConfigError(f"homing state {state!r} is not one of "
+                             f"{', '.join(_STATUS_BITS)}") from None
+    if model == "kinco":
+        return bits | (0x8000 if homed else 0)
+    return bits | (0x8000 if state in ("idle", "aborted") else 0)
+
+
 @dataclass
 class HomingSequence:
     """One homing operation of ``model`` (see the module docstring)."""
@@ -232,10 +256,10 @@ class HomingSequence:
     def _limit_error(self, t: int, x: int, which: str) -> Failed:
         m = self.method
         assert m is not None
-        if not self.kinco and m.number in HCFA_LIMIT_ERRORS[which]:
-            rule = "HCFA §7.5.4 lists this limit as a homing error for this method"
-        elif self.reversed and which != m.reverse_at:
+        if self.reversed and which != m.reverse_at:
             rule = "both limits were seen (HCFA §7.5.4)"
+        elif not self.kinco and m.number in HCFA_LIMIT_ERRORS[which]:
+            rule = "HCFA §7.5.4 lists this limit as a homing error for this method"
         else:
             rule = ("the method does not use this limit in this phase (plcrt extends the "
                     "§7.5.4 error table, docs/cia402.md)")

@@ -8,7 +8,7 @@ plant into :class:`~.homing_methods.HomingPlant`, and calls the sequence.
 
 Protocol (what the drive calls)::
 
-    seq = HomingSequence("kinco", params, plant)
+    seq = HomingSequence("kinco-servo", params, plant)
     step = seq.start(t, position)          # Phase | Done | Failed
     while isinstance(step, Phase):
         t, position, event = step.first_event()     # or the drive's own detection
@@ -49,7 +49,7 @@ Decisions are logged in docs/cia402.md, "Homing".
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from fractions import Fraction
 from typing import Union
 
@@ -214,30 +214,31 @@ def homing_status(model: str, state: str, homed: bool) -> int:
     except KeyError:
         raise PlcConfigError(f"homing state {state!r} is not one of "
                              f"{', '.join(_STATUS_BITS)}") from None
-    if model == "kinco":
+    if model == "kinco-servo":
         return bits | (0x8000 if homed else 0)
     return bits | (0x8000 if state in ("idle", "aborted") else 0)
 
 
-@dataclass
 class HomingSequence:
-    """One homing operation of ``model`` (see the module docstring)."""
+    """One homing operation of ``model`` (see the module docstring).
 
-    model: str
-    params: HomingParams
-    plant: HomingPlant
-    method: Method | None = field(init=False)
-    state: str = field(init=False, default="idle")
+    ``state`` names the current phase (search, decelerate, leave, pass,
+    back, final, offset, stall search, stall) or the outcome (idle, done,
+    failed, aborted); ``home`` is the home point once it is known.
+    """
 
-    def __post_init__(self) -> None:
-        table = method_table(self.model)
-        self.kinco = self.model == "kinco"
-        self.method = table.get(self.params.method)
-        p = self.params
-        self.vh = Fraction(max(p.v_search, p.v_zero))
-        self.vl = Fraction(p.v_zero)
-        self.rate = Fraction(p.accel, US)
-        self.reversed = False
+    def __init__(self, model: str, params: HomingParams, plant: HomingPlant) -> None:
+        table = method_table(model)
+        self.model = model
+        self.params = params
+        self.plant = plant
+        self.kinco = model == "kinco-servo"
+        self.method: Method | None = table.get(params.method)
+        self.vh = Fraction(max(params.v_search, params.v_zero))   # 6099h:01
+        self.vl = Fraction(params.v_zero)                          # 6099h:02
+        self.rate = Fraction(params.accel, US)                     # 609Ah in Hz per µs
+        self.state = "idle"
+        self.reversed = False          #: the search has reversed at its limit
         self.home: int | None = None
         self.phase: Phase | None = None
         self.deadline: int | None = None
@@ -295,7 +296,8 @@ class HomingSequence:
         return segs
 
     def _stop_then(self, t: int, x: int, v: Fraction) -> Step:
-        """Decelerate to a stop with 609Ah (at once from 6099h:02 or less)."""
+        """Decelerate to a stop with 609Ah (at once from 6099h:02 or less),
+        then approach the edge from rest."""
         d = self.phase.direction if self.phase else 0
         if v <= self.vl:
             return self._position(t, x)

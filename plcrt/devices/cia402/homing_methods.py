@@ -180,7 +180,7 @@ def _rows(model: str) -> dict[int, Method]:
     return rows
 
 
-MODELS = ("hcfa-am0520b", "kinco")
+MODELS = ("hcfa-am0520b", "kinco-servo")
 METHODS: dict[str, dict[int, Method]] = {m: _rows(m) for m in MODELS}
 
 

@@ -22,7 +22,7 @@ PERIOD, PHASE = 500, 130
 PLANT = HomingPlant(NL, PL, (LO, HI), PERIOD, PHASE, -12000, 12000)
 V_HIGH, V_LOW, ACC = 20000, 2000, 200000
 
-HCFA, KINCO = "hcfa-am0520b", "kinco"
+HCFA, KINCO = "hcfa-am0520b", "kinco-servo"
 SWITCH_METHODS = [*range(1, 15), *range(17, 31)]
 
 
@@ -447,7 +447,7 @@ def test_home_is_the_defined_point_and_no_limit_is_passed(geo, model, n, sp1, sp
     assume(plant.neg_limit + 1 < exp < plant.pos_limit - 1)
     results = []
     for vh, vl in (sp1, sp2):
-        acc = vh * vh   # deceleration distance vh^2 / 2a = 1/2 count
+        acc = vh * vh // 1000   # slowing down from 6099h:01 takes 500 counts
         seq = HomingSequence(model, HomingParams(n, vh, vl, acc, offset, offset_mode=1), plant)
         result, phases = run(seq, 0, start)
         assert isinstance(result, Done), result

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Union
 
-from ...errors import PlcConfigError
+from ...errors import PlcConfigError, PlcRuntimeError
 from ..homing_geometry import index_at_or_beyond
 from ..motion import US, Seg, cruise, first_time_at, plan_distance, ramp
 from .homing_methods import (HARD_STOP, HERE, HS_NEG, HS_POS, INDEX, NLS, PLS,
@@ -160,7 +160,7 @@ class Phase:
         if self.deadline is not None and (best is None or self.deadline < best[0]):
             best = (self.deadline, 2, self.position_at(self.deadline), "timeout")
         if best is None:
-            raise PlcConfigError(f"homing phase {self.name!r} has no end: nothing to watch")
+            raise PlcRuntimeError(f"homing phase {self.name!r} has no end: nothing to watch")
         return best[0], best[2], best[3]
 
 
@@ -309,10 +309,16 @@ class HomingSequence:
         p, m, plant = self.params, self.method, self.plant
         if m is None:
             known = ", ".join(str(n) for n in sorted(method_table(self.model)))
-            alarm = None if self.kinco else 62
+            where = "Kinco §2.2" if self.kinco else "HCFA §7.5.4, §10.1; alarm 62"
             return self._fail(t, x, f"6098h = {p.method} is not a method of {self.model} "
-                                    f"(supported: {known}; HCFA §7.5.4 alarm 62, Kinco §2.2)",
-                              alarm)
+                                    f"(supported: {known}; {where})",
+                              None if self.kinco else 62)
+        if self.kinco and p.blind_zone not in BLIND_QUARTERS:
+            return self._fail(t, x, f"6099h:06 = {p.blind_zone}: the index blind zone takes "
+                                    f"0, 1 or 2 (0, 1/4, 1/2 rev, Kinco §2.4)")
+        if self.kinco and p.offset_mode not in (0, 1):
+            return self._fail(t, x, f"6099h:05 = {p.offset_mode}: the offset mode takes 0 or 1 "
+                                    f"(Kinco §2.1, §2.3-3)")
         if m.signal != HERE and min(p.v_search, p.v_zero, p.accel) <= 0:
             return self._fail(t, x, "6099h:01, 6099h:02 and 609Ah must all be non-zero "
                                     "(statusword bit 14, HCFA §7.5.4)")
@@ -399,7 +405,7 @@ class HomingSequence:
         assert plant.index_period is not None
         blind = 0
         if self.kinco and m.signal != INDEX:
-            blind = plant.index_period * BLIND_QUARTERS.get(p.blind_zone, 0) // 4
+            blind = plant.index_period * BLIND_QUARTERS[p.blind_zone] // 4
         return index_at_or_beyond(c + m.final * blind, m.final, plant.index_period,
                                   plant.index_phase)
 
@@ -484,7 +490,7 @@ class HomingSequence:
             return Done(t, self.home if self.home is not None else x, x, -x,
                         f"{self._label()}: home at {self.home}, moved 607Ch = "
                         f"{self.params.offset} and set 6064h = 0 (offset mode 0, Kinco §2.3-3)")
-        raise PlcConfigError(f"{self._label()}: event {event!r} is not expected in the "
+        raise PlcRuntimeError(f"{self._label()}: event {event!r} is not expected in the "
                              f"{self.state} phase")
 
     def _entry(self, t: int, e: int, v: Fraction) -> Step:
@@ -542,7 +548,7 @@ def run(seq: HomingSequence, t: int, x: int, max_phases: int = 64) -> tuple[Done
     while isinstance(step, Phase):
         phases.append(step)
         if len(phases) > max_phases:
-            raise PlcConfigError(f"homing method {seq.params.method}: more than {max_phases} "
+            raise PlcRuntimeError(f"homing method {seq.params.method}: more than {max_phases} "
                                  f"phases")
         t, x, event = step.first_event()
         step = seq.on_event(t, x, event)

@@ -152,6 +152,10 @@ def test_hcfa_index_method_started_on_the_home_switch_fails():
     (10, -5000, ["search", "final"]),                  # 10A
     (12, 6000, ["search", "decelerate", "back", "final"]),   # 12A
     (13, 6000, ["search", "pass", "final"]),           # 13A
+    (7, 6000, ["search", "search", "final"]),          # 7B: PLS, back fast, slow on the edge
+    (9, 6000, ["search", "search", "decelerate", "back", "final"]),   # 9B
+    (11, -5000, ["search", "search", "final"]),        # 11B
+    (14, 2000, ["final"]),                             # 14C: slow out through lo
 ])
 def test_hcfa_paths_follow_section_10_1(n, start, names):
     result, phases = home(HCFA, n, start)
@@ -245,6 +249,20 @@ def test_kinco_blind_zone_ignores_index_pulses_near_the_edge(blind, expected):
     result, _ = home(KINCO, 11, 6000, plant, blind_zone=blind)
     assert result.home_point == expected
     assert expected == expected_home(11, plant, blind=PERIOD * blind // 4)
+
+
+@pytest.mark.parametrize("kw,what", [({"blind_zone": 3}, "6099h:06 = 3"),
+                                     ({"offset_mode": 2}, "6099h:05 = 2")])
+def test_kinco_refuses_bad_homing_settings(kw, what):
+    result, _ = home(KINCO, 11, 6000, **kw)
+    assert isinstance(result, Failed) and what in result.explanation
+
+
+def test_protocol_misuse_is_a_plc_error():
+    seq = HomingSequence(HCFA, params(7), PLANT)
+    seq.start(0, -5000)
+    with pytest.raises(PlcError, match="not expected"):
+        seq.on_event(10, -4000, "stall")
 
 
 def test_hcfa_has_no_blind_zone():

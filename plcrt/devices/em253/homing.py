@@ -27,6 +27,8 @@ mode   search  edge        final     Z     home position
 0      -       -           -         -     the current position (no motion)
 =====  ======  ==========  ========  ====  ===================================
 
+The edge crossings and the Z search are the pure functions of
+:mod:`plcrt.devices.homing_geometry`, shared with the CiA 402 methods.
 Modes 7-14 have the geometry of CiA 402 methods 7-14 (digest
 shared/reference/homing-and-motion.md, table 1.2).  Modes 1-4 follow the
 appendix text: "机械往原点开关方向运动，在检测到原点开关信号后减速停止，再反转
@@ -82,6 +84,7 @@ from fractions import Fraction
 from functools import partial
 from typing import Any
 
+from ..homing_geometry import edge_crossing, index_at_or_beyond
 from ..motion import Seg, cruise, plan_distance, ramp_distance
 from .axis import Axis, stop_plan, velocity_plan
 
@@ -120,19 +123,13 @@ MODES: dict[int, Mode | None] = {
 def crossing(mode: Mode, rps: tuple[int, int]) -> int:
     """Mechanical position at which the final approach crosses the edge
     (the first position on the far side)."""
-    lo, hi = rps
-    table = {("lo", -1): lo - 1, ("lo", 1): lo, ("hi", -1): hi, ("hi", 1): hi + 1}
     assert mode.edge is not None
-    return table[(mode.edge, mode.final)]
+    return edge_crossing(mode.edge, mode.final, *rps)
 
 
 def z_at_or_beyond(pos: int, direction: int, period: int, offset: int) -> int:
     """First Z position at or beyond ``pos`` in ``direction``."""
-    if direction > 0:
-        k = -((offset - pos) // period)   # ceil((pos - offset) / period)
-    else:
-        k = (pos - offset) // period      # floor
-    return offset + k * period
+    return index_at_or_beyond(pos, direction, period, offset)
 
 
 def home_position(mode: Mode, plant: Any, start: int) -> int | None:

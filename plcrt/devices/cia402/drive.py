@@ -27,14 +27,14 @@ from typing import Callable, Optional
 
 from ...errors import PlcError
 from .axis import Axis
-from .esm import Esm, EsmState
+from .esm import AlResult, Esm, EsmState
 from .homing_plan import HomingPlan, homing_plans
 from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, ProfileVelocity,
                     MODE_NAMES)
 from .od import ObjectDictionary, SdoAbort
 from .pdo import ASSIGN, RX_MAPS, TX_MAPS, PdoConfig, pack, unpack
 from .plant import DrivePlant
-from .statemachine import Drive402, Result, State
+from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
 from .store import Store, Write
 
@@ -156,7 +156,7 @@ class Drive:
                 self.store.sdo_write(index, sub, data, state=state)   # raises the length code
             res = self.pdo.write(index, sub, int(entry.decode(bytes(data))))
             if not res.ok:
-                raise SdoAbort(res.abort, res.explanation)
+                raise SdoAbort(res.abort, res.explanation.split('): ', 1)[-1])
             self.store.set(index, sub, int(entry.decode(bytes(data))))
             return
         self.store.sdo_write(index, sub, data, state=state, moving=self.moving)
@@ -217,6 +217,25 @@ class Drive:
         self.sm.mode = mode or None
         if oe:
             self.mode.enable(t)
+
+    def request_esm(self, state: EsmState | int, ack: bool = False) -> AlResult:
+        """AL Control from the master at the present time (HCFA §6.5): a
+        mapping error raises alarm 35; leaving OP disables the drive."""
+        res = self.esm.request(state, self.now / 1e6, ack)
+        self._esm_result(res)
+        return res
+
+    def _esm_result(self, res: AlResult) -> None:
+        t = self.now
+        if res.explanation:
+            self.note(t, "HCFA §6.5", res.explanation, "ESM")
+        if res.fault is not None:
+            self.fault(t, *res.fault)
+        if res.left_op and self.sm.state in (State.OPERATION_ENABLED,
+                                             State.QUICK_STOP_ACTIVE):
+            self._do(t, self.sm.command(Command.DISABLE_VOLTAGE, t / 1e6,
+                                        "the bus left OP (digest §6.1)"))
+        self.publish()
 
     # ---------------------------------------------------------------- state machine
     def _mirror(self) -> None:

@@ -61,6 +61,7 @@ class LinLeg:
 
 
 AnyLeg = Union[Leg, LinLeg]
+ZERO = Fraction(0)
 
 
 def _floor(x: Fraction) -> int:
@@ -76,6 +77,7 @@ class Axis:
         self.legs: list[AnyLeg] = []
         self.evaluations = 0        #: polynomial evaluations (for cost tests)
         self.version = 0            #: changes whenever the plan changes
+        self._memo: tuple = (None, None, None)
 
     # ---------------------------------------------------------------- state
     def _leg_x(self, leg: AnyLeg, t: int | Fraction) -> tuple[Fraction, Fraction]:
@@ -83,7 +85,7 @@ class Axis:
         self.evaluations += 1
         if isinstance(leg, LinLeg):
             if t >= leg.t1:
-                return Fraction(leg.x1), Fraction(0)
+                return Fraction(leg.x1), ZERO
             tt = max(t, leg.t0)
             return (leg.x0 + Fraction((leg.x1 - leg.x0) * (tt - leg.t0), leg.t1 - leg.t0),
                     Fraction((leg.x1 - leg.x0) * US, leg.t1 - leg.t0))
@@ -97,11 +99,16 @@ class Axis:
 
     def exact(self, t: int) -> tuple[Fraction, Fraction]:
         """Exact position and signed speed (P/s) at integer µs *t*."""
+        if self._memo[0] == t and self._memo[1] == self.version:
+            return self._memo[2]
+        out = self._rest, ZERO
         for leg in self.legs:
             end = leg.t_end
             if end is None or t < end:
-                return self._leg_x(leg, t)
-        return self._rest, Fraction(0)
+                out = self._leg_x(leg, t)
+                break
+        self._memo = (t, self.version, out)
+        return out
 
     def position(self, t: int) -> int:
         """6064h: whole counts (floor of the exact position)."""

@@ -22,6 +22,7 @@ What it is not: no bus.  The canopen port and the PLC coupler call
 
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -87,6 +88,10 @@ class Drive:
         self._cache_version = -1
         self._cache: dict[tuple, Optional[int]] = {}
         self._signed = frozenset((e.index, e.sub) for e in self.od if e.dtype.startswith("I"))
+        self._own = frozenset((i, 0) for i in _OUTPUTS if self.od.find(i, 0) is not None)
+        self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
+        self._batch = False
+        self._rx_noted = False
         self.store.on_write(self._on_write)
         self._mirror()
         self.publish()
@@ -185,7 +190,8 @@ class Drive:
                 self.sm.dec_6085 = int(value)
             if self.sm.state is State.OPERATION_ENABLED:
                 self.mode.parameter(t, index, sub)
-        self.publish()
+        if not self._batch:
+            self.publish()        # 6041h is current when an SDO write returns
 
     def _controlword(self, t: int, cw: int) -> None:
         old, self.controlword = self.controlword, cw
@@ -353,33 +359,73 @@ class Drive:
             raise PlcError(f"drive: more than {_MAX_EVENTS} events before {t_us} µs "
                            "(a homing plan that does not move on?)")
         self.now = t_us
-        self.publish()
+        if not self._batch:
+            self.publish()
 
     def cycle(self, t_us: int, rx: Optional[bytes] = None) -> bytes:
         """One bus cycle at *t_us*: advance, apply the RxPDO image *rx* (in
         OP; objects before 6040h), evaluate the held controlword, run the
         mode's cycle, and return the TxPDO image."""
-        self.advance(t_us)
-        if rx is not None:
-            if self.esm.outputs:
-                values = unpack(self.pdo.active_rx, rx, self._signed)
-                for key in sorted(values, key=lambda k: k == (0x6040, 0)):
-                    v = values[key]
-                    if key == (0x6040, 0) or self._stored(key) != v:
-                        self.store.set(key[0], key[1], v, source="pdo")
-            elif not getattr(self, "_rx_noted", False):
+        self._batch = True
+        try:
+            self.advance(t_us)
+            if rx is not None:
+                self._apply_rx(t_us, rx)
+            if self.sm.state is not State.OPERATION_ENABLED:
+                # in OE a held level can only hold OE: every other level acted when written
+                self._do(t_us, self.sm.cycle(t_us / 1e6))
+            if self.sm.state is State.OPERATION_ENABLED:
+                self.mode.cycle(t_us)
+        finally:
+            self._batch = False
+        self.publish()
+        get, out = self.store.get, self._out
+        codec = self._codec(self.pdo.active_tx)
+        if codec is not None:
+            return codec[0].pack(*[out[k] if k in out else int(get(*k)) for k in codec[1]])
+        values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
+                  else int(get(e.index, e.sub)) for e in self.pdo.active_tx if e.index}
+        return pack(self.pdo.active_tx, values)
+
+    def _codec(self, entries: tuple) -> Optional[tuple[struct.Struct, list[tuple[int, int]]]]:
+        """A struct for a byte-aligned image (the same bytes as pdo.pack /
+        pdo.unpack, which serve every other mapping)."""
+        hit = self._codecs.get(id(entries))
+        if hit is not None and hit[0] is entries:
+            return hit[1]
+        fmt, keys = "<", []
+        for e in entries:
+            if e.bits not in (8, 16, 32):
+                self._codecs[id(entries)] = (entries, None)
+                return None
+            if e.index == 0:
+                fmt += "x" * (e.bits // 8)
+                continue
+            code = {8: "b", 16: "h", 32: "i"}[e.bits]
+            fmt += code if (e.index, e.sub) in self._signed else code.upper()
+            keys.append((e.index, e.sub))
+        codec = (struct.Struct(fmt), keys)
+        self._codecs[id(entries)] = (entries, codec)
+        return codec
+
+    def _apply_rx(self, t_us: int, rx: bytes) -> None:
+        if not self.esm.outputs:
+            if not self._rx_noted:
                 self._rx_noted = True
                 self.note(t_us, "HCFA §6.5", f"RxPDO ignored in {self.esm.state.name}: "
                           "outputs act in OP only", "drive")
-        if self.sm.state is not State.OPERATION_ENABLED:
-            # in OE a held level can only hold OE: every other level acted when written
-            self._do(t_us, self.sm.cycle(t_us / 1e6))
-        if self.sm.state is State.OPERATION_ENABLED:
-            self.mode.cycle(t_us)
-        self.publish()
-        values = {(e.index, e.sub): int(self.store.get(e.index, e.sub))
-                  for e in self.pdo.active_tx if e.index}
-        return pack(self.pdo.active_tx, values)
+            return
+        codec = self._codec(self.pdo.active_rx)
+        if codec is not None and len(rx) == codec[0].size:
+            values = dict(zip(codec[1], codec[0].unpack(rx)))
+        else:
+            values = unpack(self.pdo.active_rx, rx, self._signed)
+        cw = values.pop((0x6040, 0), None)
+        for key, v in values.items():               # objects first, then 6040h
+            if self._stored(key) != v:
+                self.store.set(key[0], key[1], v, source="pdo")
+        if cw is not None and cw != self.controlword:
+            self.store.set(0x6040, 0, cw, source="pdo")
 
     def _stored(self, key: tuple[int, int]) -> int:
         return int(self.store.get(*key))
@@ -402,11 +448,12 @@ class Drive:
                   0x6064: pos, 0x606C: self.axis.velocity(t), 0x603F: self.sm.error_code,
                   0x1001: self.sm.error_register, 0x60F4: fe,
                   0x60FD: self.plant.inputs(pos)}
-        for index, v in values.items():
-            key = (index, 0)
-            if self._out.get(key) != v and self.od.find(index, 0) is not None:
-                self.store.set(index, 0, v)
-                self._out[key] = v
+        out = self._out
+        changed = {(i, 0): v for i, v in values.items()
+                   if out.get((i, 0)) != v and (i, 0) in self._own}
+        if changed:
+            self.store.set_status(changed)
+            out.update(changed)
 
     @property
     def statusword(self) -> int:

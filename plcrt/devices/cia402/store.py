@@ -111,6 +111,21 @@ class Store:
                 for hook in list(self._write_hooks):
                     hook(write)
 
+    def set_status(self, values: dict[tuple[int, int], int]) -> None:
+        """Set the drive's own integer status objects (6041h, 6064h, ...)
+        in one step: a range check only, no hooks (the bus-cycle fast path).
+
+        Raises:
+            PlcConfigError: a value outside its entry's type range.
+        """
+        with self.lock:
+            for key, value in values.items():
+                entry = self.od.entry(*key)
+                if not entry.low <= value <= entry.high:
+                    raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
+                self._active[key] = value
+                self._pending.pop(key, None)
+
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.
 

@@ -348,3 +348,20 @@ def test_statusword_always_shows_drive402_state(steps, mode):
         assert state_of_statusword(sw) is d.sm.state
         if d.sm.state not in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE):
             assert not d.moving
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.integers(-2**31, 2**31 - 1), min_size=7, max_size=7))
+def test_fast_images_are_the_bytes_of_pdo_pack(vals):
+    from plcrt.devices.cia402.pdo import pack, unpack
+    d = Drive()
+    tx = d.pdo.active_tx
+    keys = [(e.index, e.sub) for e in tx]
+    values = {}
+    for (index, sub), v, e in zip(keys, vals, tx):
+        lo = -(1 << (e.bits - 1)) if (index, sub) in d._signed else 0
+        values[(index, sub)] = lo + v % (1 << e.bits)
+    codec = d._codec(tx)
+    data = codec[0].pack(*[values[k] for k in codec[1]])
+    assert data == pack(tx, values)
+    assert dict(zip(codec[1], codec[0].unpack(data))) == unpack(tx, data, d._signed)

@@ -112,7 +112,11 @@ class Axis:
 
     def position(self, t: int) -> int:
         """6064h: whole counts (floor of the exact position)."""
-        return _floor(self.exact(t)[0])
+        if not self.legs:
+            x = self._rest
+        else:
+            x = self.exact(t)[0]
+        return x.numerator // x.denominator
 
     def velocity(self, t: int) -> int:
         """606Ch: whole P/s, truncated toward 0."""
@@ -238,7 +242,8 @@ class Axis:
         if abs(x1 - x0) > cap:
             x1 = x0 + cap if x1 > x0 else x0 - cap
         if x1 == x0:
-            self._set(Fraction(x0), [])
+            if self.legs or self._rest != x0:
+                self._set(Fraction(x0), [])
         else:
             self._set(Fraction(x0), [LinLeg(t0, t1, x0, x1)])
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Callable, Optional
 
 from ...errors import PlcError
-from .axis import Axis
+from .axis import Axis, LinLeg
 from .esm import AlResult, Esm, EsmState
 from .homing_plan import HomingPlan, homing_plans
 from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, ProfileVelocity,
@@ -290,7 +290,8 @@ class Drive:
                 best = (te, kind, data)
 
         end = ax.end_time()
-        if ax.legs and end is not None:
+        if ax.legs and end is not None and (self._qs_wait or not isinstance(ax.legs[-1], LinLeg)):
+            # a CSP line needs no end event: its end position holds by itself
             offer(max(end, self.now), "end", None)
         if ax.legs:
             watches: list[tuple[str, int, int, object]] = []

@@ -309,7 +309,8 @@ class CyclicPosition(Mode):
             self.limit_stop = True
             self.demand = target
             return
-        self.limit_stop = False if target == pos or not d.limit_active(t) else self.limit_stop
+        if not d.limit_active(t):
+            self.limit_stop = False
         d.axis.linear(t, t + max(period, 1), target, d.param(0x6080))
         self.demand = target
 

@@ -42,6 +42,9 @@ from .store import Store, Write
 __all__ = ["Drive", "DriveEvent"]
 
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
+#: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
+#: (no speed limit then) and no P03.07 (no homing time limit).
+_ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0}
 _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an error
 
 
@@ -88,6 +91,7 @@ class Drive:
         self._cache_version = -1
         self._cache: dict[tuple, Optional[int]] = {}
         self._signed = frozenset((e.index, e.sub) for e in self.od if e.dtype.startswith("I"))
+        self._absent = {k: v for k, v in _ABSENT.items() if self.od.find(*k) is None}
         self._own = frozenset((i, 0) for i in _OUTPUTS if self.od.find(i, 0) is not None)
         self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
         self._batch = False
@@ -102,7 +106,10 @@ class Drive:
         return self.engines[self.mode_number]
 
     def param(self, index: int, sub: int = 0) -> int:
-        """The active value of an object the drive acts on."""
+        """The active value of an object the drive acts on (an object the
+        model lacks reads as its entry in ``_ABSENT``)."""
+        if (index, sub) in self._absent:
+            return self._absent[(index, sub)]
         return int(self.store.get(index, sub))
 
     def note(self, t: int, section: str, text: str, source: str = "") -> None:

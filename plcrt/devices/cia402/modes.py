@@ -377,7 +377,7 @@ class Homing(Mode):
                     f"(simulated: {sorted(d.homing_plans)})")
             return
         self.plan, self.status = factory(), "running"
-        limit_ms = d.param(0x2003, 7) if d.store.od.find(0x2003, 7) else 0
+        limit_ms = d.param(0x2003, 7)
         self.deadline = t + limit_ms * 1000 if limit_ms else None
         d.note(t, "HCFA §7.5.4", f"homing method {method} started at count {req.position}")
         self._apply(t, self.plan.start(req))

@@ -365,3 +365,77 @@ def test_fast_images_are_the_bytes_of_pdo_pack(vals):
     data = codec[0].pack(*[values[k] for k in codec[1]])
     assert data == pack(tx, values)
     assert dict(zip(codec[1], codec[0].unpack(data))) == unpack(tx, data, d._signed)
+
+
+# ---------------------------------------------------------------- more reactions
+
+def test_kinco_model_runs_pp_and_shows_reference_found_after_homing():
+    d = enable(Drive("kinco-servo"), 1, x6081=10_000, x6083=100_000, x6084=100_000)
+    d.write(0x607A, 0, 5000)
+    d.write(0x6040, 0, 0x1F)
+    d.write(0x6040, 0, 0x0F)
+    d.advance(2_000_000)
+    assert d.position == 5000 and d.statusword & 0x0400 and not d.statusword & 0x8000
+    d.write(0x6060, 0, 6)
+    d.write(0x607C, 0, 0)
+    d.write(0x6098, 0, 35)
+    d.write(0x6040, 0, 0x1F)
+    assert d.position == 0 and d.statusword & 0x9400 == 0x9400   # Kinco §2.6 bit 15
+
+
+def test_disable_operation_stops_the_axis_at_once_and_the_mode_forgets_its_move():
+    d = enable(Drive(), 1, x6081=10_000, x6083=100_000, x6084=100_000)
+    d.write(0x607A, 0, 50_000)
+    d.write(0x6040, 0, 0x1F)
+    d.advance(1_000_000)
+    d.write(0x6040, 0, 0x07)                          # transition 5
+    held = d.position
+    d.advance(2_000_000)
+    assert d.sm.state is State.SWITCHED_ON and d.position == held
+    d.write(0x6040, 0, 0x0F)
+    d.advance(3_000_000)
+    assert d.position == held and d.statusword == 0x8637
+
+
+def test_mode_change_while_moving_stops_and_is_logged():
+    d = enable(Drive(), 3, x6083=100_000, x6084=100_000)
+    d.write(0x60FF, 0, 10_000)
+    d.advance(500_000)
+    d.write(0x6060, 0, 1)
+    assert not d.moving and d.read(0x6061) == 1
+    assert any("while moving" in e.text for e in d.log)
+
+
+def test_the_bus_leaving_op_disables_the_drive():
+    d = Drive()
+    to_op(d)
+    t = 0
+    for cw in (0x06, 0x07, 0x0F, 0x0F):
+        t += 1000
+        d.cycle(t, rx(d, cw, 0))
+    assert d.sm.state is State.OPERATION_ENABLED
+    d.request_esm(EsmState.SAFEOP)
+    assert d.sm.state is State.SWITCH_ON_DISABLED
+
+
+def test_quick_stop_during_a_pp_move_drops_its_set_points():
+    d = enable(Drive(), 1, x6081=10_000, x6083=100_000, x6084=100_000, x6085=1_000_000,
+               x605A=6)
+    d.write(0x607A, 0, 50_000)
+    d.write(0x6040, 0, 0x1F)
+    d.write(0x6040, 0, 0x0F)
+    d.advance(1_000_000)
+    d.write(0x6040, 0, 0x0B)                          # bit 2 = 0: quick stop
+    d.advance(1_010_000)                              # 10 000 / 1e6 = 10 ms
+    assert not d.moving and d.statusword == 0x0617
+    stopped = d.position
+    d.write(0x6040, 0, 0x0F)                          # 16: back to OE, no motion
+    d.advance(3_000_000)
+    assert d.position == stopped and d.statusword & 0x0400
+
+
+def test_time_cannot_go_back():
+    d = Drive()
+    d.advance(1000)
+    with pytest.raises(PlcError, match="cannot go back"):
+        d.advance(999)

@@ -160,6 +160,10 @@ class Drive:
     def sdo_write(self, index: int, sub: int, data: bytes) -> None:
         """SDO download at the present time; raises :class:`SdoAbort`.
         Mapping objects follow the dynamic mapping procedure (HCFA §6.7.4)."""
+        with self.store.lock:
+            self._sdo_write(index, sub, data)
+
+    def _sdo_write(self, index: int, sub: int, data: bytes) -> None:
         state = {EsmState.PREOP: "PREOP", EsmState.SAFEOP: "SAFEOP",
                  EsmState.OP: "OP"}.get(self.esm.state, "INIT")
         if index in ASSIGN or index in RX_MAPS or index in TX_MAPS:
@@ -330,6 +334,10 @@ class Drive:
         """Move simulated time forward to *t_us* (integer µs), exactly."""
         if t_us < self.now:
             raise PlcError(f"drive time cannot go back: now {self.now} µs, asked {t_us} µs")
+        with self.store.lock:          # a canopen port writes from its Notifier thread
+            self._advance(t_us)
+
+    def _advance(self, t_us: int) -> None:
         for _ in range(_MAX_EVENTS):
             ev = self._next_event(t_us)
             if ev is None:
@@ -374,6 +382,10 @@ class Drive:
         """One bus cycle at *t_us*: advance, apply the RxPDO image *rx* (in
         OP; objects before 6040h), evaluate the held controlword, run the
         mode's cycle, and return the TxPDO image."""
+        with self.store.lock:
+            return self._cycle(t_us, rx)
+
+    def _cycle(self, t_us: int, rx: Optional[bytes]) -> bytes:
         self._batch = True
         try:
             self.advance(t_us)

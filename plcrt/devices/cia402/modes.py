@@ -131,6 +131,11 @@ class ProfilePosition(Mode):
                    f"= {acc}, 6084h = {dec}); statusword bit 14 set until a set-point is taken")
             return
         v_max = d.param(0x6080)
+        if v_max == 0:
+            self.param_zero = True
+            d.note(t, "HCFA §7.5.1", f"set-point 607Ah = {raw} refused: 6080h (max motor speed) "
+                   "= 0")
+            return
         if v > v_max:
             d.note(t, "HCFA §7.5.1", f"6081h = {v} P/s above 6080h = {v_max}: limited to 6080h")
             v = v_max
@@ -403,6 +408,12 @@ class Homing(Mode):
             self._end("error")
             return
         m = step.motion
+        if m is not None and m.kind == "position" and m.speed <= 0:
+            d.axis.stop_at_once(t)
+            self._end("error")
+            d.note(t, "HCFA §7.5.4", f"homing plan asked for a move to {m.value} at speed "
+                   f"{m.speed}: a positioning needs a positive speed; homing error")
+            return
         if m is not None:
             if m.kind == "velocity":
                 d.axis.run_at(t, m.value, m.accel, m.accel)

@@ -439,3 +439,21 @@ def test_time_cannot_go_back():
     d.advance(1000)
     with pytest.raises(PlcError, match="cannot go back"):
         d.advance(999)
+
+
+def test_a_homing_plan_asking_for_a_move_at_speed_0_ends_in_homing_error():
+    class Bad(SwitchPlan):
+        def start(self, r):
+            self.r = r
+            return HomingStep(HomingMotion("position", 1000, speed=0, accel=r.accel))
+    d = Drive(homing={1: Bad})
+    enable(d, 6, x6098=1)
+    d.write(0x6040, 0, 0x1F)
+    assert d.statusword == 0x2637 and "positive speed" in d.log[-1].text
+
+
+def test_homing_parameter_zero_refuses_the_start_with_bit_14():
+    d = Drive(homing={1: SwitchPlan})
+    enable(d, 6, x6098=1, x609A=0)
+    d.write(0x6040, 0, 0x1F)
+    assert d.statusword & 0x4000 and "609Ah" in d.log[-1].text

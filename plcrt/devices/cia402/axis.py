@@ -64,10 +64,6 @@ AnyLeg = Union[Leg, LinLeg]
 ZERO = Fraction(0)
 
 
-def _floor(x: Fraction) -> int:
-    return x.numerator // x.denominator
-
-
 class Axis:
     """One axis: at rest at an exact position, or following a plan."""
 

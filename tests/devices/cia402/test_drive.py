@@ -305,6 +305,29 @@ def test_positions_do_not_depend_on_the_bus_cycle():
     assert pp_run(1000) == pp_run(250)
 
 
+def pv_run(period: int) -> list[int]:
+    d = enable(Drive(plant=DrivePlant(pos_limit=30_000)), 3, x6083=77_777, x6084=55_555,
+               x6085=333_333)
+    out, t = [], 0
+    while t < 2_000_000:
+        t += period
+        d.cycle(t)
+        if t == 5000:
+            d.write(0x60FF, 0, 23_456)
+        if t == 400_000:
+            d.write(0x60FF, 0, -9_999)
+        if t == 700_000:
+            d.write(0x60FF, 0, 40_000)                # runs into PLS
+        if t % 1000 == 0:
+            out.append((d.position, d.statusword))
+    return out
+
+
+def test_pv_and_the_limit_stop_do_not_depend_on_the_bus_cycle():
+    slow, fast = pv_run(1000), pv_run(250)
+    assert slow == fast and slow[-1][1] & 0x0800
+
+
 def evaluations(speed: int) -> int:
     # the limit switch is crossed mid-move: its time is found by bisection
     d = enable(Drive(plant=DrivePlant(pos_limit=5 * 10**6)), 1,
@@ -328,7 +351,7 @@ def test_cost_of_a_move_does_not_grow_with_speed():
 @given(st.lists(st.tuples(st.sampled_from([0x00, 0x02, 0x06, 0x07, 0x0F, 0x1F, 0x80, 0x8F,
                                            0x10F]),
                           st.integers(0, 50_000), st.booleans()), max_size=25),
-       st.sampled_from([1, 3, 8]))
+       st.sampled_from([1, 3, 6, 8]))
 def test_statusword_always_shows_drive402_state(steps, mode):
     d = Drive()
     d.write(0x6060, 0, mode)

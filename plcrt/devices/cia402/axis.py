@@ -86,7 +86,12 @@ class Axis:
             return (leg.x0 + Fraction((leg.x1 - leg.x0) * (tt - leg.t0), leg.t1 - leg.t0),
                     Fraction((leg.x1 - leg.x0) * US, leg.t1 - leg.t0))
         for seg in leg.segs:
-            if seg.t1 is None or t < seg.t1:
+            if seg.t1_ceil is None or t < seg.t1_ceil:
+                if isinstance(t, int) and t * seg.t0.denominator >= seg.t0.numerator:
+                    # integer polynomial (the common case): one normalisation each
+                    num = (seg.A * t + seg.B) * t + seg.C
+                    return (leg.origin + Fraction(leg.direction * num, seg.D),
+                            Fraction(leg.direction * (2 * seg.A * t + seg.B) * US, seg.D))
                 tt = max(Fraction(t), seg.t0)
                 return (leg.origin + leg.direction * seg.travel(tt),
                         leg.direction * seg.speed(tt))
@@ -111,13 +116,26 @@ class Axis:
         if not self.legs:
             x = self._rest
         else:
+            leg = self.legs[-1]
+            if isinstance(leg, LinLeg) and len(self.legs) == 1:   # CSP: integers only
+                if t >= leg.t1:
+                    return leg.x1
+                tt = max(t, leg.t0)
+                return leg.x0 + (leg.x1 - leg.x0) * (tt - leg.t0) // (leg.t1 - leg.t0)
             x = self.exact(t)[0]
         return x.numerator // x.denominator
 
     def velocity(self, t: int) -> int:
         """606Ch: whole P/s, truncated toward 0."""
-        v = self.exact(t)[1]
-        return int(v)
+        if not self.legs:
+            return 0
+        leg = self.legs[-1]
+        if isinstance(leg, LinLeg) and len(self.legs) == 1:      # CSP: integers only
+            if t >= leg.t1 or t < leg.t0:
+                return 0
+            num, den = (leg.x1 - leg.x0) * US, leg.t1 - leg.t0
+            return num // den if num >= 0 else -(-num // den)
+        return int(self.exact(t)[1])
 
     def end_time(self) -> Optional[int]:
         """First µs at which the plan is over; None at rest or when endless."""

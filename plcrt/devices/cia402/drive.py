@@ -62,7 +62,11 @@ class DriveEvent:
 
 
 class Drive:
-    """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``)."""
+    """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``).
+
+    *plant*: its switches (none by default); *node_id*: the bus address a
+    port gives it; *t_us*: the time it powers up; *homing*: the homing
+    methods by 6098h value (default :func:`~.homing_plan.homing_plans`)."""
 
     def __init__(self, model: str = "hcfa-am0520b", *, plant: Optional[DrivePlant] = None,
                  node_id: int = 1, t_us: int = 0,
@@ -127,12 +131,15 @@ class Drive:
         return 1000
 
     def limit_active(self, t: int) -> bool:
+        if self.plant.neg_limit is None and self.plant.pos_limit is None:
+            return False
         pos = self.axis.position(t)
         return self.plant.nls(pos) or self.plant.pls(pos)
 
     def limit_toward(self, t: int, direction: int) -> Optional[str]:
         """The active limit switch in *direction*, if any (not while homing)."""
-        if self.mode_number == 6:
+        if self.mode_number == 6 or (self.plant.neg_limit is None
+                                     and self.plant.pos_limit is None):
             return None
         pos = self.axis.position(t)
         if direction > 0 and self.plant.pls(pos):

@@ -71,6 +71,7 @@ class Store:
         self._write_hooks: list[Hook] = []
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
+        self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
 
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:
@@ -118,13 +119,19 @@ class Store:
         Raises:
             PlcConfigError: a value outside its entry's type range.
         """
+        bounds = self._bounds
         with self.lock:
             for key, value in values.items():
-                entry = self.od.entry(*key)
-                if not entry.low <= value <= entry.high:
+                b = bounds.get(key)
+                if b is None:
+                    entry = self.od.entry(*key)
+                    b = bounds[key] = (entry.low, entry.high)
+                if not b[0] <= value <= b[1]:
+                    entry = self.od.entry(*key)
                     raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
                 self._active[key] = value
-                self._pending.pop(key, None)
+                if self._pending:
+                    self._pending.pop(key, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.

@@ -69,6 +69,7 @@ class Axis:
 
     def __init__(self, position: int = 0) -> None:
         self._rest = Fraction(position)
+        self.shift = 0              #: count - mechanical position (set by homing)
         self._dir = 1
         self.legs: list[AnyLeg] = []
         self.evaluations = 0        #: polynomial evaluations (for cost tests)
@@ -112,7 +113,13 @@ class Axis:
         return out
 
     def position(self, t: int) -> int:
-        """6064h: whole counts (floor of the exact position)."""
+        """6064h: whole counts (floor of the exact position, plus the shift
+        homing set)."""
+        return self.mechanical(t) + self.shift
+
+    def mechanical(self, t: int) -> int:
+        """Whole counts in the plant's frame (switch positions), which
+        homing does not move."""
         if not self.legs:
             x = self._rest
         else:
@@ -181,8 +188,10 @@ class Axis:
         self._set(self.exact(t)[0], [])
 
     def set_position(self, t: int, value: int) -> None:
-        """The axis is at rest and its count becomes *value* (homing)."""
-        self._set(Fraction(value), [])
+        """Stop; the count becomes *value* where the axis is (homing): the
+        mechanical position stays, the shift changes."""
+        self.stop_at_once(t)
+        self.shift = value - self.mechanical(t)
 
     def _stop_leg(self, t: Fraction, x: Fraction, v: Fraction, dec: int) -> Optional[Leg]:
         if v == 0 or dec <= 0:
@@ -196,9 +205,13 @@ class Axis:
         leg = self._stop_leg(Fraction(t), x, v, dec)
         self._set(x, [leg] if leg else [])
 
-    def go_to(self, t: int, target: int, v_max: int, acc: int, dec: int) -> None:
-        """Move to *target* and stop there exactly: from any speed, stopping
-        first (and coming back) if the axis cannot stop before it."""
+    def go_to(self, t: int, target: int, v_max: int, acc: int, dec: int,
+              mechanical: bool = False) -> None:
+        """Move to count *target* (a plant position with *mechanical*) and
+        stop there exactly: from any speed, stopping first (and coming back)
+        if the axis cannot stop before it."""
+        if not mechanical:
+            target -= self.shift
         x, v = self.exact(t)
         legs: list[AnyLeg] = []
         t0: Fraction = Fraction(t)
@@ -250,8 +263,8 @@ class Axis:
     def linear(self, t0: int, t1: int, target: int, v_max: int) -> None:
         """CSP: from the count at *t0* to *target* at *t1*, at most *v_max*
         P/s (then it ends short, at a whole count)."""
-        x0 = self.position(t0)
-        x1 = target
+        x0 = self.mechanical(t0)
+        x1 = target - self.shift
         cap = v_max * (t1 - t0) // US
         if abs(x1 - x0) > cap:
             x1 = x0 + cap if x1 > x0 else x0 - cap
@@ -262,10 +275,14 @@ class Axis:
             self._set(Fraction(x0), [LinLeg(t0, t1, x0, x1)])
 
     # ---------------------------------------------------------------- crossings
-    def first_reach(self, t_from: int, level: int, direction: int) -> Optional[int]:
-        """First integer µs ``>= t_from`` at which the count reaches *level*
-        moving in *direction* (+1: count >= level; -1: count <= level), or
-        None.  Only legs moving that way count."""
+    def first_reach(self, t_from: int, level: int, direction: int,
+                    mechanical: bool = False) -> Optional[int]:
+        """First integer µs ``>= t_from`` at which the count (the plant
+        position with *mechanical*) reaches *level* moving in *direction*
+        (+1: count >= level; -1: count <= level), or None.  Only legs moving
+        that way count."""
+        if not mechanical:
+            level -= self.shift
 
         def cond(x: Fraction) -> bool:
             return x >= level if direction > 0 else x < level + 1

@@ -133,7 +133,7 @@ class Drive:
     def limit_active(self, t: int) -> bool:
         if self.plant.neg_limit is None and self.plant.pos_limit is None:
             return False
-        pos = self.axis.position(t)
+        pos = self.axis.mechanical(t)
         return self.plant.nls(pos) or self.plant.pls(pos)
 
     def limit_toward(self, t: int, direction: int) -> Optional[str]:
@@ -141,7 +141,7 @@ class Drive:
         if self.mode_number == 6 or (self.plant.neg_limit is None
                                      and self.plant.pos_limit is None):
             return None
-        pos = self.axis.position(t)
+        pos = self.axis.mechanical(t)
         if direction > 0 and self.plant.pls(pos):
             return f"the positive limit switch (PLS at {self.plant.pos_limit})"
         if direction < 0 and self.plant.nls(pos):
@@ -325,7 +325,7 @@ class Drive:
             for kind, level, direction, data in watches:
                 key = (kind, level, direction)
                 if key not in self._cache:
-                    te = ax.first_reach(self.now, level, direction)
+                    te = ax.first_reach(self.now, level, direction, mechanical=True)
                     self._cache[key] = None if te == self.now else te
                 te = self._cache[key]
                 if te is not None and te >= self.now:
@@ -474,7 +474,7 @@ class Drive:
         values = {0x6041: self.sm.statusword, 0x6061: self.mode_number, 0x6062: demand,
                   0x6064: pos, 0x606C: self.axis.velocity(t), 0x603F: self.sm.error_code,
                   0x1001: self.sm.error_register, 0x60F4: fe,
-                  0x60FD: self.plant.inputs(pos)}
+                  0x60FD: self.plant.inputs(self.axis.mechanical(t))}
         out = self._out
         changed = {(i, 0): v for i, v in values.items()
                    if out.get((i, 0)) != v and (i, 0) in self._own}

@@ -26,7 +26,10 @@ How a drive runs a plan (``plcrt.devices.cia402.modes.Homing``):
    plan).  Limit switches do not stop the axis while homing (HCFA safety note
    §1: POT/NOT are not limit stops during homing); a plan watches them itself.
 
-Positions are counts, speeds P/s, accelerations P/s², times µs.
+Positions in watches, ``"position"`` motions and events are in the plant's
+frame (:class:`~.plant.DrivePlant` switch positions), which homing does not
+move; ``home_position`` is the count (6064h) the axis takes.  Before the first
+homing the two frames agree.  Speeds are P/s, accelerations P/s², times µs.
 """
 
 from __future__ import annotations
@@ -51,6 +54,7 @@ class HomingRequest:
     accel: int           #: 609Ah
     offset: int          #: 607Ch
     position: int        #: 6064h at the start
+    mechanical: int      #: the same place in the plant's frame (switch positions)
     t_us: int
     plant: DrivePlant
 
@@ -112,7 +116,8 @@ class CurrentPositionHoming:
                                f"{request.offset} (CiA 402)")
 
     def event(self, name: str, t_us: int, position: int) -> HomingStep:
-        return HomingStep(outcome="attained", home_position=position,
+        assert self.request is not None
+        return HomingStep(outcome="attained", home_position=self.request.offset,
                           note=f"method 35/37 has no motion ({name})")
 
 

@@ -366,7 +366,8 @@ class Homing(Mode):
         d = self.d
         method = d.param(0x6098)
         req = HomingRequest(d.model, method, d.param(0x6099, 1), d.param(0x6099, 2),
-                            d.param(0x609A), d.param(0x607C), d.axis.position(t), t, d.plant)
+                            d.param(0x609A), d.param(0x607C), d.axis.position(t),
+                            d.axis.mechanical(t), t, d.plant)
         zero = [n for n, x in (("6099h:01", req.fast), ("6099h:02", req.slow),
                                ("609Ah", req.accel)) if x == 0]
         if zero and method not in (35, 37):
@@ -397,7 +398,6 @@ class Homing(Mode):
             d.fault(t, *step.fault)
             return
         if step.outcome == "attained":
-            d.axis.stop_at_once(t)
             home = step.home_position if step.home_position is not None else d.axis.position(t)
             d.axis.set_position(t, home)
             self._end("attained")
@@ -418,7 +418,7 @@ class Homing(Mode):
             if m.kind == "velocity":
                 d.axis.run_at(t, m.value, m.accel, m.accel)
             elif m.kind == "position":
-                d.axis.go_to(t, m.value, m.speed, m.accel, m.accel)
+                d.axis.go_to(t, m.value, m.speed, m.accel, m.accel, mechanical=True)
             else:
                 d.axis.stop(t, m.accel)
         self.watches = step.watches
@@ -426,11 +426,11 @@ class Homing(Mode):
     def motion_end(self, t: int) -> None:
         self.d.axis.settle(t)
         if self.plan is not None:
-            self._apply(t, self.plan.event("stopped", t, self.d.axis.position(t)))
+            self._apply(t, self.plan.event("stopped", t, self.d.axis.mechanical(t)))
 
     def watch_hit(self, t: int, watch: Watch) -> None:
         if self.plan is not None:
-            self._apply(t, self.plan.event(watch.name, t, self.d.axis.position(t)))
+            self._apply(t, self.plan.event(watch.name, t, self.d.axis.mechanical(t)))
 
     def timeout(self, t: int) -> None:
         self.d.axis.stop_at_once(t)

@@ -199,17 +199,16 @@ def test_limit_switch_time_is_exact_with_a_ramp_beyond_it():
 
 
 def test_pp_set_point_beyond_an_active_limit_is_refused():
-    d = Drive(plant=DrivePlant(pos_limit=100))
-    d.axis.set_position(0, 150)
+    d = Drive(plant=DrivePlant(pos_limit=-100))       # the axis starts on PLS
     enable(d, 1, x6081=1000, x6083=1000, x6084=1000)
     d.write(0x607A, 0, 500)
     d.write(0x6040, 0, 0x1F)
     assert any("refused" in e.text and "PLS" in e.text for e in d.log)
     d.write(0x6040, 0, 0x0F)
-    d.write(0x607A, 0, 0)
+    d.write(0x607A, 0, -500)
     d.write(0x6040, 0, 0x1F)
     d.advance(10_000_000)
-    assert d.position == 0
+    assert d.position == -500
 
 
 # ---------------------------------------------------------------- homing hook
@@ -253,6 +252,18 @@ def test_homing_plan_watches_and_motion_end_are_reported_exactly():
     # 0.1 s ramp (1000 P), then 9000 P at 20 kP/s: the switch at 0.55 s
     assert plan.hit == (550_000, 10_000)
     assert d.position == -7 and d.statusword == 0x1637
+    # the count moved, the switches did not: the axis stands on the home switch
+    assert d.axis.mechanical(d.now) == 10_000 + 1000 and d.read(0x60FD) == 0x4
+    d.write(0x6060, 0, 1)                             # PP targets are counts
+    for cw in (0x06, 0x07, 0x0F):
+        d.write(0x6040, 0, cw)
+    d.cycle(d.now)
+    for index, value in ((0x6081, 10_000), (0x6083, 100_000), (0x6084, 100_000)):
+        d.write(index, 0, value)
+    d.write(0x607A, 0, -7 + 1001)                     # mechanical 12 001: off the switch
+    d.write(0x6040, 0, 0x1F)
+    d.advance(d.now + 2_000_000)
+    assert d.position == 994 and d.read(0x60FD) == 0
 
 
 def test_homing_time_limit_p03_07_raises_alarm_63():

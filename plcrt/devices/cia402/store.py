@@ -71,6 +71,7 @@ class Store:
         self._write_hooks: list[Hook] = []
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
+        self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
 
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:
@@ -110,6 +111,27 @@ class Store:
             if source != "drive":
                 for hook in list(self._write_hooks):
                     hook(write)
+
+    def set_status(self, values: dict[tuple[int, int], int]) -> None:
+        """Set the drive's own integer status objects (6041h, 6064h, ...)
+        in one step: a range check only, no hooks (the bus-cycle fast path).
+
+        Raises:
+            PlcConfigError: a value outside its entry's type range.
+        """
+        bounds = self._bounds
+        with self.lock:
+            for key, value in values.items():
+                b = bounds.get(key)
+                if b is None:
+                    entry = self.od.entry(*key)
+                    b = bounds[key] = (entry.low, entry.high)
+                if not b[0] <= value <= b[1]:
+                    entry = self.od.entry(*key)
+                    raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
+                self._active[key] = value
+                if self._pending:
+                    self._pending.pop(key, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.

@@ -1,0 +1,140 @@
+"""plcrt CiA 402 drive benchmark: simulated drive-seconds per wall-clock second.
+
+Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
+
+1. runs one and then eight HCFA drives in CSP (6060h = 8) through
+   process-data images at a 1 ms bus cycle (``Drive.cycle`` with the default
+   RxPDO 1600h image carrying 6040h and 607Ah, returning the TxPDO 1A00h
+   image), the master sending a sine-like target each cycle, and reports
+   simulated drive-seconds per wall second (drives x simulated seconds /
+   wall seconds) as "x real time";
+2. runs the same PP move (one set-point, the positive limit switch crossed
+   half-way through the window) at 10 kP/s and at 1 MP/s with 1 ms cycles and reports the ratio of their costs: the drive solves
+   positions and crossings in closed form (plcrt.devices.motion), so the
+   ratio stays near 1 although the speed differs a hundredfold.
+
+Each figure is the best of ``--repeat`` runs (fresh drives, set-up not
+timed).  A measuring tool: it asserts nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import platform
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # run from a checkout without installing
+
+from plcrt.devices.cia402.drive import Drive            # noqa: E402
+from plcrt.devices.cia402.esm import EsmState           # noqa: E402
+from plcrt.devices.cia402.plant import DrivePlant       # noqa: E402
+
+CYCLE_US = 1000
+
+
+def rx(cw: int, target: int) -> bytes:
+    return cw.to_bytes(2, "little") + target.to_bytes(4, "little", signed=True) + b"\0\0"
+
+
+def csp_drives(n: int) -> list[Drive]:
+    drives = []
+    for _ in range(n):
+        d = Drive()
+        for s in (EsmState.PREOP, EsmState.SAFEOP, EsmState.OP):
+            d.request_esm(s)
+        t = 0
+        for cw in (0x06, 0x07, 0x0F, 0x0F):
+            t += CYCLE_US
+            d.cycle(t, rx(cw, 0))
+        drives.append(d)
+    return drives
+
+
+def time_csp(n: int, seconds: float) -> float:
+    drives = csp_drives(n)
+    cycles = int(seconds * 1e6) // CYCLE_US
+    t0 = drives[0].now
+    # a triangle wave of +-20 000 counts, 400 counts per cycle at most
+    targets = [rx(0x0F, 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100))
+               for k in range(cycles)]
+    gc.collect()
+    start = time.perf_counter()
+    for k in range(cycles):
+        t = t0 + (k + 1) * CYCLE_US
+        image = targets[k]
+        for d in drives:
+            d.cycle(t, image)
+    wall = time.perf_counter() - start
+    return n * cycles * CYCLE_US / 1e6 / wall
+
+
+def time_pp(speed: int, seconds: float) -> float:
+    # the same move in time: a limit switch crossed half-way through the window
+    d = Drive(plant=DrivePlant(pos_limit=int(speed * seconds / 2)))
+    d.write(0x6060, 0, 1)
+    for index, value in ((0x6080, 10**7), (0x6081, speed), (0x6083, speed * 10),
+                         (0x6084, speed * 10), (0x6085, speed * 10)):
+        d.write(index, 0, value)
+    for cw in (0x06, 0x07, 0x0F):
+        d.write(0x6040, 0, cw)
+    d.cycle(CYCLE_US)
+    d.write(0x607A, 0, int(speed * seconds * 2))
+    d.write(0x6040, 0, 0x1F)
+    d.write(0x6040, 0, 0x0F)
+    cycles = int(seconds * 1e6) // CYCLE_US
+    gc.collect()
+    start = time.perf_counter()
+    for k in range(2, cycles + 2):
+        d.cycle(k * CYCLE_US)
+    return time.perf_counter() - start
+
+
+def calibration() -> float:
+    """Wall seconds of 10^6 integer additions in a Python loop (best of 3):
+    how fast this machine runs plain Python, to compare figures across machines."""
+    best = float("inf")
+    for _ in range(3):
+        start, x = time.perf_counter(), 0
+        for k in range(10**6):
+            x += k
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per run")
+    ap.add_argument("--repeat", type=int, default=3, help="runs per figure (best is kept)")
+    ap.add_argument("--json", action="store_true")
+    args = ap.parse_args(argv)
+    one = max(time_csp(1, args.seconds) for _ in range(args.repeat))
+    eight = max(time_csp(8, args.seconds / 4) for _ in range(args.repeat))
+    slow = min(time_pp(10_000, args.seconds) for _ in range(args.repeat))
+    fast = min(time_pp(1_000_000, args.seconds) for _ in range(args.repeat))
+    cal = calibration()
+    out = {"machine": f"{platform.python_implementation()} {platform.python_version()} "
+                      f"on {platform.machine()}",
+           "calibration_1e6_adds_s": round(cal, 3),
+           "csp_1_drive_x_real_time": round(one, 1),
+           "csp_8_drives_x_real_time": round(eight, 1),
+           "pp_10kHz_wall_s": round(slow, 4), "pp_1MHz_wall_s": round(fast, 4),
+           "pp_cost_ratio_fast_over_slow": round(fast / slow, 2)}
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    print(f"plcrt CiA 402 drive benchmark ({out['machine']}), 1 ms bus cycle, best of "
+          f"{args.repeat}; 10^6 Python additions take {cal * 1e3:.0f} ms here")
+    print(f"  CSP, 1 drive:  {one:8.1f} x real time")
+    print(f"  CSP, 8 drives: {eight:8.1f} x real time (drive-seconds per wall second)")
+    print(f"  PP move at 10 kP/s: {slow * 1e3:.1f} ms wall, at 1 MP/s: {fast * 1e3:.1f} ms wall "
+          f"(ratio {fast / slow:.2f}) for {args.seconds:g} s simulated")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

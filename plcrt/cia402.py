@@ -3,7 +3,9 @@
 * :func:`object_dictionary` gives the ``canopen.ObjectDictionary`` of a drive
   model, for a CANopen master's side (``BaseNode402(node_id, od)``);
 * :func:`eds_text` gives the same dictionary as an EDS file;
-* :func:`models` lists the drive models.
+* :func:`models` lists the drive models;
+* :func:`attach` puts a simulated drive on a connected ``canopen.Network``
+  as a ``canopen.LocalNode`` (see :mod:`plcrt.devices.cia402.canopen_node`).
 
 All three read the model's data file, ``library/cia402/<model>.toml`` (see
 :mod:`plcrt.devices.cia402.od`).  ``canopen`` is imported only when a
@@ -16,11 +18,16 @@ import io
 from typing import TYPE_CHECKING, Any
 
 from .devices.cia402.od import Entry, ObjectDictionary
+from .errors import PlcConfigError
 
 if TYPE_CHECKING:  # pragma: no cover
     import canopen.objectdictionary
 
-__all__ = ["eds_text", "models", "object_dictionary"]
+__all__ = ["attach", "eds_text", "models", "object_dictionary"]
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .devices.cia402.canopen_node import CanopenDrive, Clock
+    from .devices.cia402.plant import DrivePlant
 
 #: plcrt dtype -> CANopen data type code (CiA 301 Table 44).
 _CANOPEN_TYPES = {"BOOL": 0x01, "I8": 0x02, "I16": 0x03, "I32": 0x04, "U8": 0x05, "U16": 0x06,
@@ -66,6 +73,33 @@ def object_dictionary(model: str = "hcfa-am0520b") -> canopen.objectdictionary.O
             record.add_member(_variable(e))
         od.add_object(record)
     return od
+
+
+def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
+           plant: "DrivePlant | None" = None, *, clock: "Clock" = "wall") -> "CanopenDrive":
+    """Put a simulated drive of *model* on the connected ``canopen.Network``
+    *network* as node *node_id*; a master drives it with SDOs, NMT and
+    heartbeat (``BaseNode402(node_id, object_dictionary(model))``).
+
+    *clock*: ``"wall"`` (the drive's time follows the wall clock, one bus
+    cycle per bus period in a background thread), ``"manual"`` (time moves
+    only by ``.advance(seconds)``) or ``"step"`` (each SDO read of 6041h
+    runs one bus cycle first; ``.advance`` works too).
+
+    Returns an object with ``.drive`` (:class:`~.devices.cia402.drive.Drive`),
+    ``.node`` (the ``canopen.LocalNode``), ``.advance(seconds)`` and
+    ``.close()``.
+
+    Raises:
+        PlcConfigError: unknown model, bad node id, a network that is not a
+            connected ``canopen.Network``, an unknown clock.
+    """
+    from .devices.cia402.canopen_node import CanopenDrive
+
+    if model not in models():
+        raise PlcConfigError(f"cia402.attach: unknown drive model {model!r}; models: "
+                             + ", ".join(models()))
+    return CanopenDrive(network, node_id, model, plant, clock=clock)
 
 
 def eds_text(model: str = "hcfa-am0520b") -> str:

@@ -11,7 +11,10 @@ Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
 2. runs the same PP move (one set-point, the positive limit switch crossed
    half-way through the window) at 10 kP/s and at 1 MP/s with 1 ms cycles and reports the ratio of their costs: the drive solves
    positions and crossings in closed form (plcrt.devices.motion), so the
-   ratio stays near 1 although the speed differs a hundredfold.
+   ratio stays near 1 although the speed differs a hundredfold;
+3. measures SDO round trips per second over python-can's ``virtual`` bus:
+   a canopen master uploads 6064h from a drive put on the bus with
+   ``plcrt.cia402.attach`` (manual clock, so only the SDO path is timed).
 
 Each figure is the best of ``--repeat`` runs (fresh drives, set-up not
 timed).  A measuring tool: it asserts nothing.
@@ -106,6 +109,31 @@ def calibration() -> float:
     return best
 
 
+def sdo_round_trips(n: int = 2000) -> float:
+    """SDO uploads of 6064h per wall second, canopen master <-> attached drive."""
+    import canopen
+
+    from plcrt import cia402
+
+    channel = f"plcrt-bench-{time.monotonic_ns()}"
+    dev, mst = canopen.Network(), canopen.Network()
+    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
+    dev.connect(interface="virtual", channel=channel)
+    mst.connect(interface="virtual", channel=channel)
+    sim = cia402.attach(dev, 5, clock="manual")
+    node = mst.add_node(5, cia402.object_dictionary())
+    try:
+        node.sdo.upload(0x6064, 0)
+        start = time.perf_counter()
+        for _ in range(n):
+            node.sdo.upload(0x6064, 0)
+        return n / (time.perf_counter() - start)
+    finally:
+        sim.close()
+        mst.disconnect()
+        dev.disconnect()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per run")
@@ -116,6 +144,7 @@ def main(argv: list[str] | None = None) -> int:
     eight = max(time_csp(8, args.seconds / 4) for _ in range(args.repeat))
     slow = min(time_pp(10_000, args.seconds) for _ in range(args.repeat))
     fast = min(time_pp(1_000_000, args.seconds) for _ in range(args.repeat))
+    sdo = max(sdo_round_trips() for _ in range(args.repeat))
     cal = calibration()
     out = {"machine": f"{platform.python_implementation()} {platform.python_version()} "
                       f"on {platform.machine()}",
@@ -123,7 +152,8 @@ def main(argv: list[str] | None = None) -> int:
            "csp_1_drive_x_real_time": round(one, 1),
            "csp_8_drives_x_real_time": round(eight, 1),
            "pp_10kHz_wall_s": round(slow, 4), "pp_1MHz_wall_s": round(fast, 4),
-           "pp_cost_ratio_fast_over_slow": round(fast / slow, 2)}
+           "pp_cost_ratio_fast_over_slow": round(fast / slow, 2),
+           "sdo_round_trips_per_s": round(sdo)}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -133,6 +163,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  CSP, 8 drives: {eight:8.1f} x real time (drive-seconds per wall second)")
     print(f"  PP move at 10 kP/s: {slow * 1e3:.1f} ms wall, at 1 MP/s: {fast * 1e3:.1f} ms wall "
           f"(ratio {fast / slow:.2f}) for {args.seconds:g} s simulated")
+    print(f"  SDO round trips over the virtual bus (canopen master, attach): {sdo:8.0f} /s")
     return 0
 
 

@@ -39,11 +39,16 @@ def models() -> list[str]:
     return ObjectDictionary.models()
 
 
-def object_dictionary(model: str = "hcfa-am0520b") -> canopen.objectdictionary.ObjectDictionary:
+def object_dictionary(model: str = "hcfa-am0520b", node_id: int | None = None
+                      ) -> canopen.objectdictionary.ObjectDictionary:
     """The canopen object dictionary of a drive model: one ``ODVariable`` per
     single-entry object, one ``ODRecord`` per object with subindexes, with
     data type, access, default, limits, PDO mappability and unit of the data
     file (the entry's manual section becomes the description).
+
+    With *node_id*, the dictionary also has the CAN view of a drive put on
+    the bus by :func:`attach` as that node (1017h, one TPDO and one RPDO):
+    a master that wants the drive's PDOs uses it.
 
     Raises:
         PlcConfigError: unknown model or malformed data file.
@@ -72,6 +77,9 @@ def object_dictionary(model: str = "hcfa-am0520b") -> canopen.objectdictionary.O
         for e in subs:
             record.add_member(_variable(e))
         od.add_object(record)
+    if node_id is not None:
+        from .devices.cia402.canopen_node import can_view
+        can_view(od, node_id)
     return od
 
 

@@ -42,7 +42,7 @@ from typing import Any, Literal, Optional
 
 import canopen
 from canopen.nmt import NmtSlave
-from canopen.objectdictionary import ODVariable, datatypes
+from canopen.objectdictionary import ODRecord, ODVariable, datatypes
 
 from ...errors import PlcConfigError
 from .drive import Drive
@@ -50,7 +50,7 @@ from .esm import EsmState
 from .od import SdoAbort
 from .plant import DrivePlant
 
-__all__ = ["CanopenDrive", "Clock", "can_view"]
+__all__ = ["CanopenDrive", "Clock", "can_view", "pdo_slots"]
 
 log = logging.getLogger("plcrt.cia402.canopen")
 
@@ -111,7 +111,8 @@ class CanopenDrive:
         self._lock = self.drive.store.lock
         self._t0 = time.monotonic()
         codod = od if od is not None else object_dictionary(model)
-        can_view(codod)
+        self.tpdo_no, self.rpdo_no = pdo_slots(codod)
+        can_view(codod, node_id)
         self.node = canopen.LocalNode(node_id, codod)
         self.node._write_callbacks.clear()          # canopen's own 1017h hook belongs to .nmt
         self.node.nmt = _Nmt(node_id, self.node, self)
@@ -120,6 +121,10 @@ class CanopenDrive:
         self.node.add_read_callback(self._on_read)
         self.network = network
         network.create_node(self.node)
+        self.node.tpdo.read(from_od=True)
+        self.node.rpdo.read(from_od=True)
+        self._rpdo_noted = False
+        self.node.rpdo[self.rpdo_no].add_callback(self._on_rpdo)
         self.drive.request_esm(EsmState.PREOP)
         self.node.nmt.send_command(0x81)            # reset: boot-up message
         self.node.nmt.send_command(0x80)            # to PRE-OPERATIONAL, heartbeat per 1017h
@@ -144,6 +149,7 @@ class CanopenDrive:
             end = self.drive.now + round(seconds * 1e6)
             while self.drive.now < end:
                 self.drive.cycle(min(end, self._next_boundary()))
+            self._fill_tpdo()
 
     def _next_boundary(self) -> int:
         p = self.period_us
@@ -155,6 +161,7 @@ class CanopenDrive:
         with self._lock:
             while self._next_boundary() <= t:
                 self.drive.cycle(self._next_boundary())
+            self._fill_tpdo()
 
     def _run(self) -> None:
         period = self.period_us / 1e6
@@ -171,6 +178,7 @@ class CanopenDrive:
         if self._thread is not None:
             self._thread.join(timeout=1.0)
         self.node.nmt.stop_heartbeat()
+        self.node.tpdo[self.tpdo_no].stop()
         if self.node.id in self.network:
             del self.network[self.node.id]
 
@@ -205,6 +213,7 @@ class CanopenDrive:
                 if self.clock == "wall":
                     self._sync()
                 self.drive.sdo_write(index, subindex, bytes(data))
+                self._fill_tpdo()
         except SdoAbort as e:
             log.info("node %d: %s", self.drive.node_id, e)
             raise canopen.SdoAbortedError(e.code) from None
@@ -213,8 +222,46 @@ class CanopenDrive:
                           index, subindex)
             raise canopen.SdoAbortedError(0x08000000) from None
 
+    # ---------------------------------------------------------------- PDOs
+    def _fill_tpdo(self) -> None:
+        """Copy the drive's objects into the TPDO (canopen does not, caveat 3)."""
+        tpdo = self.node.tpdo[self.tpdo_no]
+        for var in tpdo:
+            var.raw = int(self.drive.store.get(var.index, var.subindex))
+        tpdo.update()
+
+    def _on_rpdo(self, rpdo: Any) -> None:
+        """An RPDO reached the node: write its objects to the drive, 6040h
+        last (canopen does not, caveat 3).  PDOs act in OPERATIONAL only."""
+        try:
+            with self._lock:
+                if self.node.nmt.state != "OPERATIONAL":
+                    if not self._rpdo_noted:
+                        self._rpdo_noted = True
+                        self.drive.note(self.drive.now, "CiA 301 §7.3.2.2",
+                                        f"RPDO ignored in NMT {self.node.nmt.state}", "NMT")
+                    return
+                if self.clock == "wall":
+                    self._sync()
+                values = [(v.index, v.subindex, int(v.raw)) for v in rpdo]
+                for index, sub, value in sorted(values, key=lambda v: v[0] == 0x6040):
+                    if index != 0x6040 and int(self.drive.store.get(index, sub)) == value:
+                        continue
+                    self.drive.write(index, sub, value)
+                self._fill_tpdo()
+        except SdoAbort as e:
+            log.warning("node %d: RPDO %d: %s", self.drive.node_id, self.rpdo_no, e)
+        except Exception:
+            log.exception("node %d: RPDO %d failed", self.drive.node_id, self.rpdo_no)
+
     # ---------------------------------------------------------------- NMT
     def _nmt_changed(self, state: int) -> None:
+        tpdo = self.node.tpdo[self.tpdo_no]
+        if state == 5 and tpdo._task is None:
+            self._fill_tpdo()
+            tpdo.start(TPDO_PERIOD_MS / 1000)
+        elif state != 5 and tpdo._task is not None:
+            tpdo.stop()
         steps = _NMT_TO_ESM.get(state)
         if steps is None:
             return
@@ -229,14 +276,57 @@ class CanopenDrive:
                     return
 
 
-def can_view(od: Any) -> None:
-    """Add the CAN objects a master expects where the model lacks them:
-    1017h producer heartbeat time (CiA 301 §7.5.2.32)."""
+#: The CAN view's PDO contents (CiA 301 §7.5.2.35-38): one TPDO and one RPDO.
+TPDO_OBJECTS = ((0x6041, 0, 16), (0x6064, 0, 32), (0x6061, 0, 8))
+RPDO_OBJECTS = ((0x6040, 0, 16), (0x607A, 0, 32))
+TPDO_PERIOD_MS = 2          # digest §7.2 caveat 4: a cyclic TPDO keeps BaseNode402 happy
+
+
+def pdo_slots(od: Any) -> tuple[int, int]:
+    """The CAN view's (TPDO, RPDO) numbers: the first whose communication
+    and mapping objects the model's dictionary lacks (HCFA: TPDO 3, RPDO 5;
+    the EtherCAT mapping objects 1600h-1603h, 1A00h-1A01h stay the drive's)."""
+    def free(com: int, map_: int) -> int:
+        return next(n for n in range(512) if com + n not in od and map_ + n not in od)
+    return free(0x1800, 0x1A00) + 1, free(0x1400, 0x1600) + 1
+
+
+def _var(name: str, index: int, sub: int, dtype: int, default: int, access: str = "rw") -> Any:
+    var = ODVariable(name, index, sub)
+    var.data_type = dtype
+    var.access_type = access
+    var.default = default
+    var.description = "CiA 301 (CAN view of the drive)"
+    return var
+
+
+def can_view(od: Any, node_id: int) -> None:
+    """Add the CAN objects a CANopen master expects where the model lacks
+    them: 1017h producer heartbeat time (CiA 301 §7.5.2.32), one TPDO
+    (:data:`TPDO_OBJECTS`, COB-ID 180h+id, cyclic) and one RPDO
+    (:data:`RPDO_OBJECTS`, COB-ID 200h+id) at the slots of :func:`pdo_slots`."""
     if 0x1017 not in od:
-        var = ODVariable("Producer heartbeat time", 0x1017, 0)
-        var.data_type = datatypes.UNSIGNED16
-        var.access_type = "rw"
-        var.default = 0
+        var = _var("Producer heartbeat time", 0x1017, 0, datatypes.UNSIGNED16, 0)
         var.unit = "ms"
-        var.description = "CiA 301 §7.5.2.32 (CAN view of the drive)"
         od.add_object(var)
+    tpdo, rpdo = pdo_slots(od)
+    for com, map_, cob, trans, objects, what in (
+            (0x1800 + tpdo - 1, 0x1A00 + tpdo - 1, 0x180 + node_id, 0xFE, TPDO_OBJECTS,
+             f"TPDO {tpdo}"),
+            (0x1400 + rpdo - 1, 0x1600 + rpdo - 1, 0x200 + node_id, 0xFE, RPDO_OBJECTS,
+             f"RPDO {rpdo}")):
+        rec = ODRecord(f"{what} communication parameter", com)
+        rec.add_member(_var("Highest sub-index supported", com, 0, datatypes.UNSIGNED8, 5, "ro"))
+        rec.add_member(_var("COB-ID", com, 1, datatypes.UNSIGNED32, cob))
+        rec.add_member(_var("Transmission type", com, 2, datatypes.UNSIGNED8, trans))
+        rec.add_member(_var("Inhibit time", com, 3, datatypes.UNSIGNED16, 0))
+        rec.add_member(_var("Event timer", com, 5, datatypes.UNSIGNED16,
+                            TPDO_PERIOD_MS if com >= 0x1800 else 0))
+        od.add_object(rec)
+        rec = ODRecord(f"{what} mapping parameter", map_)
+        rec.add_member(_var("Number of mapped objects", map_, 0, datatypes.UNSIGNED8,
+                            len(objects)))
+        for k, (index, sub, bits) in enumerate(objects, 1):
+            rec.add_member(_var(f"Mapped object {k}", map_, k, datatypes.UNSIGNED32,
+                                index << 16 | sub << 8 | bits))
+        od.add_object(rec)

@@ -196,3 +196,50 @@ def test_bad_arguments_are_config_errors(bus, kwargs, words):
 def test_a_network_that_is_not_connected_is_refused():
     with pytest.raises(PlcConfigError, match="not connected"):
         cia402.attach(canopen.Network(), 5)
+
+
+def test_pdos_carry_the_statusword_and_the_controlword(bus):
+    """The CAN view (object_dictionary(model, node_id)): BaseNode402 finds
+    the cyclic TPDO (6041h, 6064h, 6061h) and the RPDO (6040h, 607Ah) and
+    drives the drive through them in NMT OPERATIONAL."""
+    dev, mst = bus
+    sim = cia402.attach(dev, 11)
+    try:
+        n = BaseNode402(11, cia402.object_dictionary("hcfa-am0520b", node_id=11))
+        mst.add_node(n)
+        n.nmt.state = "PRE-OPERATIONAL"
+        n.setup_402_state_machine(read_pdos=True)
+        assert 0x6041 in n.tpdo_pointers and 0x6040 in n.rpdo_pointers
+        n.nmt.state = "OPERATIONAL"
+        assert wait_for(lambda: sim.drive.esm.state is EsmState.OP)
+        n.tpdo[sim.tpdo_no].wait_for_reception(timeout=1)
+        n.op_mode = "PROFILED POSITION"
+        n.state = "OPERATION ENABLED"
+        assert sim.drive.sm.state is State.OPERATION_ENABLED
+        for index, value in ((0x6081, 200_000), (0x6083, 2_000_000), (0x6084, 2_000_000)):
+            n.sdo[index].raw = value
+        rpdo = n.rpdo[sim.rpdo_no]
+        rpdo[0x607A].raw = 4_000                       # the RPDO carries the target
+        rpdo[0x6040].raw = 0x0F
+        rpdo.transmit()
+        rpdo[0x6040].raw = 0x1F
+        rpdo.transmit()
+        assert wait_for(lambda: n.tpdo[sim.tpdo_no][0x6064].raw == 4_000, timeout=2)
+        assert n.statusword & 0x0400
+    finally:
+        sim.close()
+
+
+def test_rpdo_outside_operational_is_ignored_and_logged(bus):
+    dev, mst = bus
+    sim = cia402.attach(dev, 12, clock="manual")
+    try:
+        n = BaseNode402(12, cia402.object_dictionary("hcfa-am0520b", node_id=12))
+        mst.add_node(n)
+        n.rpdo.read()
+        n.rpdo[sim.rpdo_no][0x6040].raw = 0x06
+        n.rpdo[sim.rpdo_no].transmit()
+        assert wait_for(lambda: any("RPDO ignored" in e.text for e in sim.drive.log))
+        assert sim.drive.sm.state is State.SWITCH_ON_DISABLED
+    finally:
+        sim.close()

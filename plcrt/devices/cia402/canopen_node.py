@@ -26,11 +26,17 @@ that imports ``canopen``.
 * Caveat 6 (``homing()`` judges 6041h at once): the drive publishes 6041h
   inside the SDO write of 6040h, so the statusword the master reads next is
   already the one of the new controlword.  Caveat 1 (``setup_402_state_machine``
-  on a fresh node): the node boots to PRE-OPERATIONAL and sends its boot-up
-  message when attached; the master still has to see it
-  (``nmt.state = 'PRE-OPERATIONAL'`` or a heartbeat).
+  on a fresh node): the node boots to PRE-OPERATIONAL, sends its boot-up
+  message when attached and its heartbeat every 50 ms (1017h default of the
+  CAN view), so a master's NMT learns the state within one heartbeat
+  (``nmt.wait_for_heartbeat()``).
+* PDOs (caveats 2-5): the CAN view (:func:`can_view`) adds one cyclic TPDO
+  (6041h, 6064h, 6061h; every 2 ms in OPERATIONAL, filled from the drive)
+  and one RPDO (6040h, 607Ah; routed to the drive, 6040h last, in
+  OPERATIONAL only), at numbers the model's EtherCAT mapping objects leave
+  free.  A master sees them with ``object_dictionary(model, node_id)``.
 
-What it is not: no PDOs yet (the master works over SDO, caveat 2); no EMCY.
+What it is not: no EMCY, no SYNC, no remapping of the CAN view's PDOs.
 """
 
 from __future__ import annotations
@@ -148,7 +154,7 @@ class CanopenDrive:
         with self._lock:
             end = self.drive.now + round(seconds * 1e6)
             while self.drive.now < end:
-                self.drive.cycle(min(end, self._next_boundary()))
+                self.drive.tick(min(end, self._next_boundary()))
             self._fill_tpdo()
 
     def _next_boundary(self) -> int:
@@ -160,7 +166,7 @@ class CanopenDrive:
         t = int((time.monotonic() - self._t0) * 1e6)
         with self._lock:
             while self._next_boundary() <= t:
-                self.drive.cycle(self._next_boundary())
+                self.drive.tick(self._next_boundary())
             self._fill_tpdo()
 
     def _run(self) -> None:
@@ -194,7 +200,7 @@ class CanopenDrive:
                 if self.clock == "wall":
                     self._sync()
                 elif self.clock == "step" and index == 0x6041:
-                    self.drive.cycle(self._next_boundary())
+                    self.drive.tick(self._next_boundary())
                 data = self.drive.sdo_read(index, subindex)
             return od.decode_raw(data)
         except SdoAbort as e:
@@ -279,6 +285,9 @@ class CanopenDrive:
 #: The CAN view's PDO contents (CiA 301 §7.5.2.35-38): one TPDO and one RPDO.
 TPDO_OBJECTS = ((0x6041, 0, 16), (0x6064, 0, 32), (0x6061, 0, 8))
 RPDO_OBJECTS = ((0x6040, 0, 16), (0x607A, 0, 32))
+#: 1017h default of the CAN view: a master's NMT learns PRE-OPERATIONAL from
+#: the heartbeat, which caveat 1's guard in setup_402_state_machine needs.
+HEARTBEAT_MS = 50
 TPDO_PERIOD_MS = 2          # digest §7.2 caveat 4: a cyclic TPDO keeps BaseNode402 happy
 
 
@@ -306,7 +315,8 @@ def can_view(od: Any, node_id: int) -> None:
     (:data:`TPDO_OBJECTS`, COB-ID 180h+id, cyclic) and one RPDO
     (:data:`RPDO_OBJECTS`, COB-ID 200h+id) at the slots of :func:`pdo_slots`."""
     if 0x1017 not in od:
-        var = _var("Producer heartbeat time", 0x1017, 0, datatypes.UNSIGNED16, 0)
+        var = _var("Producer heartbeat time", 0x1017, 0, datatypes.UNSIGNED16,
+                   HEARTBEAT_MS)
         var.unit = "ms"
         od.add_object(var)
     tpdo, rpdo = pdo_slots(od)

@@ -392,7 +392,24 @@ class Drive:
         with self.store.lock:
             return self._cycle(t_us, rx)
 
+    def tick(self, t_us: int) -> None:
+        """One bus cycle at *t_us* without process data (a CANopen port,
+        whose PDOs are not the EtherCAT images): advance, evaluate the held
+        controlword, run the mode's cycle."""
+        with self.store.lock:
+            self._step(t_us, None)
+
     def _cycle(self, t_us: int, rx: Optional[bytes]) -> bytes:
+        self._step(t_us, rx)
+        get, out = self.store.get, self._out
+        codec = self._codec(self.pdo.active_tx)
+        if codec is not None:
+            return codec[0].pack(*[out[k] if k in out else int(get(*k)) for k in codec[1]])
+        values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
+                  else int(get(e.index, e.sub)) for e in self.pdo.active_tx if e.index}
+        return pack(self.pdo.active_tx, values)
+
+    def _step(self, t_us: int, rx: Optional[bytes]) -> None:
         self._batch = True
         try:
             self.advance(t_us)
@@ -406,13 +423,6 @@ class Drive:
         finally:
             self._batch = False
         self.publish()
-        get, out = self.store.get, self._out
-        codec = self._codec(self.pdo.active_tx)
-        if codec is not None:
-            return codec[0].pack(*[out[k] if k in out else int(get(*k)) for k in codec[1]])
-        values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
-                  else int(get(e.index, e.sub)) for e in self.pdo.active_tx if e.index}
-        return pack(self.pdo.active_tx, values)
 
     def _codec(self, entries: tuple) -> Optional[tuple[struct.Struct, list[tuple[int, int]]]]:
         """A struct for a byte-aligned image (the same bytes as pdo.pack /

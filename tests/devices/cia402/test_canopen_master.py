@@ -243,3 +243,29 @@ def test_rpdo_outside_operational_is_ignored_and_logged(bus):
         assert sim.drive.sm.state is State.SWITCH_ON_DISABLED
     finally:
         sim.close()
+
+
+def test_a_fresh_master_learns_pre_operational_from_the_heartbeat(bus):
+    """Caveat 1: setup_402_state_machine() on a fresh node needs the master's
+    NMT to know the state; the node's default heartbeat (50 ms) tells it."""
+    dev, mst = bus
+    sim = cia402.attach(dev, 13, clock="manual")
+    try:
+        n = BaseNode402(13, cia402.object_dictionary())
+        mst.add_node(n)
+        n.nmt.wait_for_heartbeat(timeout=1)
+        assert n.nmt.state == "PRE-OPERATIONAL"
+        n.setup_402_state_machine()                     # no AssertionError
+    finally:
+        sim.close()
+
+
+def test_the_kinco_model_is_enabled_by_its_master(bus):
+    dev, mst = bus
+    sim = cia402.attach(dev, 14, model="kinco-servo", clock="step")
+    try:
+        n = master(mst, 14, "kinco-servo")
+        n.state = "OPERATION ENABLED"
+        assert sim.drive.sm.state is State.OPERATION_ENABLED
+    finally:
+        sim.close()

@@ -452,5 +452,7 @@ class Homing(Mode):
             return None if not z else (self.d.idle_mode_bits() | z)
         state = {"running": "running", "attained": "done", "error": "failed",
                  "interrupted": "aborted", "halted": "aborted"}[self.status]
-        halt = B8 if self.status == "halted" else 0
-        return z | halt | homing_status(self.d.model, state, self.d.sm.homed)
+        bits = homing_status(self.d.model, state, self.d.sm.homed)
+        if self.status == "halted":        # §7.3 halt word 0x0737: bit 8, bit 15 clear
+            bits = (bits & ~B15) | B8
+        return z | bits

@@ -232,3 +232,16 @@ def test_drive_and_sequence_agree(model, data, start, lo, width, period, phase, 
     ref = reference(model, n, pure, offset=offset, offset_mode=offset_mode)
     d = home_on_drive(model, n, drive_plant, offset=offset, offset_mode=offset_mode)
     assert_agrees(d, ref)
+
+
+def test_halt_and_bit_4_falling_end_homing_with_the_hcfa_words():
+    """HCFA §7.3 / §7.5.4: halt during homing gives 0x0737, bit 4 falling 0x8637;
+    neither sets a home (6064h keeps counting from the start)."""
+    drive_plant, _ = shifted(-5000)
+    d = home_on_drive(HCFA, 7, drive_plant, horizon_us=50_000)
+    d.write(0x6040, 0, 0x11F)                         # halt
+    d.advance(d.now + 1_000_000)
+    assert d.statusword == 0x0737 and d.position == d.axis.mechanical(d.now)
+    d = home_on_drive(HCFA, 7, drive_plant, horizon_us=50_000)
+    d.write(0x6040, 0, 0x0F)                          # bit 4 falls
+    assert d.statusword == 0x8637 and not d.axis.moving(d.now)

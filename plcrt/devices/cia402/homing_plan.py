@@ -13,8 +13,8 @@ How a drive runs a plan (``plcrt.devices.cia402.modes.Homing``):
    (HCFA §7.5.4) the drive looks 6098h up in its registry.  No plan: alarm 62
    (invalid homing method).  Otherwise it calls ``plan.start(request)``.
 2. It carries out the step: ``motion`` replaces the axis's plan (None keeps
-   it; ``from_rest`` first stops the axis at once); it reports each ``watches`` entry the first time the count reaches it
-   moving that way, and the motion's end (the axis at rest, event name
+   it; ``from_rest`` first stops the axis at once); it reports each
+   ``watches`` entry the first time the count reaches it moving that way, and the motion's end (the axis at rest, event name
    ``"stopped"``), by ``plan.event(name, t_us, position)``, which returns the
    next step.  The watches of a step replace those of the one before.
 3. ``outcome = "attained"``: the axis stops where it is and its count becomes

@@ -43,10 +43,11 @@ def shifted(start: int, nl=NL, pl=PL, lo=LO, hi=HI, period=PERIOD, phase=PHASE,
 
 
 def reference(model: str, n: int, pure: HomingPlant, offset: int = 0, offset_mode: int = 0,
-              timeout_ms: int = 0, v_high: int = V_HIGH, v_low: int = V_LOW,
+              timeout_ms: int = 0, blind_zone: int = 0, v_high: int = V_HIGH, v_low: int = V_LOW,
               acc: int = ACC) -> Done | Failed:
     params = HomingParams(n, v_high, v_low, acc, offset,
-                          offset_mode=offset_mode, timeout_ms=timeout_ms)
+                          offset_mode=offset_mode, blind_zone=blind_zone,
+                          timeout_ms=timeout_ms)
     result, phases = run(HomingSequence(model, params, pure), 0, 0)
     PHASES[id(result)] = len(phases)
     return result
@@ -57,7 +58,7 @@ PHASES: dict[int, int] = {}
 
 
 def home_on_drive(model: str, n: int, plant: DrivePlant, offset: int = 0,
-                  offset_mode: int = 0, timeout_ms: int = 0, v_high: int = V_HIGH,
+                  offset_mode: int = 0, timeout_ms: int = 0, blind_zone: int = 0, v_high: int = V_HIGH,
                   v_low: int = V_LOW, acc: int = ACC, horizon_us: int = 120_000_000) -> Drive:
     d = Drive(model, plant=plant)
     d.write(0x6060, 0, 6)
@@ -66,6 +67,7 @@ def home_on_drive(model: str, n: int, plant: DrivePlant, offset: int = 0,
         d.write(index, sub, value)
     if model == KINCO:
         d.write(0x6099, 5, offset_mode)
+        d.write(0x6099, 6, blind_zone)
     else:
         d.write(0x2003, 7, timeout_ms)
     for cw in (0x06, 0x07, 0x0F):
@@ -221,16 +223,19 @@ def test_registry_holds_every_method_of_both_models():
        start=st.integers(NL - 200, PL + 200), lo=st.integers(-8000, 7000),
        width=st.integers(1, 2500), period=st.integers(50, 4000),
        phase=st.integers(0, 3999), offset=st.integers(-5000, 5000),
-       offset_mode=st.integers(0, 1))
+       offset_mode=st.integers(0, 1), blind_zone=st.integers(0, 2))
 def test_drive_and_sequence_agree(model, data, start, lo, width, period, phase, offset,
-                                  offset_mode):
-    """For any method, start, switch, index pattern and offset the drive ends as the
-    pure sequence does (outcome, position, 6064h, alarm)."""
+                                  offset_mode, blind_zone):
+    """For any method, start, switch, index pattern, offset and (Kinco) offset mode
+    and index blind zone the drive ends as the pure sequence does (outcome,
+    position, 6064h, alarm, time)."""
     n = data.draw(st.sampled_from(sorted(method_table(model))))
     drive_plant, pure = shifted(start, lo=lo, hi=lo + width, period=period,
                                 phase=phase % period)
-    ref = reference(model, n, pure, offset=offset, offset_mode=offset_mode)
-    d = home_on_drive(model, n, drive_plant, offset=offset, offset_mode=offset_mode)
+    ref = reference(model, n, pure, offset=offset, offset_mode=offset_mode,
+                    blind_zone=blind_zone if model == KINCO else 0)
+    d = home_on_drive(model, n, drive_plant, offset=offset, offset_mode=offset_mode,
+                      blind_zone=blind_zone)
     assert_agrees(d, ref)
 
 
@@ -245,3 +250,13 @@ def test_halt_and_bit_4_falling_end_homing_with_the_hcfa_words():
     d = home_on_drive(HCFA, 7, drive_plant, horizon_us=50_000)
     d.write(0x6040, 0, 0x0F)                          # bit 4 falls
     assert d.statusword == 0x8637 and not d.axis.moving(d.now)
+
+
+def test_kinco_blind_zone_reaches_the_sequence():
+    """6099h:06 = 2 (½ rev, Kinco §2.4) moves the home of method 7 to a later index,
+    through the drive as in the sequence."""
+    drive_plant, pure = shifted(-5000, phase=LO - 1 - 10)   # an index 10 counts past the edge
+    near = reference(KINCO, 7, pure)
+    far = reference(KINCO, 7, pure, blind_zone=2)
+    assert isinstance(near, Done) and isinstance(far, Done) and far.home_point != near.home_point
+    assert_agrees(home_on_drive(KINCO, 7, drive_plant, blind_zone=2), far)

@@ -29,6 +29,7 @@ from typing import Callable, Optional
 from ...errors import PlcError
 from .axis import Axis, LinLeg
 from .esm import AlResult, Esm, EsmState
+from . import homing_adapter  # noqa: F401  (registers the homing methods)
 from .homing_plan import HomingPlan, homing_plans
 from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, ProfileVelocity,
                     MODE_NAMES)
@@ -44,7 +45,7 @@ __all__ = ["Drive", "DriveEvent"]
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
 #: (no speed limit then) and no P03.07 (no homing time limit).
-_ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0}
+_ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0}
 _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an error
 
 

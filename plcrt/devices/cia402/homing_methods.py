@@ -173,7 +173,12 @@ def _rows(model: str) -> dict[int, Method]:
     idx_src = "HCFA §7.5.4 (error table)" if hcfa else "Kinco §2.5"
     add(33, INDEX, None, -1, -1, True, source=idx_src)
     add(34, INDEX, None, +1, +1, True, source=idx_src)
-    if not hcfa:
+    if hcfa:
+        # §7.5.4 "supports all homing methods except ___" (the exception is lost) with
+        # 6098h 0-100: the CiA 402 "current position" methods are kept (docs/cia402.md)
+        add(35, HERE, None, 0, 0, False, source="HCFA §7.5.4 (CiA 402-2 method 35)")
+        add(37, HERE, None, 0, 0, False, source="HCFA §7.5.4 (CiA 402-2 method 37)")
+    else:
         add(35, HERE, None, 0, 0, False, source="Kinco §2.5")
         add(-17, HARD_STOP, None, -1, -1, False, source="Kinco §2.5")
         add(-18, HARD_STOP, None, +1, +1, False, source="Kinco §2.5")

@@ -3,9 +3,9 @@
 What it is: the data a drive gives a homing method (:class:`HomingRequest`),
 what a method answers (:class:`HomingStep`: a motion, positions to watch, or
 an outcome), the :class:`HomingPlan` protocol, the registry of methods per
-drive model (:func:`homing_plans`, :func:`register`) and the one method that
-needs no geometry: 35 / 37, "the current position is home" (CiA 402; Kinco
-§2.2 lists 35, HCFA §7.5.4 accepts 6098h 0–100).
+drive model (:func:`homing_plans`, :func:`register`).  The methods
+themselves are :class:`~.homing.HomingSequence` runs, registered for every
+method of each model by :mod:`.homing_adapter`.
 
 How a drive runs a plan (``plcrt.devices.cia402.modes.Homing``):
 
@@ -13,8 +13,8 @@ How a drive runs a plan (``plcrt.devices.cia402.modes.Homing``):
    (HCFA §7.5.4) the drive looks 6098h up in its registry.  No plan: alarm 62
    (invalid homing method).  Otherwise it calls ``plan.start(request)``.
 2. It carries out the step: ``motion`` replaces the axis's plan (None keeps
-   it); it reports each ``watches`` entry the first time the count reaches it
-   moving that way, and the motion's end (the axis at rest, event name
+   it; ``from_rest`` first stops the axis at once); it reports each
+   ``watches`` entry the first time the count reaches it moving that way, and the motion's end (the axis at rest, event name
    ``"stopped"``), by ``plan.event(name, t_us, position)``, which returns the
    next step.  The watches of a step replace those of the one before.
 3. ``outcome = "attained"``: the axis stops where it is and its count becomes
@@ -40,7 +40,7 @@ from typing import Callable, Literal, Optional, Protocol
 from .plant import DrivePlant
 
 __all__ = ["HomingRequest", "HomingMotion", "Watch", "HomingStep", "HomingPlan",
-           "CurrentPositionHoming", "homing_plans", "register"]
+           "homing_plans", "register"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,18 +57,23 @@ class HomingRequest:
     mechanical: int      #: the same place in the plant's frame (switch positions)
     t_us: int
     plant: DrivePlant
+    offset_mode: int = 0  #: Kinco 6099h:05 (§2.3-3)
+    blind_zone: int = 0   #: Kinco 6099h:06 (§2.4)
+    timeout_ms: int = 0   #: HCFA P03.07 (§8.2), 0 = off
 
 
 @dataclass(frozen=True, slots=True)
 class HomingMotion:
     """``"velocity"``: run at signed ``value`` P/s until told otherwise;
     ``"position"``: go to count ``value`` at ``speed`` and stop there;
-    ``"stop"``: ramp to rest.  Ramps use ``accel`` (0: at once)."""
+    ``"stop"``: ramp to rest.  Ramps use ``accel`` (0: at once).
+    ``from_rest``: the axis first stops at once (a reversal at a limit)."""
 
     kind: Literal["velocity", "position", "stop"]
     value: int = 0
     speed: int = 0
     accel: int = 0
+    from_rest: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,32 +106,10 @@ class HomingPlan(Protocol):
     def event(self, name: str, t_us: int, position: int) -> HomingStep: ...
 
 
-class CurrentPositionHoming:
-    """Methods 35 and 37: the current position is home; the count becomes
-    607Ch (CiA 402-2: the home position is the home offset) without motion."""
-
-    def __init__(self) -> None:
-        self.request: Optional[HomingRequest] = None
-
-    def start(self, request: HomingRequest) -> HomingStep:
-        self.request = request
-        return HomingStep(outcome="attained", home_position=request.offset,
-                          note=f"method {request.method}: the current position "
-                               f"{request.position} is home, the count becomes 607Ch = "
-                               f"{request.offset} (CiA 402)")
-
-    def event(self, name: str, t_us: int, position: int) -> HomingStep:
-        assert self.request is not None
-        return HomingStep(outcome="attained", home_position=self.request.offset,
-                          note=f"method 35/37 has no motion ({name})")
-
-
 PlanFactory = Callable[[], HomingPlan]
 
-_REGISTRY: dict[str, dict[int, PlanFactory]] = {
-    "hcfa-am0520b": {35: CurrentPositionHoming, 37: CurrentPositionHoming},
-    "kinco-servo": {35: CurrentPositionHoming, 37: CurrentPositionHoming},
-}
+#: filled by :mod:`.homing_adapter` (imported by :mod:`.drive`)
+_REGISTRY: dict[str, dict[int, PlanFactory]] = {"hcfa-am0520b": {}, "kinco-servo": {}}
 
 
 def homing_plans(model: str) -> dict[int, PlanFactory]:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Optional
 
+from .homing import homing_status
 from .homing_plan import HomingPlan, HomingRequest, HomingStep, Watch
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -367,7 +368,9 @@ class Homing(Mode):
         method = d.param(0x6098)
         req = HomingRequest(d.model, method, d.param(0x6099, 1), d.param(0x6099, 2),
                             d.param(0x609A), d.param(0x607C), d.axis.position(t),
-                            d.axis.mechanical(t), t, d.plant)
+                            d.axis.mechanical(t), t, d.plant,
+                            offset_mode=d.param(0x6099, 5), blind_zone=d.param(0x6099, 6),
+                            timeout_ms=d.param(0x2003, 7))
         zero = [n for n, x in (("6099h:01", req.fast), ("6099h:02", req.slow),
                                ("609Ah", req.accel)) if x == 0]
         if zero and method not in (35, 37):
@@ -383,6 +386,7 @@ class Homing(Mode):
                     f"(simulated: {sorted(d.homing_plans)})")
             return
         self.plan, self.status = factory(), "running"
+        d.sm.homed = False      # Kinco §2.6: bit 15 clears when a new homing starts
         limit_ms = d.param(0x2003, 7)
         self.deadline = t + limit_ms * 1000 if limit_ms else None
         d.note(t, "HCFA §7.5.4", f"homing method {method} started at count {req.position}")
@@ -415,6 +419,8 @@ class Homing(Mode):
                    f"{m.speed}: a positioning needs a positive speed; homing error")
             return
         if m is not None:
+            if m.from_rest:
+                d.axis.stop_at_once(t)
             if m.kind == "velocity":
                 d.axis.run_at(t, m.value, m.accel, m.accel)
             elif m.kind == "position":
@@ -444,5 +450,9 @@ class Homing(Mode):
         z = B14 if self.param_zero else 0
         if self.status == "idle":
             return None if not z else (self.d.idle_mode_bits() | z)
-        return z | {"running": 0, "attained": B12 | B10, "error": B13 | B10,
-                    "interrupted": B10 | B15, "halted": B10 | B8}[self.status]
+        state = {"running": "running", "attained": "done", "error": "failed",
+                 "interrupted": "aborted", "halted": "aborted"}[self.status]
+        bits = homing_status(self.d.model, state, self.d.sm.homed)
+        if self.status == "halted":        # §7.3 halt word 0x0737: bit 8, bit 15 clear
+            bits = (bits & ~B15) | B8
+        return z | bits

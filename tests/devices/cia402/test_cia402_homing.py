@@ -335,13 +335,13 @@ def test_kinco_35_zeroes_here_without_motion():
 
 
 def test_supported_methods_per_model():
-    assert sorted(METHODS[HCFA]) == [*range(1, 15), *range(17, 31), 33, 34]
+    assert sorted(METHODS[HCFA]) == [*range(1, 15), *range(17, 31), 33, 34, 35, 37]
     assert sorted(METHODS[KINCO]) == [-18, -17, *range(1, 15), *range(17, 31), 33, 34, 35]
     with pytest.raises(PlcError, match="unknown drive model"):
         method_table("nope")
 
 
-@pytest.mark.parametrize("model,n,alarm", [(HCFA, 15, 62), (HCFA, 35, 62), (HCFA, -17, 62),
+@pytest.mark.parametrize("model,n,alarm", [(HCFA, 15, 62), (HCFA, 36, 62), (HCFA, -17, 62),
                                            (KINCO, 37, None), (KINCO, 15, None)])
 def test_unsupported_method_fails_with_the_alarm(model, n, alarm):
     result, _ = home(model, n, 0)

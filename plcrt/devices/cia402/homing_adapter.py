@@ -1,0 +1,128 @@
+"""The homing methods of :mod:`.homing` run as a drive's homing plans.
+
+What it is: :class:`SequencePlan`, a :class:`~.homing_plan.HomingPlan` over
+:class:`~.homing.HomingSequence`, and :func:`install`, which registers it
+for every method of each model's table (:func:`~.homing_methods.method_table`)
+in the registry the drive reads (:func:`~.homing_plan.homing_plans`).  The
+module registers on import; :mod:`.drive` imports it.
+
+The translation (HCFA §7.5.4, Kinco §2.1):
+
+* the drive's :class:`~.plant.DrivePlant` becomes a
+  :class:`~.homing_methods.HomingPlant` (the drive's plant has no
+  mechanical ends, so Kinco -17 / -18 fail with the sequence's explanation);
+* 6098h, 6099h:01 / :02, 609Ah, 607Ch, Kinco 6099h:05 / :06 and HCFA P03.07
+  become :class:`~.homing.HomingParams`;
+* a :class:`~.homing.Phase` becomes a motion and the phase's watches: a
+  phase of constant speed or a ramp to a speed is ``"velocity"`` (a phase
+  whose first segment cruises starts at that speed at once, the stepper
+  start of :meth:`HomingSequence._to_speed`), a ramp to rest is ``"stop"``,
+  the Kinco offset move is ``"position"``; a phase that starts from rest
+  while the axis moves (reversal at a limit, after leaving the switch) asks
+  the drive to stop at once first (``HomingMotion.from_rest``);
+* the drive's ``"stopped"`` event is the phase's ``"end"``; a watch reports
+  the watched position itself, as :meth:`Phase.first_event` does;
+* :class:`~.homing.Done` is ``"attained"`` with ``home_position`` = the
+  final mechanical position plus ``position_shift`` (the model's offset
+  rule); :class:`~.homing.Failed` is ``"error"`` with its explanation, and a
+  fault (603Fh = alarm, the alarm, the explanation) when it names alarm 62
+  or 63.
+
+What it is not: it computes no geometry; the sequence does.  Time limits are
+the drive's own (P03.07, :class:`~.modes.Homing`).
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+from .homing import Done, Failed, HomingParams, HomingSequence, Phase, Step
+from .homing_methods import MODELS, HomingPlant, method_table
+from .homing_plan import HomingMotion, HomingRequest, HomingStep, Watch, register
+
+__all__ = ["SequencePlan", "homing_params", "homing_plant", "install"]
+
+
+def homing_plant(request: HomingRequest) -> HomingPlant:
+    """The drive's plant as the homing sequence sees it."""
+    p = request.plant
+    return HomingPlant(neg_limit=p.neg_limit, pos_limit=p.pos_limit,
+                       home_switch=p.home_switch, index_period=p.index_period,
+                       index_phase=p.index_phase)
+
+
+def homing_params(request: HomingRequest) -> HomingParams:
+    """The drive's homing objects as :class:`HomingParams`."""
+    return HomingParams(method=request.method, v_search=request.fast, v_zero=request.slow,
+                        accel=request.accel, offset=request.offset,
+                        offset_mode=request.offset_mode, blind_zone=request.blind_zone,
+                        timeout_ms=request.timeout_ms)
+
+
+class SequencePlan:
+    """One homing run of the drive, carried out by a :class:`HomingSequence`."""
+
+    def __init__(self) -> None:
+        self.seq: Optional[HomingSequence] = None
+        self.phase: Optional[Phase] = None
+        self.result: Optional[Done | Failed] = None
+        self._watch_at: dict[str, int] = {}
+
+    def start(self, request: HomingRequest) -> HomingStep:
+        self.seq = HomingSequence(request.model, homing_params(request), homing_plant(request))
+        return self._step(self.seq.start(request.t_us, request.mechanical), moving=False)
+
+    def event(self, name: str, t_us: int, position: int) -> HomingStep:
+        assert self.seq is not None
+        if name == "stopped":
+            step = self.seq.on_event(t_us, position, "end")
+        else:
+            step = self.seq.on_event(t_us, self._watch_at.get(name, position), name)
+        return self._step(step, moving=True)
+
+    # -- translation ------------------------------------------------------------------
+    def _step(self, step: Step, moving: bool) -> HomingStep:
+        if isinstance(step, Done):
+            self.result, self.phase = step, None
+            return HomingStep(outcome="attained",
+                              home_position=step.position + step.position_shift,
+                              note=step.explanation)
+        if isinstance(step, Failed):
+            self.result, self.phase = step, None
+            fault = (step.alarm, step.alarm, step.explanation) if step.alarm else None
+            return HomingStep(outcome="error", fault=fault, note=step.explanation)
+        self.phase = step
+        self._watch_at = {}
+        watches = []
+        for w in step.watches:
+            self._watch_at.setdefault(w.event, w.position)
+            watches.append(Watch(w.event, w.position, step.direction))
+        return HomingStep(motion=self._motion(step), watches=tuple(watches),
+                          note=f"homing phase {step.name} from {step.x0}")
+
+    def _motion(self, ph: Phase) -> HomingMotion:
+        assert self.seq is not None
+        rate = self.seq.params.accel
+        if not ph.segs:
+            return HomingMotion("stop", accel=0)
+        first, last = ph.segs[0], ph.segs[-1]
+        from_rest = first.v0 == 0
+        if ph.name == "offset":
+            target = ph.x0 + ph.direction * abs(self.seq.params.offset)
+            return HomingMotion("position", target, int(self.seq.vh), rate, from_rest=True)
+        if last.v1 == 0:
+            return HomingMotion("stop", accel=rate)
+        speed = last.v1
+        accel = rate if first.t1 is not None and first.v0 != first.v1 else 0
+        return HomingMotion("velocity", ph.direction * int(speed), accel=accel,
+                            from_rest=from_rest)
+
+
+def install() -> None:
+    """Register :class:`SequencePlan` for every method of both models."""
+    for model in MODELS:
+        for method in method_table(model):
+            register(model, method, SequencePlan)
+
+
+install()

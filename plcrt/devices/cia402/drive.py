@@ -82,7 +82,7 @@ class Drive:
         self.log: list[DriveEvent] = []
         self.axis = Axis(0)
         self.controlword = int(self.store.get(0x6040))
-        self.pdo = PdoConfig(self._lookup, lambda: self.esm.state)
+        self.pdo = PdoConfig(self._lookup, lambda: self.esm.state, self._default_maps())
         self.esm = Esm(self.pdo.activate)
         mode = int(self.store.get(0x6060))
         self.sm = Drive402(model, t=t_us / 1e6, mode=mode or None)
@@ -120,6 +120,22 @@ class Drive:
     def note(self, t: int, section: str, text: str, source: str = "") -> None:
         self.log.append(DriveEvent(t, source or MODE_NAMES.get(self.mode_number, "drive"),
                                    text, section))
+
+    def _default_maps(self) -> dict[int, tuple[int, ...]]:
+        """The power-up PDO maps and assignment of this model's object
+        dictionary.  A CANopen model (Kinco) has no 1C12h/1C13h: its first
+        RxPDO and TxPDO maps are the process data."""
+        out: dict[int, tuple[int, ...]] = {}
+        for index in (*RX_MAPS, *TX_MAPS, *ASSIGN):
+            if self.od.find(index, 0) is None:
+                continue
+            count = int(self.store.get(index, 0))
+            out[index] = tuple(int(self.store.get(index, k)) for k in range(1, count + 1)
+                               if self.od.find(index, k) is not None)
+        for assign, first in ((0x1C12, RX_MAPS[0]), (0x1C13, TX_MAPS[0])):
+            if assign not in out and first in out:
+                out[assign] = (first,)
+        return out
 
     def _lookup(self, index: int, sub: int) -> Optional[tuple[int, str]]:
         e = self.od.find(index, sub)

@@ -159,12 +159,16 @@ class PdoConfig:
     is the ESM's PRE-OP -> SAFE-OP validator (step H): it checks the assignment
     and, when good, makes it the active mapping."""
 
-    def __init__(self, lookup: Lookup, state: Callable[[], EsmState]) -> None:
+    def __init__(self, lookup: Lookup, state: Callable[[], EsmState],
+                 defaults: dict[int, tuple[int, ...]] | None = None) -> None:
+        """``defaults``: the power-up maps and assignment by object index
+        (the model's object dictionary); missing ones are HCFA's."""
         self.lookup = lookup
         self.state = state
         self.entries: dict[int, list[int]] = {}
         self.count: dict[int, int] = {}
-        for index, rows in {**DEFAULT_MAPS, **{a: v for a, v in DEFAULT_ASSIGN.items()}}.items():
+        start = {**DEFAULT_MAPS, **DEFAULT_ASSIGN, **(defaults or {})}
+        for index, rows in start.items():
             size = MAX_ENTRIES if index in DEFAULT_MAPS else len(ASSIGN[index])
             self.entries[index] = list(rows) + [0] * (size - len(rows))
             self.count[index] = len(rows)

@@ -1,14 +1,28 @@
 """Shared test set-up: makes the helper modules in ``tests/`` importable
-(``stl_helpers``, ``reference_interp``) from the mirrored sub-folders, and
-says in the report header and the summary when the tests of the shared
-real-file corpus were skipped because the corpus is not there."""
+(``stl_helpers``, ``reference_interp``) from the mirrored sub-folders, says
+in the report header and the summary when the tests of the shared real-file
+corpus were skipped because the corpus is not there, and makes the property
+tests deterministic under CI.
+
+Property tests (hypothesis) explore new random examples on every developer
+run and keep the failures they find in ``.hypothesis/``.  Under CI (the
+``CI`` environment variable set) they draw the same examples every time
+(``derandomize``), so a submission is judged on a fixed set of cases
+rather than on a fresh draw; ``PLCRT_PROPERTY_EXAMPLES`` still scales them.
+"""
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, database=None)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 _TESTS = str(Path(__file__).resolve().parent)
 if _TESTS not in sys.path:

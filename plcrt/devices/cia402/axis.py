@@ -199,6 +199,17 @@ class Axis:
         seg = ramp(t, Fraction(0), abs(v), Fraction(0), Fraction(dec, US))
         return Leg(1 if v > 0 else -1, x, [seg])
 
+    def _stop_first(self, t0: Fraction, x: Fraction, v: Fraction, dec: int,
+                    legs: list[AnyLeg]) -> tuple[Fraction, Fraction]:
+        """Append the ramp to rest (if any) to *legs*; returns the time and
+        position where the axis is then at rest."""
+        leg = self._stop_leg(t0, x, v, dec)
+        if leg is None:
+            return t0, x
+        legs.append(leg)
+        t_end, travel = leg.segs[-1].end
+        return t_end, x + leg.direction * travel
+
     def stop(self, t: int, dec: int) -> None:
         """Ramp to rest at *dec* P/s² (0: at once)."""
         x, v = self.exact(t)
@@ -219,11 +230,7 @@ class Axis:
         dist = target - x
         if v != 0 and ((dist > 0) != (v > 0) or dist == 0
                        or ramp_distance(abs(v), Fraction(0), r_dec) > abs(dist)):
-            leg = self._stop_leg(t0, x, v, dec)
-            if leg is not None:
-                legs.append(leg)
-                t0, travel = leg.segs[-1].end
-                x = x + leg.direction * travel
+            t0, x = self._stop_first(t0, x, v, dec, legs)
             v = Fraction(0)
         length = abs(target - x)
         if length > 0:
@@ -240,11 +247,7 @@ class Axis:
         legs: list[AnyLeg] = []
         t0: Fraction = Fraction(t)
         if v != 0 and (v_target == 0 or (v_target > 0) != (v > 0)):
-            leg = self._stop_leg(t0, x, v, dec)
-            if leg is not None:
-                legs.append(leg)
-                t0, travel = leg.segs[-1].end
-                x = x + leg.direction * travel
+            t0, x = self._stop_first(t0, x, v, dec, legs)
             v = Fraction(0)
         if v_target != 0:
             direction = 1 if v_target > 0 else -1

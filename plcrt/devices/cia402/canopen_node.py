@@ -189,6 +189,17 @@ class CanopenDrive:
             del self.network[self.node.id]
 
     # ---------------------------------------------------------------- SDO server
+    def _abort(self, e: Exception, what: str, index: int, sub: int) -> Exception:
+        """The SDO abort a callback raises for *e*: plcrt's own abort code, or
+        0x08000000 for anything else (logged with its traceback), so that no
+        exception escapes into canopen's server (digest §7.2, caveat 9)."""
+        if isinstance(e, SdoAbort):
+            log.info("node %d: %s", self.drive.node_id, e)
+            return canopen.SdoAbortedError(e.code)
+        log.error("node %d: SDO %s %04Xh:%02X failed", self.drive.node_id, what, index, sub,
+                  exc_info=e)
+        return canopen.SdoAbortedError(0x08000000)
+
     def _owns(self, index: int, sub: int) -> bool:
         return self.drive.od.find(index, sub) is not None
 
@@ -203,13 +214,8 @@ class CanopenDrive:
                     self.drive.tick(self._next_boundary())
                 data = self.drive.sdo_read(index, subindex)
             return od.decode_raw(data)
-        except SdoAbort as e:
-            log.info("node %d: %s", self.drive.node_id, e)
-            raise canopen.SdoAbortedError(e.code) from None
-        except Exception:
-            log.exception("node %d: SDO read %04Xh:%02X failed", self.drive.node_id,
-                          index, subindex)
-            raise canopen.SdoAbortedError(0x08000000) from None
+        except Exception as e:
+            raise self._abort(e, "read", index, subindex) from None
 
     def _on_write(self, index: int, subindex: int, od: Any, data: bytes, **_: Any) -> None:
         if not self._owns(index, subindex):
@@ -220,13 +226,8 @@ class CanopenDrive:
                     self._sync()
                 self.drive.sdo_write(index, subindex, bytes(data))
                 self._fill_tpdo()
-        except SdoAbort as e:
-            log.info("node %d: %s", self.drive.node_id, e)
-            raise canopen.SdoAbortedError(e.code) from None
-        except Exception:
-            log.exception("node %d: SDO write %04Xh:%02X failed", self.drive.node_id,
-                          index, subindex)
-            raise canopen.SdoAbortedError(0x08000000) from None
+        except Exception as e:
+            raise self._abort(e, "write", index, subindex) from None
 
     # ---------------------------------------------------------------- PDOs
     def _fill_tpdo(self) -> None:

@@ -64,12 +64,7 @@ class MotionEn3(MotionBlock):
             for ax in mod.axes:
                 owner = ax.owner
                 if ax.segs and abs(ax.speed(t)) > mod.max_hz and owner is not None:
-                    if hasattr(owner, "_update"):
-                        owner.output_limit_lowered(t)
-                    else:
-                        owner.warn("P_DorCCW switched to single-ended while the homing "
-                                   "runs above 200 kHz: the homing keeps its speeds",
-                                   "dorccw")
+                    owner.output_limit_lowered(t)
         out = []
         for i, (sev, clr) in enumerate(((sev0, clr0), (sev1, clr1))):
             ax = mod.axes[i]
@@ -362,6 +357,12 @@ class Homing(MotionBlock):
         if self.status == ST_RUN and not self.running():
             self.status = ST_STOPPED
         return INNER_OK, self.status, spd
+
+    def output_limit_lowered(self, t: int) -> None:
+        """HOMING has no parameters to apply again (its speeds are fixed at
+        the start): it keeps them and says so."""
+        self.warn("P_DorCCW switched to single-ended while the homing runs above "
+                  "200 kHz: the homing keeps its speeds", "dorccw")
 
     def _start(self, t: int, mode: int, v_low: int, v_high: int, offset: int) -> None:
         from .homing import MODES, HomingSequence

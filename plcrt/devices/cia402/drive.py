@@ -462,18 +462,41 @@ class Drive:
         self._codecs[id(entries)] = (entries, codec)
         return codec
 
+    def exchange(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
+        """One bus cycle at *t_us* whose received process data are given
+        by object, ``{(index, sub): value}``, instead of as a packed RxPDO
+        image: the path of a master module that owns its mapping (the PLC
+        coupler).  The objects act as from an RxPDO (in OP only, objects
+        before 6040h); the caller reads what it transmits from
+        :attr:`store`."""
+        with self.store.lock:
+            self._batch = True
+            try:
+                self.advance(t_us)
+                self._apply_values(t_us, dict(values))
+                if self.sm.state is not State.OPERATION_ENABLED:
+                    self._do(t_us, self.sm.cycle(t_us / 1e6))
+                if self.sm.state is State.OPERATION_ENABLED:
+                    self.mode.cycle(t_us)
+            finally:
+                self._batch = False
+            self.publish()
+
     def _apply_rx(self, t_us: int, rx: bytes) -> None:
+        codec = self._codec(self.pdo.active_rx)
+        if codec is not None and len(rx) == codec[0].size:
+            values = dict(zip(codec[1], codec[0].unpack(rx)))
+        else:
+            values = unpack(self.pdo.active_rx, rx, self._signed)
+        self._apply_values(t_us, values)
+
+    def _apply_values(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
         if not self.esm.outputs:
             if not self._rx_noted:
                 self._rx_noted = True
                 self.note(t_us, "HCFA §6.5", f"RxPDO ignored in {self.esm.state.name}: "
                           "outputs act in OP only", "drive")
             return
-        codec = self._codec(self.pdo.active_rx)
-        if codec is not None and len(rx) == codec[0].size:
-            values = dict(zip(codec[1], codec[0].unpack(rx)))
-        else:
-            values = unpack(self.pdo.active_rx, rx, self._signed)
         cw = values.pop((0x6040, 0), None)
         for key, v in values.items():               # objects first, then 6040h
             if self._stored(key) != v:

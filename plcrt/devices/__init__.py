@@ -66,6 +66,65 @@ class AxisState(Mapping[str, Any]):
 _AXIS_KEYS = tuple(f.name for f in fields(AxisState))
 
 
+@dataclass(frozen=True, eq=False)
+class DriveState(Mapping[str, Any]):
+    """One CiA 402 drive on a fieldbus module at a moment of simulated time.
+
+    What :meth:`plcrt.Plc.drive` and the test harness's ``drive()`` return,
+    read as an object (``d.position``) or as a read-only mapping
+    (``d["position"]``, ``d.to_dict()`` for JSON), like :class:`AxisState`.
+    """
+
+    slot: int
+    node: int
+    model: str
+    state: str          #: the CiA 402 power state, e.g. "OPERATION ENABLED"
+    statusword: int     #: 6041h
+    controlword: int    #: 6040h as the drive holds it
+    mode: int           #: 6061h, the mode shown (1 PP, 3 PV, 6 HM, 8 CSP, 0 none)
+    position: int       #: 6064h, counts
+    velocity: int       #: 6069h/606Ch, counts per second
+    following_error: int  #: 60F4h
+    error_code: int     #: 603Fh (0: no fault)
+    online: bool        #: the bus exchanges process data with it (EtherCAT OP)
+
+    @property
+    def moving(self) -> bool:
+        """Whether the drive's axis is moving (velocity not zero)."""
+        return self.velocity != 0
+
+    @property
+    def fault(self) -> bool:
+        """Statusword bit 3, fault."""
+        return bool(self.statusword & 0x0008)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A plain dict of the fields, for JSON."""
+        return asdict(self)
+
+    def __getitem__(self, key: str) -> Any:
+        if key not in _DRIVE_KEYS:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(_DRIVE_KEYS)
+
+    def __len__(self) -> int:
+        return len(_DRIVE_KEYS)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Mapping):
+            return dict(self) == dict(other)
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(tuple(self.values()))
+
+
+_DRIVE_KEYS = tuple(f.name for f in fields(DriveState))
+
+
 class Device(Protocol):
     """What the scan engine needs from a simulated device."""
 
@@ -80,6 +139,7 @@ class Device(Protocol):
 
 def build_devices(plc: Any, plant: Any) -> list[Any]:
     """Create the devices a plant describes (table of module kinds)."""
+    from .cia402.coupler import FieldbusModule
     from .em253.module import EM253Module
-    kinds = {"EM253": EM253Module}
+    kinds = {"EM253": EM253Module, "FIELDBUS": FieldbusModule}
     return [kinds[m.kind](plc, m) for _, m in sorted(plant.modules.items())]

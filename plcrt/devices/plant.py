@@ -12,6 +12,20 @@
     z_offset = 1000             # ... at this mechanical position (and +/- periods)
     events = [ { at = 2.5, input = "STF", value = true } ]   # scripted inputs
 
+    [module.1]                  # a fieldbus master module with CiA 402 drives
+    kind = "FIELDBUS"
+    v = 1000                    # the drives' images from VB1000, 80 bytes each
+    cycle_ms = 1                # bus cycle
+    [module.1.drive.1]          # node address 1..127
+    model = "hcfa-am0520b"      # or "kinco-servo"
+    image = 1000                # this drive's image (default: the next free one)
+    neg_limit = -50000          # NLS active at and below (counts)
+    pos_limit = 50000           # PLS active at and above
+    home_switch = [-1000, 1000] # home switch active in this closed range
+    index_period = 10000        # one index pulse per period ...
+    index_phase = 0             # ... at this position (and +/- periods)
+    params = { "6099:01" = 20000, "6099:02" = 2000 }   # written by SDO at start-up
+
 Only this module reads the format; it returns plain dataclasses that the
 device implementations consume.  Every problem is a PlcConfigError naming
 the file and the key.
@@ -20,6 +34,7 @@ the file and the key.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,12 +42,29 @@ from typing import Any
 
 from ..errors import PlcConfigError, PlcError
 from ..lang.limits import file_limit, read_capped
+from .cia402.coupler import IMAGE_BYTES
 from .em253.axis import AxisPlant
 
-KINDS = ("EM253",)
+KINDS = ("EM253", "FIELDBUS")
 EVENT_INPUTS = ("STF",)
 _AXIS_KEYS = {"start", "rps", "limit_neg", "limit_pos", "z_period", "z_offset", "events"}
-_MODULE_KEYS = {"kind", "axis"}
+_MODULE_KEYS = {"EM253": {"kind", "axis"},
+                "FIELDBUS": {"kind", "v", "cycle_ms", "drive"}}
+_DRIVE_KEYS = {"model", "image", "neg_limit", "pos_limit", "home_switch", "index_period",
+               "index_phase", "neg_stop", "pos_stop", "params"}
+_PARAM_RE = re.compile(r"(?:0x)?([0-9A-Fa-f]{4})(?::(?:0x)?([0-9A-Fa-f]{1,2}))?h?")
+
+
+@dataclass
+class DriveConfig:
+    """One CiA 402 drive on a fieldbus module (node address, model, V image)."""
+
+    node: int
+    model: str
+    image: int                                   #: first VB of its 64-byte image
+    plant: dict[str, Any] = field(default_factory=dict)   #: DrivePlant keywords
+    params: list[tuple[int, int, int, str]] = field(default_factory=list)
+    where: str = field(default="", compare=False)   #: file and key, for messages
 
 
 @dataclass
@@ -40,6 +72,10 @@ class ModuleConfig:
     slot: int
     kind: str = "EM253"
     axes: dict[int, AxisPlant] = field(default_factory=dict)
+    drives: dict[int, DriveConfig] = field(default_factory=dict)
+    v: int = 1000                                #: FIELDBUS: first VB of the images
+    cycle_us: int = 1000                         #: FIELDBUS: bus cycle
+    where: str = field(default="", compare=False)
 
 
 @dataclass
@@ -97,13 +133,18 @@ def _build(data: dict, file: str) -> Plant:
         slot = int(key)
         if not isinstance(mod, dict):
             raise PlcConfigError(f"{where} must be a table")
-        unknown = set(mod) - _MODULE_KEYS
-        if unknown:
-            raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}")
         kind = str(mod.get("kind", "EM253")).upper()
         if kind not in KINDS:
             raise PlcConfigError(f"{where}: unknown module kind {kind!r} (known: {', '.join(KINDS)})")
-        cfg = ModuleConfig(slot, kind)
+        unknown = set(mod) - _MODULE_KEYS[kind]
+        if unknown:
+            raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+                                 f"(a {kind} module has {', '.join(sorted(_MODULE_KEYS[kind]))})")
+        cfg = ModuleConfig(slot, kind, where=where)
+        if kind == "FIELDBUS":
+            _fieldbus(cfg, mod, where, key)
+            modules[slot] = cfg
+            continue
         axes = mod.get("axis", {})
         if not isinstance(axes, dict):
             raise PlcConfigError(f"{where}.axis must be a table of axes "
@@ -165,3 +206,76 @@ def _axis(ax: dict, where: str) -> AxisPlant:
         p.events.append((int(round(at * 1e6)), name, bool(value)))
     p.events.sort()
     return p
+
+
+def _fieldbus(cfg: ModuleConfig, mod: dict, where: str, key: str) -> None:
+    """A FIELDBUS module: its V area, bus cycle and drives."""
+    cfg.v = _int(mod.get("v", 1000), f"{where}.v")
+    if cfg.v < 0:
+        raise PlcConfigError(f"{where}.v must be a V byte address (0 or more), got {cfg.v}")
+    cycle = mod.get("cycle_ms", 1)
+    if isinstance(cycle, bool) or not isinstance(cycle, (int, float)) or not math.isfinite(cycle):
+        raise PlcConfigError(f"{where}.cycle_ms must be a number of milliseconds, got {cycle!r}")
+    cfg.cycle_us = int(round(cycle * 1000))
+    if not 125 <= cfg.cycle_us <= 100_000 or cycle * 1000 != cfg.cycle_us:
+        raise PlcConfigError(f"{where}.cycle_ms must be a whole number of µs from 0.125 to "
+                             f"100 ms, got {cycle!r}")
+    drives = mod.get("drive", {})
+    if not isinstance(drives, dict) or not drives:
+        raise PlcConfigError(f"{where}: a FIELDBUS module needs drives "
+                             f"([module.{key}.drive.1] with model = ...)")
+    nodes = []
+    for dkey, d in drives.items():
+        dwhere = f"{where}.drive.{dkey}"
+        if not str(dkey).isdigit() or not 1 <= int(dkey) <= 127:
+            raise PlcConfigError(f"{dwhere}: the node address must be 1..127")
+        if not isinstance(d, dict):
+            raise PlcConfigError(f"{dwhere} must be a table")
+        nodes.append((int(dkey), d, dwhere))
+    taken: list[tuple[int, str]] = []
+    next_free = cfg.v
+    for node, d, dwhere in sorted(nodes, key=lambda n: n[0]):
+        cfg.drives[node] = dc = _drive(node, d, dwhere, next_free)
+        for other, owhere in taken:
+            if abs(other - dc.image) < IMAGE_BYTES:
+                raise PlcConfigError(
+                    f"{dwhere}.image: VB{dc.image}..VB{dc.image + IMAGE_BYTES - 1} overlaps "
+                    f"the image of {owhere} at VB{other} ({IMAGE_BYTES} bytes each)")
+        taken.append((dc.image, dwhere))
+        next_free = max(next_free, dc.image + IMAGE_BYTES)
+
+
+def _drive(node: int, d: dict, where: str, default_image: int) -> DriveConfig:
+    unknown = set(d) - _DRIVE_KEYS
+    if unknown:
+        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(known: {', '.join(sorted(_DRIVE_KEYS))})")
+    model = d.get("model")
+    if not isinstance(model, str):
+        raise PlcConfigError(f"{where}.model must name a drive model "
+                             f"(plcrt cia402 models lists them)")
+    image = _int(d.get("image", default_image), f"{where}.image")
+    if image < 0:
+        raise PlcConfigError(f"{where}.image must be a V byte address, got {image}")
+    plant: dict[str, Any] = {}
+    for k in ("neg_limit", "pos_limit", "index_period", "index_phase", "neg_stop", "pos_stop"):
+        if k in d:
+            plant[k] = _int(d[k], f"{where}.{k}")
+    if "home_switch" in d:
+        r = d["home_switch"]
+        if not (isinstance(r, list) and len(r) == 2):
+            raise PlcConfigError(f"{where}.home_switch must be [low, high]")
+        plant["home_switch"] = (_int(r[0], f"{where}.home_switch"),
+                                _int(r[1], f"{where}.home_switch"))
+    params = []
+    raw = d.get("params", {})
+    if not isinstance(raw, dict):
+        raise PlcConfigError(f"{where}.params must be a table {{ \"6099:01\" = 20000 }}")
+    for name, value in raw.items():
+        m = _PARAM_RE.fullmatch(name.strip())
+        if m is None:
+            raise PlcConfigError(f"{where}.params: {name!r} is no object address "
+                                 f"(write INDEX:SUB in hex, e.g. \"6099:01\")")
+        params.append((int(m.group(1), 16), int(m.group(2) or "0", 16),
+                       _int(value, f"{where}.params.{name}"), f"{where}.params.{name}"))
+    return DriveConfig(node, model, image, plant, params, where)

@@ -39,7 +39,7 @@ from .values import (Duration, check_load_options, check_parsed_inputs, scan_num
                      scan_total, source_items)
 
 if TYPE_CHECKING:
-    from ..devices import AxisState
+    from ..devices import AxisState, DriveState
 
 #: Estimated execution time per instruction for the watchdog (µs).  Only
 #: loops (FOR/NEXT, backward jumps) are checked, and their instructions are
@@ -343,6 +343,30 @@ class Plc(AddressAccess):
     def axes(self) -> list[AxisState]:
         """State of every configured axis (see :meth:`axis`)."""
         return [e for _, m in sorted(self.modules.items()) for e in m.snapshot(self._t_us)]
+
+    def drives(self) -> list[DriveState]:
+        """State of every CiA 402 drive on a fieldbus module of the plant
+        (:class:`plcrt.devices.DriveState`), in slot and node order."""
+        return [e for _, m in sorted(self.modules.items())
+                if hasattr(m, "drive_states") for e in m.drive_states(self._t_us)]
+
+    def drive(self, node: int, slot: int | None = None) -> DriveState:
+        """State of the drive at bus address *node* (on the fieldbus module
+        in *slot*, or the only one with that node): slot, node, model, state,
+        statusword, controlword, mode, position, velocity, following_error,
+        error_code, online."""
+        if isinstance(node, bool) or not isinstance(node, int) or \
+                (slot is not None and (isinstance(slot, bool) or not isinstance(slot, int))):
+            raise PlcAddressError(f"a drive is named by its node address (int) and optionally "
+                                  f"its module's slot, got {node!r:.40}, {slot!r:.40}")
+        found = [d for d in self.drives() if d.node == node and slot in (None, d.slot)]
+        if not found:
+            where = f" on the module in slot {slot}" if slot is not None else ""
+            raise PlcAddressError(f"no drive at node {node}{where} in the plant")
+        if len(found) > 1:
+            raise PlcAddressError(f"node {node} is on several fieldbus modules (slots "
+                                  f"{', '.join(str(d.slot) for d in found)}): name the slot")
+        return found[0]
 
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""

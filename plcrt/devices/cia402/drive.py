@@ -22,6 +22,7 @@ What it is not: no bus.  The canopen port and the PLC coupler call
 
 from __future__ import annotations
 
+import copy
 import struct
 from dataclasses import dataclass
 from typing import Callable, Optional
@@ -104,6 +105,16 @@ class Drive:
         self.store.on_write(self._on_write)
         self._mirror()
         self.publish()
+
+    def __deepcopy__(self, memo: dict) -> "Drive":
+        # a fork of a PLC copies its drives; compiled struct codecs are not
+        # copyable and are rebuilt on first use, the dictionary is shared
+        new = object.__new__(type(self))
+        memo[id(self)] = new
+        memo.setdefault(id(self.od), self.od)
+        for key, value in self.__dict__.items():
+            new.__dict__[key] = {} if key == "_codecs" else copy.deepcopy(value, memo)
+        return new
 
     # ---------------------------------------------------------------- helpers
     @property

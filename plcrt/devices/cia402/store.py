@@ -16,6 +16,7 @@ they produce with :meth:`Store.set`.
 
 from __future__ import annotations
 
+import copy
 import threading
 from dataclasses import dataclass
 from typing import Callable
@@ -72,6 +73,15 @@ class Store:
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
+
+    def __deepcopy__(self, memo: dict) -> "Store":
+        # a fork of a PLC copies its drives: a lock is not copied, it is made anew
+        new = object.__new__(type(self))
+        memo[id(self)] = new
+        memo.setdefault(id(self.od), self.od)        # the dictionary itself is read-only data
+        for key, value in self.__dict__.items():
+            new.__dict__[key] = threading.RLock() if key == "lock" else copy.deepcopy(value, memo)
+        return new
 
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:

@@ -277,7 +277,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     elif not quiet:
         _print_values(program, plc, values)
         if args.plant:
-            _print_axes(plc.axes())
+            _print_devices(plc)
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
@@ -464,6 +464,9 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
     }
     if plc is not None and getattr(args, "plant", None):
         obj["axes"] = [a.to_dict() for a in plc.axes()]
+        drives = plc.drives()
+        if drives:
+            obj["drives"] = [d.to_dict() | {"flags": d.flags} for d in drives]
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
@@ -531,28 +534,56 @@ def axis_rows(axes: Sequence[Mapping[str, Any]]) -> list[list[str]]:
     return rows
 
 
-def _print_axes(axes: Sequence[Mapping[str, Any]]) -> None:
-    """The plant's axes after the watch values: a rich table on a terminal,
-    aligned plain text otherwise (numbers right-aligned)."""
-    if not axes:
+#: columns of the drives table (:meth:`plcrt.Plc.drives`)
+_DRIVE_COLUMNS = ("slot", "node", "model", "mode", "position", "velocity", "statusword", "state")
+
+
+def drive_rows(drives: Sequence[Any]) -> list[list[str]]:
+    """Table cells of :meth:`plcrt.Plc.drives` entries (columns ``_DRIVE_COLUMNS``):
+    the statusword in hex and decoded (power state, the mode's bits, 603Fh)."""
+    rows = []
+    for d in drives:
+        notes = list(d.flags)
+        if d.error_code:
+            notes.append(f"603Fh 0x{d.error_code:04X}")
+        if not d.online:
+            notes.append("offline")
+        state = d.state + (f" ({', '.join(notes)})" if notes else "")
+        rows.append([str(d.slot), str(d.node), d.model, d.mode_name, str(d.position),
+                     str(d.velocity), f"0x{d.statusword:04X}", state])
+    return rows
+
+
+def _print_devices(plc: Any) -> None:
+    """The plant's EM253 axes and bus drives after the watch values."""
+    axes, drives = plc.axes(), plc.drives()
+    if axes:
+        _print_table(_AXIS_COLUMNS, axis_rows(axes))
+    if drives:
+        _print_table(_DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
+    if not axes and not drives:
         print("axes: none configured in the plant")
+
+
+def _print_table(columns: Sequence[str], rows: list[list[str]],
+                 left: Sequence[int] = ()) -> None:
+    """A rich table on a terminal, aligned plain text otherwise: numbers
+    right-aligned, the last column and those in *left* left-aligned."""
+    lefts = {len(columns) - 1, *left}
+    if sys.stdout.isatty() and _print_rich_grid(columns, rows, lefts):
         return
-    rows = axis_rows(axes)
-    if sys.stdout.isatty() and _print_rich_axes(rows):
-        return
-    widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(_AXIS_COLUMNS)]
-    last = len(_AXIS_COLUMNS) - 1
+    widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(columns)]
 
     def line(cells: Sequence[str]) -> str:
-        return "  ".join(c.ljust(w) if i == last else c.rjust(w)
+        return "  ".join(c.ljust(w) if i in lefts else c.rjust(w)
                          for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
 
-    print(line(_AXIS_COLUMNS))
+    print(line(columns))
     for row in rows:
         print(line(row))
 
 
-def _print_rich_axes(rows: list[list[str]]) -> bool:
+def _print_rich_grid(columns: Sequence[str], rows: list[list[str]], lefts: set[int]) -> bool:
     try:
         from rich.console import Console
         from rich.table import Table
@@ -560,8 +591,8 @@ def _print_rich_axes(rows: list[list[str]]) -> bool:
     except ImportError:
         return False
     table = Table()
-    for i, col in enumerate(_AXIS_COLUMNS):
-        table.add_column(col, justify="left" if i == len(_AXIS_COLUMNS) - 1 else "right")
+    for i, col in enumerate(columns):
+        table.add_column(col, justify="left" if i in lefts else "right")
     for row in rows:
         table.add_row(*(Text(cell) for cell in row))   # plain text, never markup
     Console().print(table)

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 from ..errors import PlcConfigError, PlcError
 from ..testing.harness import PlcTimeout, condition, reader, seconds
 from .base import Command, CommandError
-from .panels import axes_table, block_heading, fmt, key_values, mode, ms, sim_time
+from .panels import axes_table, block_heading, drives_table, fmt, key_values, mode, ms, sim_time
 from .trace_commands import TRACE_COMMANDS, trace_summary
 
 if TYPE_CHECKING:
@@ -281,6 +281,16 @@ def _cmd_axes(s: Session, args: list[str]) -> None:
         s._print(line)
 
 
+def _cmd_drives(s: Session, args: list[str]) -> None:
+    _no_args(args, "drives")
+    drives = s.plc.drives()
+    if not drives:
+        s._print("no drives (load a --plant with a FIELDBUS module)")
+        return
+    for line in drives_table(drives):
+        s._print(line)
+
+
 def _cmd_status(s: Session, args: list[str]) -> None:
     _no_args(args, "status")
     plc = s.plc
@@ -477,6 +487,8 @@ _TABLE = (
             "draw a network (no NET: all of them) with live values"),
     Command("axes", _cmd_axes, "axes",
             "the EM253 axes: position, mechanical position, speed, status"),
+    Command("drives", _cmd_drives, "drives",
+            "the bus drives: mode, position, velocity, statusword and its meaning"),
     Command("status", _cmd_status, "status",
             "time, scans, mode, scan time, breakpoints, forces"),
     Command("continue", _cmd_continue, "continue",

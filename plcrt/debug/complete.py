@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..safetext import printable
+from ..trace.recorder import DRIVE_QUANTITIES
 from .commands import COMMANDS, lookup
 
 if TYPE_CHECKING:
@@ -160,6 +161,7 @@ def vocabulary(session: Session) -> Vocabulary:
                     if _offerable(n))
     signals = tuple(f"axis{a['slot']}.{a['axis']}.{kind}" for a in plc.axes()
                     for kind in ("position", "mechanical", "speed"))
+    signals += tuple(f"drive{d.node}.{kind}" for d in plc.drives() for kind in DRIVE_QUANTITIES)
     return Vocabulary(
         commands=tuple(COMMANDS),
         networks=tuple(networks),

@@ -87,6 +87,23 @@ def axes_table(axes: Sequence[dict[str, Any]]) -> list[str]:
     return [line(head)] + [line(r) for r in rows]
 
 
+def drives_table(drives: Sequence[Any]) -> list[str]:
+    """The bus drives (entries of :meth:`plcrt.Plc.drives`, at least one):
+    numbers right-aligned, model and state left-aligned, the statusword in
+    hex and decoded."""
+    from ..cli import drive_rows
+    head = ("slot", "node", "model", "mode", "position", "velocity", "statusword", "state")
+    rows = [tuple(r) for r in drive_rows(drives)]
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
+    lefts = {2, 3, len(head) - 1}
+
+    def line(cells: tuple[str, ...]) -> str:
+        return "  ".join(c.ljust(w) if i in lefts else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    return [line(head)] + [line(r) for r in rows]
+
+
 def block_heading(pou: ir.Pou) -> str:
     """``OB1 (MAIN)  title``: the line above a block's networks."""
     name = f" ({pou.name})" if pou.name and pou.name != pou.ident else ""
@@ -136,5 +153,5 @@ def draw_network(out: TextIO, plc: Plc, pou: ir.Pou, network: ir.Network, *,
         out.write(printable(f"{insn.mnemonic:<7}{ops}".rstrip()) + "\n")
 
 
-__all__ = ["axes_table", "block_heading", "draw_network", "fmt", "key_values", "load_view",
+__all__ = ["axes_table", "block_heading", "drives_table", "draw_network", "fmt", "key_values", "load_view",
            "mode", "ms", "sim_time", "status_line", "watch_table"]

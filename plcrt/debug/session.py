@@ -206,8 +206,8 @@ class Session:
         plc = self.plc
         files = ", ".join(sorted({p.loc.file for p in plc.program.pous})) or plc.program.file
         nets = plc.program.network_count()
-        axes = len(plc.axes())
-        extra = f", {axes} axes" if axes else ""
+        axes, drives = len(plc.axes()), len(plc.drives())
+        extra = (f", {axes} axes" if axes else "") + (f", {drives} drive(s)" if drives else "")
         return printable(f"plcrt debug: {files} ({nets} network(s), scan {ms(plc.scan_us)} ms"
                          f"{extra}); type 'help' for the commands")
 

@@ -98,6 +98,18 @@ class DriveState(Mapping[str, Any]):
         """Statusword bit 3, fault."""
         return bool(self.statusword & 0x0008)
 
+    @property
+    def flags(self) -> list[str]:
+        """The statusword's other set bits in words for the mode shown
+        (``["target reached", "homing attained"]``)."""
+        from .cia402.status import describe_statusword
+        return describe_statusword(self.statusword, self.mode, self.model)
+
+    @property
+    def mode_name(self) -> str:
+        """6061h as its short name: PP, PV, HM, CSP (or the number)."""
+        return _MODE_NAMES.get(self.mode, str(self.mode))
+
     def to_dict(self) -> dict[str, Any]:
         """A plain dict of the fields, for JSON."""
         return asdict(self)
@@ -123,6 +135,7 @@ class DriveState(Mapping[str, Any]):
 
 
 _DRIVE_KEYS = tuple(f.name for f in fields(DriveState))
+_MODE_NAMES = {0: "none", 1: "PP", 3: "PV", 6: "HM", 8: "CSP"}
 
 
 class Device(Protocol):

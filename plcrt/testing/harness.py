@@ -23,7 +23,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Union
 
-from ..devices import AxisState
+from ..devices import AxisState, DriveState
+from ..trace.recorder import parse_signal
 from ..engine.runtime import Plc, load
 from ..engine.values import Duration, check_address, parse_number, scan_number
 from ..engine.values import duration as parse_duration
@@ -53,8 +54,15 @@ def seconds(d: Duration) -> float:
 
 def reader(plc: Plc, spec: str) -> Callable[[], Value]:
     """A function reading one address (``VW100``, ``VD4:REAL``, ``T37:BIT``,
-    symbol names) resolved once, for per-scan use (see :meth:`Plc.reader`)."""
+    symbol names) or one device quantity (``axis0.0.position``,
+    ``drive1.statusword``, the signals of ``plcrt trace``) resolved once,
+    for per-scan use (see :meth:`Plc.reader`)."""
+    if isinstance(spec, str) and _DEVICE_RE.match(spec):
+        return parse_signal(plc, spec).read
     return plc.reader(spec)[1]
+
+
+_DEVICE_RE = re.compile(r"\s*(axis|drive)\d*\.", re.IGNORECASE)
 
 
 _COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"
@@ -460,6 +468,16 @@ class Harness:
     def module(self, slot: int) -> Any:
         """The simulated module in expansion slot ``slot``, or None."""
         return self.plc.module(slot)
+
+    def drive(self, node: int, slot: int | None = None) -> DriveState:
+        """State of the bus drive at *node* (needs a plant with a FIELDBUS
+        module): ``d.position``, ``d.statusword``, ``d.state``, ``d.flags``,
+        as :meth:`Plc.drive`."""
+        return self.plc.drive(node, slot)
+
+    def drives(self) -> list[DriveState]:
+        """State of every bus drive."""
+        return self.plc.drives()
 
     def wait_axis_moving(self, slot: int = 0, axis: int = 0, *,
                          timeout: Duration = 1.0) -> float:

@@ -36,6 +36,12 @@ AXIS_QUANTITIES = {"position": False, "mechanical": False, "speed": True}
 _AXIS_RE = re.compile(r"axis(\d+)\.(\d+)\.(\w+)", re.IGNORECASE)
 _AXIS_PREFIX_RE = re.compile(r"axis\d*\.", re.IGNORECASE)
 
+#: bus-drive quantities a trace can record (fields of plcrt.devices.DriveState)
+DRIVE_QUANTITIES = ("position", "velocity", "statusword", "controlword", "mode",
+                    "following_error", "error_code")
+_DRIVE_RE = re.compile(r"drive(?:(\d+)\.)?(\d+)\.(\w+)", re.IGNORECASE)
+_DRIVE_PREFIX_RE = re.compile(r"drive\d*\.", re.IGNORECASE)
+
 
 
 @dataclass(frozen=True)
@@ -69,6 +75,8 @@ def parse_signal(plc: Any, text: str) -> Signal:
     name = text.strip()
     if _AXIS_PREFIX_RE.match(name):
         return _axis_signal(plc, name)
+    if _DRIVE_PREFIX_RE.match(name):
+        return _drive_signal(plc, name)
     try:
         kind, read = plc.reader(name)
     except PlcError as e:
@@ -100,13 +108,30 @@ def _axis_signal(plc: Any, name: str) -> Signal:
     return Signal(name, kind, lambda: plc.axis(slot, axis)[quantity])
 
 
+def _drive_signal(plc: Any, name: str) -> Signal:
+    m = _DRIVE_RE.fullmatch(name)
+    if m is None or m.group(3).lower() not in DRIVE_QUANTITIES:
+        raise PlcConfigError(f"trace signal {name!r}: a drive signal is "
+                             f"drive<node>.<quantity> (or drive<slot>.<node>.<quantity>) with "
+                             f"quantity {'|'.join(DRIVE_QUANTITIES)}, e.g. drive1.position")
+    slot = int(m.group(1)) if m.group(1) is not None else None
+    node, quantity = int(m.group(2)), m.group(3).lower()
+    try:
+        state = plc.drive(node, slot)
+    except PlcError as e:
+        raise PlcAddressError(f"trace signal {name!r}: {e.message}") from None
+    module = plc.module(state.slot)
+    return Signal(name, "int", lambda: getattr(module.drive_state(node), quantity))
+
+
 class Trace:
     """Record signals of ``plc`` after every scan (or every ``every``-th).
 
     Args:
         plc: the running program.
         signals: addresses (``I0.0``, ``VW100``, ``VD200:REAL``, ``T37``,
-            ``T37:BIT``, symbols) or axis quantities (``axis0.0.speed``).
+            ``T37:BIT``, symbols), axis quantities (``axis0.0.speed``) or
+            bus-drive quantities (``drive1.position``, ``drive1.statusword``).
         every: record only after scans whose number (``plc.scans``, counted
             from power-up) is a multiple of ``every``.
         limit: keep only the last ``limit`` samples (a ring buffer).

@@ -274,16 +274,19 @@ class FieldbusModule:
         return []
 
     def drive_states(self, t: int) -> list[DriveState]:
-        out = []
-        for node, port in self.ports.items():
-            d = port.drive
-            out.append(DriveState(
-                slot=self.slot, node=node, model=d.model, state=str(d.sm.state),
-                statusword=d.statusword, controlword=d.controlword, mode=d.mode_number,
-                position=int(d.store.get(0x6064)), velocity=int(d.store.get(0x606C)),
-                following_error=int(d.store.get(0x60F4)), error_code=int(d.store.get(0x603F)),
-                online=d.esm.state is EsmState.OP))
-        return out
+        """The state of every drive after the last bus cycle."""
+        return [self.drive_state(node) for node in self.ports]
+
+    def drive_state(self, node: int) -> DriveState:
+        """The state of the drive at *node* after the last bus cycle."""
+        d = self.ports[node].drive
+        get = d.store.get
+        return DriveState(
+            slot=self.slot, node=node, model=d.model, state=str(d.sm.state),
+            statusword=d.statusword, controlword=d.controlword, mode=d.mode_number,
+            position=int(get(0x6064)), velocity=int(get(0x606C)),
+            following_error=int(get(0x60F4)), error_code=int(get(0x603F)),
+            online=d.esm.state is EsmState.OP)
 
     def drive(self, node: int) -> Drive:
         """The simulated drive at bus address *node*."""

@@ -194,5 +194,5 @@ def test_run_on_a_terminal_draws_the_drive_table_with_rich(files, capsys, monkey
     monkeypatch.setattr(sys.stdout, "isatty", lambda: True)
     code, out, _ = run_cli(capsys, "run", prog, "--plant", plant, "--scans", "5")
     assert code == 0
-    assert "statusword" in out and "0x8637" in out
+    assert "0x8637" in out and "kinco-servo" in out
     assert "│" in out or "┃" in out       # a rich table, not the plain one

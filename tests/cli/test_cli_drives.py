@@ -192,6 +192,7 @@ def test_run_on_a_terminal_draws_the_drive_table_with_rich(files, capsys, monkey
     import sys
     prog, plant = files
     monkeypatch.setattr(sys.stdout, "isatty", lambda: True)
+    monkeypatch.setenv("COLUMNS", "160")       # a wide terminal: no cell is wrapped
     code, out, _ = run_cli(capsys, "run", prog, "--plant", plant, "--scans", "5")
     assert code == 0
     assert "0x8637" in out and "kinco-servo" in out

@@ -36,7 +36,13 @@ that imports ``canopen``.
   OPERATIONAL only), at numbers the model's EtherCAT mapping objects leave
   free.  A master sees them with ``object_dictionary(model, node_id)``.
 
-What it is not: no EMCY, no SYNC, no remapping of the CAN view's PDOs.
+* EMCY (CiA 301 §7.2.7): when 603Fh changes, the node sends an emergency
+  message on 080h + node id: the error code and the error register 1001h
+  (the manufacturer-specific bytes are 0: HCFA's alarm number is the 603Fh
+  value itself, §4.7); a fault reset sends the code 0000h (error reset).
+  A master sees them in ``node.emcy`` (``active``, ``log``, ``wait()``).
+
+What it is not: no SYNC, no remapping of the CAN view's PDOs.
 """
 
 from __future__ import annotations
@@ -130,6 +136,7 @@ class CanopenDrive:
         self.node.tpdo.read(from_od=True)
         self.node.rpdo.read(from_od=True)
         self._rpdo_noted = False
+        self._emcy_code = 0                         # 603Fh as last sent in an EMCY
         self.node.rpdo[self.rpdo_no].add_callback(self._on_rpdo)
         self.drive.request_esm(EsmState.PREOP)
         self.node.nmt.send_command(0x81)            # reset: boot-up message
@@ -213,6 +220,7 @@ class CanopenDrive:
                 elif self.clock == "step" and index == 0x6041:
                     self.drive.tick(self._next_boundary())
                 data = self.drive.sdo_read(index, subindex)
+                self._check_emcy()
             return od.decode_raw(data)
         except Exception as e:
             raise self._abort(e, "read", index, subindex) from None
@@ -231,11 +239,31 @@ class CanopenDrive:
 
     # ---------------------------------------------------------------- PDOs
     def _fill_tpdo(self) -> None:
-        """Copy the drive's objects into the TPDO (canopen does not, caveat 3)."""
+        """Copy the drive's objects into the TPDO (canopen does not, caveat 3)
+        and send an EMCY if 603Fh changed."""
+        self._check_emcy()
         tpdo = self.node.tpdo[self.tpdo_no]
         for var in tpdo:
             var.raw = int(self.drive.store.get(var.index, var.subindex))
         tpdo.update()
+
+    def _check_emcy(self) -> None:
+        code = self.drive.sm.error_code
+        if code != self._emcy_code:
+            self._emcy_code = code
+            self._send_emcy(code)
+
+    def _send_emcy(self, code: int) -> None:
+        """One emergency message (CiA 301 §7.2.7.3.1): 603Fh and 1001h."""
+        sm = self.drive.sm
+        try:
+            self.node.emcy.send(code, sm.error_register & 0xFF)
+        except Exception:                    # the bus went away: the drive goes on
+            log.exception("node %d: EMCY 0x%04X not sent", self.drive.node_id, code)
+        else:
+            self.drive.note(self.drive.now, "CiA 301 §7.2.7",
+                            f"EMCY 0x{code:04X} sent (1001h = 0x{sm.error_register:02X})",
+                            "EMCY")
 
     def _on_rpdo(self, rpdo: Any) -> None:
         """An RPDO reached the node: write its objects to the drive, 6040h

@@ -15,6 +15,7 @@ from canopen.profiles.p402 import BaseNode402  # noqa: E402
 
 from plcrt import cia402  # noqa: E402
 from plcrt.devices.cia402.esm import EsmState  # noqa: E402
+from plcrt.devices.cia402.plant import DrivePlant  # noqa: E402
 from plcrt.devices.cia402.statemachine import State  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 
@@ -267,5 +268,42 @@ def test_the_kinco_model_is_enabled_by_its_master(bus):
         n = master(mst, 14, "kinco-servo")
         n.state = "OPERATION ENABLED"
         assert sim.drive.sm.state is State.OPERATION_ENABLED
+    finally:
+        sim.close()
+
+
+def test_a_fault_and_its_reset_reach_the_master_as_emcy_messages(pair):
+    """CiA 301 §7.2.7: 603Fh and 1001h in an EMCY on 080h + node id when the
+    fault comes, and the code 0000h (error reset) when it is reset."""
+    sim, n = pair
+    n.state = "OPERATION ENABLED"
+    with sim.drive.store.lock:
+        sim.drive.fault(sim.drive.now, 0x8611, None, "injected by the test")
+        sim.drive.publish()
+    assert n.state == "FAULT"                         # the read runs the port's cycle
+    assert wait_for(lambda: n.emcy.active, timeout=2)
+    err, = n.emcy.active
+    assert err.code == 0x8611 and err.register & 0x01
+    n.reset_from_fault()
+    assert wait_for(lambda: not n.emcy.active, timeout=2)        # 0000h cleared the master's list
+    assert [e.code for e in n.emcy.log] == [0x8611, 0x0000]
+    assert any("EMCY 0x8611 sent" in str(ev) for ev in sim.drive.log)
+
+
+def test_a_homing_timeout_is_an_emcy_with_the_hcfa_code(bus):
+    """HCFA §4.7 alarm 63 (homing timeout, P03.07) reaches the master as EMCY 63."""
+    dev, mst = bus
+    # NLS far away: the search for it outlasts the homing time limit
+    sim = cia402.attach(dev, 5, clock="manual", plant=DrivePlant(neg_limit=-10**9))
+    try:
+        n = master(mst)
+        n.state = "OPERATION ENABLED"
+        n.op_mode = "HOMING"
+        n.sdo[0x6098].raw = 17                        # method 17: search NLS
+        n.sdo[0x2003][7].raw = 1000                   # P03.07: 1000 ms
+        n.controlword = 0x1F
+        sim.advance(2.0)
+        assert wait_for(lambda: n.emcy.log, timeout=2)
+        assert [e.code for e in n.emcy.log] == [63]
     finally:
         sim.close()

@@ -158,11 +158,16 @@ class FieldbusModule:
             raise PlcConfigError(f"{dc.where}.model: {e.message}") from None
         drive.request_esm(EsmState.PREOP)
         for index, sub, value, where in dc.params:
+            if sub == 0 and index in _RX_OBJECTS:
+                off = next(o for o, i, _ in OUT_LAYOUT if i == index)
+                raise PlcConfigError(f"{where}: {index:04X}h is in the module's process image "
+                                     f"(VB{dc.image + off}, offset {off}): the program sets it "
+                                     f"every bus cycle, a start-up value would be overwritten")
             try:
                 drive.write(index, sub, value)
             except SdoAbort as e:
                 raise PlcConfigError(f"{where}: the drive refuses {index:04X}h:{sub:02X} = "
-                                     f"{value}: {e}") from None
+                                     f"{value}: {e.message}") from None
         for state in (EsmState.SAFEOP, EsmState.OP):
             res = drive.request_esm(state)
             if drive.esm.state is not state:
@@ -241,7 +246,7 @@ class FieldbusModule:
             port.abort = e.code
             port.flags = ERROR
             self.plc.warn(f"fieldbus slot {self.slot} node {port.node}: SDO {what} at "
-                          f"{t / 1e6:.6f} s aborted with 0x{e.code:08X}: {e}",
+                          f"{t / 1e6:.6f} s aborted: {e.message}",
                           None, f"sdo-{self.slot}-{port.node}-{t}")
 
     def _report(self, port: _Port) -> None:

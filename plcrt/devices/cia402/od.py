@@ -150,7 +150,13 @@ class Entry:
         if self.dtype == "STR":
             return str(value).encode("latin-1")
         signed = self.dtype.startswith("I")
-        return int(value).to_bytes(self.size, "little", signed=signed)
+        try:
+            return int(value).to_bytes(self.size, "little", signed=signed)
+        except OverflowError:
+            bits, low, high = DTYPES[self.dtype]
+            # CiA 301: a value the type cannot hold cannot be sent with the object's length
+            raise SdoAbort(0x06070010, f"{self.label} is {self.dtype} ({low}..{high}): "
+                                       f"{value} does not fit it") from None
 
     def decode(self, data: bytes) -> int | str:
         """The value of little-endian CoE bytes (length already checked)."""

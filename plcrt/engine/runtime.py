@@ -35,6 +35,7 @@ from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
 from .access import AddressAccess
+from .interrupts import Interrupts
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
 
@@ -104,6 +105,11 @@ class Plc(AddressAccess):
         #: their limit, the count before the last WDR, active subroutines
         self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0, 0]
         self.devices: list[Any] = []
+        #: the interrupt system; routines run through _run_interrupt
+        self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn)
+        self._irq_t = 0            #: the time the running code executes at (µs)
+        self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
+        self._int_l = bytearray(self.model.l_bytes)
         if system_symbols is None:
             from ..lang.symbols import SYSTEM_SYMBOLS
             system_symbols = dict(SYSTEM_SYMBOLS)
@@ -192,6 +198,22 @@ class Plc(AddressAccess):
         # perf: buffers are bound once in __init__ (self._bufs)
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
+        irq = self.interrupts
+        pi0 = pi[0] & 0x0F
+        if pi0 != self._pi0 or irq.queues[0] or irq.queues[1] or irq.queues[2]:
+            # input edges from the outside world: their routines run at the
+            # scan's start, before the image is read (System Manual: the
+            # routine runs when the edge occurs; the image changes next scan)
+            self._irq_t = now
+            try:
+                irq.edges(self._pi0, pi0, now)
+                self._pi0 = pi0
+                irq.dispatch(now)
+            except PlcError as e:
+                self._fail(e)
+            except Exception as e:
+                self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
+                                           self._loc_from_tb(e)), e)
         i_img[:] = pi
         if self._force_slots:
             self._apply_forces()
@@ -210,10 +232,13 @@ class Plc(AddressAccess):
         wd[0] = 0
         wd[2] = 0
         wd[3] = 0
+        self._irq_t = now
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            if self.devices:
+            if irq.timed_next:
+                self._events(now, now + self.scan_us)
+            elif self.devices:
                 t_to = now + self.scan_us
                 for dev in self.devices:
                     dev.step(self, now, t_to)
@@ -235,6 +260,50 @@ class Plc(AddressAccess):
         if self.observers:
             for fn in self.observers:
                 fn(self)
+
+    def _events(self, t_from: int, t_to: int) -> None:
+        """The scan interval (t_from, t_to] in time order: at every timed
+        interrupt the devices are advanced to its time and its routine runs
+        there; then the devices go on to t_to."""
+        irq, devices = self.interrupts, self.devices
+        t = t_from
+        while True:
+            te = irq.next_time(t, t_to)
+            if te is None:
+                break
+            for dev in devices:
+                dev.step(self, t, te)
+            self._irq_t = te
+            irq.fire_timed(te)
+            irq.dispatch(te)
+            t = te
+        if t < t_to:
+            for dev in devices:
+                dev.step(self, t, t_to)
+
+    def _run_interrupt(self, number: int) -> None:
+        """Run INT *number* now.  The CPU saves and restores the
+        accumulators and the status bits SMB1 around a routine (System
+        Manual, "System support for interrupts")."""
+        fn = self._ns.get(f"pou_INT{number}")
+        if fn is None:
+            return
+        acc, sm = self.mem.areas["AC"], self.mem.areas["SM"]
+        saved_ac, saved_sm1 = bytes(acc), sm[1]
+        try:
+            fn(self._int_l)
+        finally:
+            acc[:] = saved_ac
+            sm[1] = saved_sm1
+
+    def _irq_warn(self, message: str, key: str) -> None:
+        self.warn(message, None, key)
+
+    def _irq_attach(self, number: int, event: int) -> None:
+        self.interrupts.attach(number, event, self._irq_t)
+
+    def _irq_enable(self) -> None:
+        self.interrupts.enable(self._irq_t)
 
     def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
         self.mode = "STOP"
@@ -423,7 +492,8 @@ class Plc(AddressAccess):
             dareas[k][:] = buf
             memo[id(buf)] = dareas[k]
         pairs: list[tuple[Any, Any]] = [(self.timers, dst.timers),
-                                        (self.counters, dst.counters)]
+                                        (self.counters, dst.counters),
+                                        (self.interrupts, dst.interrupts)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
             other = dst.unit.bindings.get(name)
@@ -451,7 +521,9 @@ class Plc(AddressAccess):
             b.__dict__.clear()
             b.__dict__.update(state)
         dst.modules = {d.slot: d for d in dst.devices}
-        for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested"):
+        dst._int_l[:] = self._int_l
+        for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
+                     "_irq_t", "_pi0"):
             setattr(dst, name, getattr(self, name))
         dst._warned = set(self._warned)
         dst.diagnostics = list(self.diagnostics)

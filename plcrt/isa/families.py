@@ -10,3 +10,4 @@ from . import convert  # noqa: F401
 from . import timers  # noqa: F401
 from . import counters  # noqa: F401
 from . import control  # noqa: F401
+from . import interrupts  # noqa: F401

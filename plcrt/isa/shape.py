@@ -75,8 +75,8 @@ _STACK = {"ALD": "and", "OLD": "or", "LPS": "push", "LRD": "read", "LPP": "pop",
           "LDS": "copy", "AENO": "eno"}
 _MODIFIERS = {"NOT", "EU", "ED"}
 _COILS = {"=", "=I", "S", "R", "SI", "RI", "JMP", "SCRT", "CSCRE", "CRET",
-          "STOP", "WDR", "END"}
-_RAIL = {"LBL", "LSCR", "SCRE", "NEXT", "RET", "MEND", "NOP"}
+          "STOP", "WDR", "END", "ENI", "DISI", "CRETI"}
+_RAIL = {"LBL", "LSCR", "SCRE", "NEXT", "RET", "MEND", "NOP", "RETI"}
 #: power inputs of boxes with more than one (System Manual, counters)
 _BOX_INPUTS = {"CTU": 2, "CTD": 2, "CTUD": 3}
 _OPS = {"LD": "load", "A": "and", "O": "or"}
@@ -107,6 +107,11 @@ _LAD: dict[str, tuple[str, str]] = {
     "JMP": ("(JMP)", "@0"), "SCRT": ("(SCRT)", "@0"), "CSCRE": ("(SCRE)", ""),
     "CRET": ("(RET)", ""), "STOP": ("(STOP)", ""), "WDR": ("(WDR)", ""),
     "END": ("(END)", ""),
+    # interrupts (System Manual, "Interrupt instructions")
+    "ENI": ("(ENI)", ""), "DISI": ("(DISI)", ""), "CRETI": ("(RETI)", ""),
+    "RETI": ("(RETI)", ""),
+    "ATCH": ("ATCH", "INT=0 EVNT=1"), "DTCH": ("DTCH", "EVNT=0"),
+    "CEVNT": ("CLR_EVNT", "EVNT=0"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),
     # rail elements: coils, or boxes (a name without parentheses)

@@ -370,8 +370,14 @@ class Session:
         self._paused = net
         what = "stopped before" if stepped else "break at"
         # scan N is the one in progress: plc.scans counts the finished ones
-        self._print(f"{what} {self._label(net)} (t={sim_time(self.plc)} s, "
-                    f"scan {self.plc.scans + 1})")
+        irq = getattr(self.plc, "interrupts", None)
+        if irq is not None and irq.running:
+            # an interrupt routine runs at its own time inside the scan interval
+            self._print(f"{what} {self._label(net)} (t={self.plc._irq_t / 1e6:.3f} s, "
+                        f"an interrupt in scan {self.plc.scans + 1})")
+        else:
+            self._print(f"{what} {self._label(net)} (t={sim_time(self.plc)} s, "
+                        f"scan {self.plc.scans + 1})")
         self._new_diagnostics()
         self._show(net)
         if self._watches:

@@ -206,3 +206,28 @@ def test_what_the_cpu_refuses_is_a_located_compile_error(ob1, ints, message):
     with pytest.raises(PlcCompileError) as e:
         plcrt.load(program(ob1, *ints))
     assert message in str(e.value)
+
+
+def test_the_debugger_breaks_in_a_routine_at_the_interrupts_time():
+    import io
+
+    from plcrt.debug.session import Session
+    plc = plcrt.load(program("LD SM0.1\nMOVB 4, SMB34\nATCH INT_0, 10\nENI", COUNT),
+                     instrument=True)
+    out = io.StringIO()
+    s = Session(plc, out=out)
+    s.run(["break INT0/1", "run 1", "print VW0", "continue", "continue", "quit"])
+    text = out.getvalue()
+    assert "break at INT0/1 (t=0.004 s, an interrupt in scan 1)" in text
+    assert "break at INT0/1 (t=0.008 s, an interrupt in scan 1)" in text
+    assert "VW0 = 0" in text
+
+
+def test_coverage_counts_the_networks_of_interrupt_routines():
+    """Coverage sees a routine's networks when its event occurred (INT0),
+    not those of a routine whose event never came (INT1 on I0.1)."""
+    plc = plcrt.load(program("LD SM0.1\nMOVB 4, SMB34\nATCH INT_0, 10\nATCH INT_1, 2\nENI",
+                             COUNT, STAMP), instrument=True)
+    plc.run("20ms")
+    ran = plc.coverage.data()["networks"]
+    assert ran["INT0/1"] == 1 and ran["INT1/1"] == 0 and ran["OB1/1"] == 1

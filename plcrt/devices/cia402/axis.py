@@ -145,8 +145,10 @@ class Axis:
     def mechanical(self, t: int) -> int:
         """Whole counts in the plant's frame (switch positions), which
         homing does not move."""
-        if not self.legs:
+        if not self.legs and self.bounds is None:
             x = self._rest
+        elif not self.legs:
+            x = self.exact(t)[0]          # at rest, perhaps held at a mechanical end
         else:
             leg = self.legs[-1]
             if isinstance(leg, LinLeg) and len(self.legs) == 1 and self.bounds is None:

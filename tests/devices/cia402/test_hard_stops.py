@@ -356,3 +356,22 @@ def test_no_position_is_ever_beyond_an_end(model, neg, width, window, timeout, c
             assert d.read(0x60F4) == d.read(0x6062) - d.read(0x6064)
     if d.sm.state is not State.OPERATION_ENABLED:
         assert not d.axis.moving(d.now) and d.read(0x606C) == 0
+
+
+def test_homing_that_runs_into_an_end_faults_on_the_following_error():
+    """A method that is not -17 / -18 meets a mechanical end (Kinco 19, its home
+    switch placed beyond pos_stop): the switch is never reached, the demand
+    pushes on, and 6065h = 10000 (Kinco default), 6066h = 0 fault the drive
+    the µs the demand reaches 50000 + 10001."""
+    d = enabled(KINCO, DrivePlant(home_switch=(60_000, 70_000), pos_stop=50_000), 6)
+    for (index, sub), value in {(0x6098, 0): 19, (0x6099, 1): V, (0x6099, 2): 2000,
+                                (0x609A, 0): ACC}.items():
+        d.write(index, sub, value)
+    d.write(0x6040, 0, 0x1F)
+    t_fault = first_us(60_001)
+    d.advance(t_fault - 1)
+    assert d.sm.state is State.OPERATION_ENABLED and d.read(0x6064) == 50_000
+    d.advance(t_fault)
+    assert d.read(0x603F) == 0x8611 and d.read(0x6064) == 50_000
+    assert any(e.t_us == first_us(50_000) and "60F4h is supervised against 6065h = 10000"
+               in e.text for e in d.log)

@@ -375,3 +375,38 @@ def test_homing_that_runs_into_an_end_faults_on_the_following_error():
     assert d.read(0x603F) == 0x8611 and d.read(0x6064) == 50_000
     assert any(e.t_us == first_us(50_000) and "60F4h is supervised against 6065h = 10000"
                in e.text for e in d.log)
+
+
+@settings(max_examples=40, deadline=None)
+@given(method=st.sampled_from([-17, -18]), start=st.integers(NS, PS),
+       window=st.integers(0, 3000), current=st.integers(0, 1), vwin=st.integers(0, 50),
+       offset=st.integers(-2000, 2000), offset_mode=st.integers(0, 1))
+def test_kinco_hard_stop_homing_agrees_with_the_sequence(method, start, window, current, vwin,
+                                                          offset, offset_mode):
+    """Any start between the ends, any armed criteria, offset and offset mode:
+    the drive ends as the pure sequence does (outcome, time, position, 6064h),
+    and its axis is never beyond an end."""
+    params = HomingParams(method, V, 2000, ACC, offset, offset_mode=offset_mode,
+                          following_error_window=window, max_current=current,
+                          velocity_window=vwin)
+    pure = HomingPlant(NL - start, PL - start, neg_stop=NS - start, pos_stop=PS - start)
+    ref, _ = run(HomingSequence(KINCO, params, pure), 0, 0)
+    d = enabled(KINCO, plant_from(start), 6)
+    for (index, sub), value in {(0x6098, 0): method, (0x6099, 1): V, (0x6099, 2): 2000,
+                                (0x609A, 0): ACC, (0x607C, 0): offset,
+                                (0x6099, 5): offset_mode, (0x6065, 0): window,
+                                (0x6099, 4): current, (0x60F9, 10): vwin}.items():
+        d.write(index, sub, value)
+    d.write(0x6040, 0, 0x1F)
+    t = 0
+    while t < 3 * US:
+        t += 50_000
+        d.advance(t)
+        assert NS - start <= d.axis.exact(t)[0] <= PS - start
+    assert [e.t_us for e in d.log if ref.explanation in e.text] == [ref.t]
+    assert d.axis.mechanical(d.now) == ref.position
+    if isinstance(ref, Done):
+        assert d.position == ref.position + ref.position_shift
+        assert d.statusword & (B10 | B12 | B13 | B15) == B10 | B12 | B15
+    else:
+        assert isinstance(ref, Failed) and d.statusword & (B12 | B13) == B13

@@ -99,11 +99,9 @@ class SequencePlan:
     def _step(self, step: Step, moving: bool) -> HomingStep:
         assert self.seq is not None
         self.timer, self.stop_watch = None, False
-        pushing = moving
         while isinstance(step, Phase) and not step.segs and step.until is not None \
                 and step.until <= step.t0:
             step = self.seq.on_event(step.until, step.x0, "end")   # the stall holds at once
-            pushing = True                                          # the axis stops there
         if isinstance(step, Done):
             self.result, self.phase = step, None
             return HomingStep(outcome="attained",
@@ -124,7 +122,7 @@ class SequencePlan:
         self.stop_watch = STOP_WATCH in self._watch_at
         if not step.segs and step.until is not None:
             self.timer = (step.until, STALL_TIMER)
-        return HomingStep(motion=self._motion(step, pushing), watches=tuple(watches),
+        return HomingStep(motion=self._motion(step, moving), watches=tuple(watches),
                           note=f"homing phase {step.name} from {step.x0}")
 
     def _motion(self, ph: Phase, moving: bool) -> Optional[HomingMotion]:

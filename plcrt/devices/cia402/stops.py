@@ -122,11 +122,17 @@ class HardStops:
                     out.append((te, ("reach", side)))
         if self._supervised():
             window = d.param(0x6065)
-            if self.over is None and ax.legs:
+            fe = self._fe(now)
+            if self.over is None and abs(fe) > window:
+                # already beyond (6065h lowered, or supervision resumed): from now
+                out.append((now, ("over", 1 if fe > 0 else -1)))
+            elif self.over is None and ax.legs:
                 for side, end in self.ends.items():
                     te = self._reach(("over", side, window), end + side * (window + 1), side)
                     if te is not None:
                         out.append((te, ("over", side)))
+            elif self.over is not None and abs(fe) <= window:
+                out.append((now, ("back", self.over[1])))
             elif self.over is not None:
                 since, side = self.over
                 out.append((max(now, since + d.param(0x6066) * 1000), ("fault", side)))

@@ -410,3 +410,25 @@ def test_kinco_hard_stop_homing_agrees_with_the_sequence(method, start, window, 
         assert d.statusword & (B10 | B12 | B13 | B15) == B10 | B12 | B15
     else:
         assert isinstance(ref, Failed) and d.statusword & (B12 | B13) == B13
+
+
+def test_a_window_lowered_while_the_axis_stands_at_an_end_starts_the_time_out():
+    """HCFA PP blocked at pos_stop = 50000 with the demand at rest at 100000:
+    writing 6065h = 1000 (6066h = 5 ms) starts the time out at once, the
+    fault follows 5 ms later; raising 6065h back before then cancels it."""
+    d = enabled(HCFA, DrivePlant(pos_stop=50_000), 1)
+    pp(d, 100_000)
+    d.advance(10 * US)
+    d.write(0x6066, 0, 5)
+    d.write(0x6065, 0, 1000)
+    d.advance(10 * US + 4_000)
+    d.write(0x6065, 0, 60_000)                        # back within: no fault
+    d.advance(11 * US)
+    assert d.sm.state is State.OPERATION_ENABLED
+    assert any("back within 6065h = 60000" in e.text for e in d.log)
+    d.write(0x6065, 0, 1000)
+    t0 = d.now
+    d.advance(t0 + 4_999)
+    assert d.sm.state is State.OPERATION_ENABLED
+    d.advance(t0 + 5_000)
+    assert d.read(0x603F) == 0x8611 and d.read(0x6064) == 50_000

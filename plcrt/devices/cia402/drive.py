@@ -9,9 +9,10 @@ reach the drive through the store's write hook; the drive writes back
 6041h, 6061h, 6062h, 6064h, 606Ch, 603Fh, 1001h, 60F4h and 60FDh as they
 change.  :meth:`Drive.advance` moves time forward to an integer µs: the
 events inside (the end of a move, a limit switch, a watched homing position,
-the homing time limit) happen at their exact µs, as for the EM253, and the
-cost does not depend on the speed.  :meth:`Drive.cycle` is one bus cycle:
-advance, apply the RxPDO image, run the cycle, return the TxPDO image.
+the homing time limit, a mechanical end, :mod:`.stops`) happen at their
+exact µs, as for the EM253, and the cost does not depend on the speed.
+:meth:`Drive.cycle` is one bus cycle: advance, apply the RxPDO image, run
+the cycle, return the TxPDO image.
 
 Every refusal and diagnostic goes to :attr:`Drive.log` with its time and the
 manual section.

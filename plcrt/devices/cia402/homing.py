@@ -44,6 +44,11 @@ reverses the search (path B).  Phases at 6099h:02 start and stop at once;
 the axis stops at once at the home event.  Kinco latches the defining edge
 in the search when the search crosses it in the final direction (§2.5,
 method 12 from the positive side); HCFA re-approaches it at 6099h:02.
+Kinco -17 / -18 (§2.5) search at 6099h:01 toward the mechanical end
+(limits are not watched); from the end on, a standing "stall" phase lasts
+until the first armed criterion (6065h, 6099h:04, 60F9h:0A) holds, timed on
+the command that still runs at 6099h:01; a start at the end stalls at once,
+the command starting from rest.
 Decisions are logged in docs/cia402.md, "Homing".
 """
 

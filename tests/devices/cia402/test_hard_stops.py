@@ -432,3 +432,15 @@ def test_a_window_lowered_while_the_axis_stands_at_an_end_starts_the_time_out():
     assert d.sm.state is State.OPERATION_ENABLED
     d.advance(t0 + 5_000)
     assert d.read(0x603F) == 0x8611 and d.read(0x6064) == 50_000
+
+
+def test_a_move_that_ends_on_the_end_itself_reaches_its_target():
+    """PP to exactly pos_stop: the axis arrives, bit 10 is set, 60F4h stays 0
+    (with 6065h = 0) and nothing is blocked."""
+    d = enabled(KINCO, DrivePlant(pos_stop=50_000), 1)
+    d.write(0x6065, 0, 0)
+    pp(d, 50_000)
+    d.advance(5 * US)
+    assert d.read(0x6064) == 50_000 and d.read(0x60F4) == 0 and d.statusword & B10
+    assert d.sm.state is State.OPERATION_ENABLED
+    assert not any("stands" in e.text for e in d.log)

@@ -71,8 +71,9 @@ class HardStops:
         d = self.d
         if d.sm.state not in (State.OPERATION_ENABLED, State.QUICK_STOP_ACTIVE):
             return False
-        if d.mode_number == 6:
-            return d.param(0x6098) not in STALL_METHODS
+        if d.mode_number == 6:         # a running -17/-18 takes 60F4h as its stall criterion
+            running = d.engines[6].plan is not None  # type: ignore[attr-defined]
+            return not running or d.param(0x6098) not in STALL_METHODS
         return d.mode_number in SUPERVISED
 
     def side_held(self, t: int) -> Optional[int]:

@@ -444,3 +444,23 @@ def test_a_move_that_ends_on_the_end_itself_reaches_its_target():
     assert d.read(0x6064) == 50_000 and d.read(0x60F4) == 0 and d.statusword & B10
     assert d.sm.state is State.OPERATION_ENABLED
     assert not any("stands" in e.text for e in d.log)
+
+
+def test_a_halted_stall_is_supervised_again():
+    """Halt (bit 8) during the -17 stall abandons the homing with the demand
+    past the end; the following error is then supervised as in any mode:
+    6065h = 1000, 6066h = 0 fault the drive while 609Ah ramps the demand down."""
+    d = enabled(KINCO, plant_from(0), 6)
+    for (index, sub), value in {(0x6098, 0): -17, (0x6099, 1): V, (0x6099, 2): 2000,
+                                (0x609A, 0): ACC, (0x6065, 0): 10_000}.items():
+        d.write(index, sub, value)             # the stall criterion is 0.5 s away
+    d.write(0x6040, 0, 0x1F)
+    d.advance(660_000)
+    assert d.read(0x60F4) == -200 and d.sm.state is State.OPERATION_ENABLED
+    d.write(0x6065, 0, 1000)                   # the running stall ignores it
+    d.advance(670_000)
+    assert d.read(0x60F4) == -400 and d.sm.state is State.OPERATION_ENABLED
+    d.write(0x6040, 0, 0x11F)                  # halt: homing abandoned, 609Ah ramp of 1000
+    d.advance(800_000)
+    assert d.read(0x603F) == 0x8611 and d.read(0x6064) == NS
+    assert not any("home at" in e.text for e in d.log)

@@ -14,6 +14,12 @@ by bisection on the polynomial at 1 µs resolution, never by stepping through
 pulses: the cost of simulating a second does not depend on the speed.
 ``evaluations`` counts polynomial evaluations, so tests can show that.
 
+Mechanical ends (``bounds``, the plant's ``neg_stop`` / ``pos_stop``): the
+plan is the *demand*, which may run past an end; the axis itself is the
+demand clamped to the ends, at rest there while the demand is beyond
+(:meth:`demand` / :meth:`demand_position` read the demand, everything else
+the axis).  :mod:`.stops` finds the times and reacts.
+
 What it is not: no drive logic; the modes (:mod:`.modes`) decide what to plan.
 Speeds are P/s, accelerations P/s², times integer µs.
 """
@@ -75,6 +81,8 @@ class Axis:
         self.evaluations = 0        #: polynomial evaluations (for cost tests)
         self.version = 0            #: changes whenever the plan changes
         self._memo: tuple = (None, None, None)
+        #: mechanical ends (neg, pos) in the plant's frame; None: no end (plant.neg_stop/pos_stop)
+        self.bounds: Optional[tuple[Optional[int], Optional[int]]] = None
 
     # ---------------------------------------------------------------- state
     def _leg_x(self, leg: AnyLeg, t: int | Fraction) -> tuple[Fraction, Fraction]:
@@ -100,7 +108,24 @@ class Axis:
         return leg.origin + leg.direction * last.x1, leg.direction * last.v1
 
     def exact(self, t: int) -> tuple[Fraction, Fraction]:
-        """Exact position and signed speed (P/s) at integer µs *t*."""
+        """Exact position and signed speed (P/s) of the axis at integer µs
+        *t*: the demand, held at a mechanical end it runs past."""
+        out = self.demand(t)
+        if self.bounds is not None:
+            neg, pos = self.bounds
+            if neg is not None and out[0] < neg:
+                return Fraction(neg), ZERO
+            if pos is not None and out[0] > pos:
+                return Fraction(pos), ZERO
+        return out
+
+    def demand_position(self, t: int) -> int:
+        """6062h outside CSP: whole counts of the demand (plus the shift)."""
+        x = self.demand(t)[0]
+        return x.numerator // x.denominator + self.shift
+
+    def demand(self, t: int) -> tuple[Fraction, Fraction]:
+        """Exact position and signed speed (P/s) of the plan at integer µs *t*."""
         if self._memo[0] == t and self._memo[1] == self.version:
             return self._memo[2]
         out = self._rest, ZERO
@@ -120,12 +145,14 @@ class Axis:
     def mechanical(self, t: int) -> int:
         """Whole counts in the plant's frame (switch positions), which
         homing does not move."""
-        if not self.legs:
+        if not self.legs and self.bounds is None:
             x = self._rest
+        elif not self.legs:
+            x = self.exact(t)[0]          # at rest, perhaps held at a mechanical end
         else:
             leg = self.legs[-1]
-            if isinstance(leg, LinLeg) and len(self.legs) == 1:   # CSP: integers only
-                if t >= leg.t1:
+            if isinstance(leg, LinLeg) and len(self.legs) == 1 and self.bounds is None:
+                if t >= leg.t1:                                     # perf: CSP, integers only
                     return leg.x1
                 tt = max(t, leg.t0)
                 return leg.x0 + (leg.x1 - leg.x0) * (tt - leg.t0) // (leg.t1 - leg.t0)
@@ -137,8 +164,8 @@ class Axis:
         if not self.legs:
             return 0
         leg = self.legs[-1]
-        if isinstance(leg, LinLeg) and len(self.legs) == 1:      # CSP: integers only
-            if t >= leg.t1 or t < leg.t0:
+        if isinstance(leg, LinLeg) and len(self.legs) == 1 and self.bounds is None:
+            if t >= leg.t1 or t < leg.t0:                           # perf: CSP, integers only
                 return 0
             num, den = (leg.x1 - leg.x0) * US, leg.t1 - leg.t0
             return num // den if num >= 0 else -(-num // den)
@@ -166,8 +193,9 @@ class Axis:
         return leg.direction * leg.segs[-1].v1
 
     def settle(self, t: int) -> None:
-        """The plan is over at *t*: keep its end position, drop the plan."""
-        x, _ = self.exact(t)
+        """The plan is over at *t*: keep its end position (the demand, also
+        past a mechanical end), drop the plan."""
+        x, _ = self.demand(t)
         self._set(x, [])
 
     def _set(self, rest: Fraction, legs: list[AnyLeg]) -> None:
@@ -184,7 +212,8 @@ class Axis:
 
     # ---------------------------------------------------------------- planning
     def stop_at_once(self, t: int) -> None:
-        """Stop where the axis is (a drive switched off, a zero deceleration)."""
+        """Stop where the axis is (a drive switched off, a zero deceleration);
+        a demand past a mechanical end comes back to the axis held there."""
         self._set(self.exact(t)[0], [])
 
     def set_position(self, t: int, value: int) -> None:
@@ -211,8 +240,8 @@ class Axis:
         return t_end, x + leg.direction * travel
 
     def stop(self, t: int, dec: int) -> None:
-        """Ramp to rest at *dec* P/s² (0: at once)."""
-        x, v = self.exact(t)
+        """Ramp the demand to rest at *dec* P/s² (0: at once)."""
+        x, v = self.demand(t)
         leg = self._stop_leg(Fraction(t), x, v, dec)
         self._set(x, [leg] if leg else [])
 
@@ -223,7 +252,7 @@ class Axis:
         if the axis cannot stop before it."""
         if not mechanical:
             target -= self.shift
-        x, v = self.exact(t)
+        x, v = self.demand(t)
         legs: list[AnyLeg] = []
         t0: Fraction = Fraction(t)
         r_dec = Fraction(dec, US)
@@ -238,12 +267,12 @@ class Axis:
             segs, _ = plan_distance(t0, Fraction(0), abs(v), Fraction(v_max), Fraction(0),
                                     length, Fraction(acc, US), r_dec)
             legs.append(Leg(direction, x, segs))
-        self._set(self.exact(t)[0] if not legs else x, legs)
+        self._set(self.demand(t)[0] if not legs else x, legs)
 
     def run_at(self, t: int, v_target: int, acc: int, dec: int) -> None:
         """Change speed to *v_target* (signed P/s) with *acc* when the speed
         grows and *dec* when it falls (0: at once), then cruise without end."""
-        x, v = self.exact(t)
+        x, v = self.demand(t)
         legs: list[AnyLeg] = []
         t0: Fraction = Fraction(t)
         if v != 0 and (v_target == 0 or (v_target > 0) != (v > 0)):
@@ -279,13 +308,19 @@ class Axis:
 
     # ---------------------------------------------------------------- crossings
     def first_reach(self, t_from: int, level: int, direction: int,
-                    mechanical: bool = False) -> Optional[int]:
+                    mechanical: bool = False, demand: bool = False) -> Optional[int]:
         """First integer µs ``>= t_from`` at which the count (the plant
         position with *mechanical*) reaches *level* moving in *direction*
         (+1: count >= level; -1: count <= level), or None.  Only legs moving
-        that way count."""
+        that way count.  The axis never reaches a level past a mechanical
+        end; the *demand* does."""
         if not mechanical:
             level -= self.shift
+        if self.bounds is not None and not demand:
+            neg, pos = self.bounds
+            if (direction > 0 and pos is not None and level > pos) or \
+                    (direction < 0 and neg is not None and level < neg):
+                return None
 
         def cond(x: Fraction) -> bool:
             return x >= level if direction > 0 else x < level + 1

@@ -9,9 +9,10 @@ reach the drive through the store's write hook; the drive writes back
 6041h, 6061h, 6062h, 6064h, 606Ch, 603Fh, 1001h, 60F4h and 60FDh as they
 change.  :meth:`Drive.advance` moves time forward to an integer µs: the
 events inside (the end of a move, a limit switch, a watched homing position,
-the homing time limit) happen at their exact µs, as for the EM253, and the
-cost does not depend on the speed.  :meth:`Drive.cycle` is one bus cycle:
-advance, apply the RxPDO image, run the cycle, return the TxPDO image.
+the homing time limit, a mechanical end, :mod:`.stops`) happen at their
+exact µs, as for the EM253, and the cost does not depend on the speed.
+:meth:`Drive.cycle` is one bus cycle: advance, apply the RxPDO image, run
+the cycle, return the TxPDO image.
 
 Every refusal and diagnostic goes to :attr:`Drive.log` with its time and the
 manual section.
@@ -39,6 +40,7 @@ from .pdo import ASSIGN, RX_MAPS, TX_MAPS, PdoConfig, pack, unpack
 from .plant import DrivePlant
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
+from .stops import HardStops
 from .store import Store, Write
 
 __all__ = ["Drive", "DriveEvent"]
@@ -46,7 +48,8 @@ __all__ = ["Drive", "DriveEvent"]
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
 #: (no speed limit then) and no P03.07 (no homing time limit).
-_ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0}
+_ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0,
+           (0x6099, 4): 0, (0x60F9, 10): 0}
 _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an error
 
 
@@ -102,6 +105,8 @@ class Drive:
         self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
         self._batch = False
         self._rx_noted = False
+        self.stops = HardStops(self) if (self.plant.neg_stop is not None
+                                         or self.plant.pos_stop is not None) else None
         self.store.on_write(self._on_write)
         self._mirror()
         self.publish()
@@ -363,6 +368,9 @@ class Drive:
             assert isinstance(hm, Homing)
             if hm.deadline is not None:
                 offer(max(hm.deadline, self.now), "timeout", None)
+        if self.stops is not None:                     # mechanical ends (stops.py)
+            for te, ev in self.stops.events():
+                offer(te, "stop", ev)
         return best
 
     def advance(self, t_us: int) -> None:
@@ -384,7 +392,7 @@ class Drive:
                     self.axis.settle(te)
                     self._qs_wait = False
                     self._do(te, self.sm.motion_stopped(te / 1e6))
-                else:
+                elif self.stops is None or not self.stops.holds_end(te):
                     self.mode.motion_end(te)
                 if self.axis.legs and self.axis.end_time() == te:
                     self.axis.settle(te)
@@ -406,6 +414,9 @@ class Drive:
                 hm = self.engines[6]
                 assert isinstance(hm, Homing)
                 hm.timeout(te)
+            elif kind == "stop":
+                assert self.stops is not None
+                self.stops.on_event(te, data)  # type: ignore[arg-type]
         else:
             raise PlcError(f"drive: more than {_MAX_EVENTS} events before {t_us} µs "
                            "(a homing plan that does not move on?)")
@@ -532,6 +543,9 @@ class Drive:
         fe = csp.following_error if self.mode_number == 8 else 0
         demand = csp.demand if self.mode_number == 8 and self.sm.state is \
             State.OPERATION_ENABLED else pos
+        if self.stops is not None and self.mode_number != 8:
+            demand = self.axis.demand_position(t)      # past a mechanical end (stops.py)
+            fe = demand - pos
         values = {0x6041: self.sm.statusword, 0x6061: self.mode_number, 0x6062: demand,
                   0x6064: pos, 0x606C: self.axis.velocity(t), 0x603F: self.sm.error_code,
                   0x1001: self.sm.error_register, 0x60F4: fe,

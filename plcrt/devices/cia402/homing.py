@@ -44,6 +44,11 @@ reverses the search (path B).  Phases at 6099h:02 start and stop at once;
 the axis stops at once at the home event.  Kinco latches the defining edge
 in the search when the search crosses it in the final direction (§2.5,
 method 12 from the positive side); HCFA re-approaches it at 6099h:02.
+Kinco -17 / -18 (§2.5) search at 6099h:01 toward the mechanical end
+(limits are not watched); from the end on, a standing "stall" phase lasts
+until the first armed criterion (6065h, 6099h:04, 60F9h:0A) holds, timed on
+the command that still runs at 6099h:01; a start at the end stalls at once,
+the command starting from rest.
 Decisions are logged in docs/cia402.md, "Homing".
 """
 
@@ -325,8 +330,7 @@ class HomingSequence:
         for need in m.needs():
             missing = {NLS: plant.neg_limit, PLS: plant.pos_limit,
                        "home_switch": plant.home_switch, "index_period": plant.index_period,
-                       "hard_stop_neg": plant.hard_stop_neg,
-                       "hard_stop_pos": plant.hard_stop_pos}[need] is None
+                       "neg_stop": plant.neg_stop, "pos_stop": plant.pos_stop}[need] is None
             if missing:
                 what = SIGNAL_NAMES.get(need, need)
                 extra = " (an index method needs closed loop and an encoder with Z, HCFA §2.2)" \
@@ -426,12 +430,15 @@ class HomingSequence:
     def _stall_search(self, t: int, x: int) -> Step:
         m = self.method
         assert m is not None
-        stop = self.plant.hard_stop_neg if m.search < 0 else self.plant.hard_stop_pos
+        stop = self.plant.neg_stop if m.search < 0 else self.plant.pos_stop
         assert stop is not None
-        if (stop - x) * m.search <= 0:
-            return self._stall(t, stop, t)
-        return self._phase("stall search", t, x, m.search, self._to_speed(t, F0, self.vh),
-                           [Watch(stop, "hard_stop")], limits=False)
+        at_stop = (stop - x) * m.search <= 0
+        # the command runs at 6099h:01 from rest also from a start at the end: it
+        # times the following error and velocity window criteria (Kinco §2.5)
+        phase = self._phase("stall search", t, stop if at_stop else x, m.search,
+                            self._to_speed(t, F0, self.vh), [Watch(stop, "hard_stop")],
+                            limits=False)
+        return self._stall(t, stop, t) if at_stop else phase
 
     def _stall(self, t: int, x: int, t_stall: int) -> Step:
         """Kinco §2.5: the first of three criteria zeroes the position."""

@@ -9,10 +9,10 @@ module registers on import; :mod:`.drive` imports it.
 The translation (HCFA §7.5.4, Kinco §2.1):
 
 * the drive's :class:`~.plant.DrivePlant` becomes a
-  :class:`~.homing_methods.HomingPlant` (the drive's plant has no
-  mechanical ends, so Kinco -17 / -18 fail with the sequence's explanation);
-* 6098h, 6099h:01 / :02, 609Ah, 607Ch, Kinco 6099h:05 / :06 and HCFA P03.07
-  become :class:`~.homing.HomingParams`;
+  :class:`~.homing_methods.HomingPlant`, mechanical ends included;
+* 6098h, 6099h:01 / :02, 609Ah, 607Ch, Kinco 6099h:05 / :06, HCFA P03.07
+  and the stall criteria of Kinco -17 / -18 (6065h, 6099h:04, 60F9h:0A,
+  §2.5) become :class:`~.homing.HomingParams`;
 * a :class:`~.homing.Phase` becomes a motion and the phase's watches: a
   phase of constant speed or a ramp to a speed is ``"velocity"`` (a phase
   whose first segment cruises starts at that speed at once, the stepper
@@ -20,6 +20,13 @@ The translation (HCFA §7.5.4, Kinco §2.1):
   the Kinco offset move is ``"position"``; a phase that starts from rest
   while the axis moves (reversal at a limit, after leaving the switch) asks
   the drive to stop at once first (``HomingMotion.from_rest``);
+* the stall of Kinco -17 / -18 (a standing phase until the first stall
+  criterion holds) keeps the demand running into the mechanical end, so
+  60F4h grows as on a real drive, and ends by the plan's ``timer``; a
+  stall that holds at once (6099h:04, or 60F9h:0A after the ramp) ends at
+  once.  A start at the end pushes into it at 6099h:01.  The sequence's
+  watch of the end is not a count watch: the drive's :mod:`.stops` reports
+  it (``stop_watch``) at the µs the demand reaches the end;
 * the drive's ``"stopped"`` event is the phase's ``"end"``; a watch reports
   the watched position itself, as :meth:`Phase.first_event` does;
 * :class:`~.homing.Done` is ``"attained"`` with ``home_position`` = the
@@ -42,13 +49,16 @@ from .homing_plan import HomingMotion, HomingRequest, HomingStep, Watch, registe
 
 __all__ = ["SequencePlan", "homing_params", "homing_plant", "install"]
 
+STALL_TIMER = "stall"   #: the timer event that ends a standing phase
+STOP_WATCH = "hard_stop"   #: the sequence's watch of a mechanical end (reported by stops.py)
+
 
 def homing_plant(request: HomingRequest) -> HomingPlant:
     """The drive's plant as the homing sequence sees it."""
     p = request.plant
     return HomingPlant(neg_limit=p.neg_limit, pos_limit=p.pos_limit,
                        home_switch=p.home_switch, index_period=p.index_period,
-                       index_phase=p.index_phase)
+                       index_phase=p.index_phase, neg_stop=p.neg_stop, pos_stop=p.pos_stop)
 
 
 def homing_params(request: HomingRequest) -> HomingParams:
@@ -56,7 +66,10 @@ def homing_params(request: HomingRequest) -> HomingParams:
     return HomingParams(method=request.method, v_search=request.fast, v_zero=request.slow,
                         accel=request.accel, offset=request.offset,
                         offset_mode=request.offset_mode, blind_zone=request.blind_zone,
-                        timeout_ms=request.timeout_ms)
+                        timeout_ms=request.timeout_ms,
+                        following_error_window=request.following_error_window,
+                        max_current=request.max_current,
+                        velocity_window=request.velocity_window)
 
 
 class SequencePlan:
@@ -67,6 +80,8 @@ class SequencePlan:
         self.phase: Optional[Phase] = None
         self.result: Optional[Done | Failed] = None
         self._watch_at: dict[str, int] = {}
+        self.timer: Optional[tuple[int, str]] = None   #: (µs, event) of a standing phase
+        self.stop_watch = False    #: the phase waits for the axis to reach a mechanical end
 
     def start(self, request: HomingRequest) -> HomingStep:
         self.seq = HomingSequence(request.model, homing_params(request), homing_plant(request))
@@ -74,7 +89,7 @@ class SequencePlan:
 
     def event(self, name: str, t_us: int, position: int) -> HomingStep:
         assert self.seq is not None
-        if name == "stopped":
+        if name in ("stopped", STALL_TIMER):
             step = self.seq.on_event(t_us, position, "end")
         else:
             step = self.seq.on_event(t_us, self._watch_at.get(name, position), name)
@@ -82,6 +97,11 @@ class SequencePlan:
 
     # -- translation ------------------------------------------------------------------
     def _step(self, step: Step, moving: bool) -> HomingStep:
+        assert self.seq is not None
+        self.timer, self.stop_watch = None, False
+        while isinstance(step, Phase) and not step.segs and step.until is not None \
+                and step.until <= step.t0:
+            step = self.seq.on_event(step.until, step.x0, "end")   # the stall holds at once
         if isinstance(step, Done):
             self.result, self.phase = step, None
             return HomingStep(outcome="attained",
@@ -96,13 +116,25 @@ class SequencePlan:
         watches = []
         for w in step.watches:
             self._watch_at.setdefault(w.event, w.position)
-            watches.append(Watch(w.event, w.position, step.direction))
-        return HomingStep(motion=self._motion(step), watches=tuple(watches),
+            if w.event != STOP_WATCH:
+                watches.append(Watch(w.event, w.position, step.direction))
+        # the drive's mechanical ends report the end itself, at the µs the demand reaches it
+        self.stop_watch = STOP_WATCH in self._watch_at
+        if not step.segs and step.until is not None:
+            self.timer = (step.until, STALL_TIMER)
+        return HomingStep(motion=self._motion(step, moving), watches=tuple(watches),
                           note=f"homing phase {step.name} from {step.x0}")
 
-    def _motion(self, ph: Phase) -> HomingMotion:
+    def _motion(self, ph: Phase, moving: bool) -> Optional[HomingMotion]:
         assert self.seq is not None
         rate = self.seq.params.accel
+        if ph.name == "stall":
+            # Kinco §2.5: the demand pushes on at 6099h:01 against the end (60F4h grows)
+            if moving:
+                return None
+            m = self.seq.method
+            assert m is not None
+            return HomingMotion("velocity", m.search * int(self.seq.vh), accel=rate)
         if not ph.segs:
             return HomingMotion("stop", accel=0)
         first, last = ph.segs[0], ph.segs[-1]

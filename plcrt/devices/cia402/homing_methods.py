@@ -19,8 +19,9 @@ Plant conventions (docs/cia402.md, "Homing"):
   matters), methods 5, 6, 21, 22 as a *negative* one (active left of ``hi``),
   methods 7-14 and 23-30 as a zone with both edges;
 * index pulses lie at ``index_phase + k * index_period``;
-* mechanical ends (hard stops, Kinco -17/-18) at ``hard_stop_neg`` /
-  ``hard_stop_pos``: the axis cannot pass them.
+* mechanical ends (hard stops, Kinco -17/-18) at ``neg_stop`` /
+  ``pos_stop`` (the names of :class:`~.plant.DrivePlant`): the axis cannot
+  pass them.
 """
 
 from __future__ import annotations
@@ -40,7 +41,8 @@ SIGNAL_NAMES = {
     NLS: "negative limit switch (NLS)", PLS: "positive limit switch (PLS)",
     HS_POS: "home switch (positive level)", HS_NEG: "home switch (negative level)",
     HS_ZONE: "home switch (zone)", INDEX: "index pulse", HERE: "present position",
-    HARD_STOP: "mechanical end",
+    HARD_STOP: "mechanical end", "neg_stop": "negative mechanical end",
+    "pos_stop": "positive mechanical end",
 }
 
 
@@ -53,8 +55,8 @@ class HomingPlant:
     home_switch: tuple[int, int] | None = None
     index_period: int | None = None
     index_phase: int = 0
-    hard_stop_neg: int | None = None
-    hard_stop_pos: int | None = None
+    neg_stop: int | None = None
+    pos_stop: int | None = None
 
     def __post_init__(self) -> None:
         if self.home_switch is not None and self.home_switch[0] > self.home_switch[1]:
@@ -65,6 +67,10 @@ class HomingPlant:
                 and self.neg_limit >= self.pos_limit):
             raise PlcConfigError(f"homing plant: neg_limit {self.neg_limit} must lie left of "
                                  f"pos_limit {self.pos_limit}")
+        if self.neg_stop is not None and self.pos_stop is not None \
+                and self.neg_stop >= self.pos_stop:
+            raise PlcConfigError(f"homing plant: neg_stop {self.neg_stop} must lie left of "
+                                 f"pos_stop {self.pos_stop}")
 
     def limit_active(self, which: str, x: int) -> bool:
         if which == NLS:
@@ -97,7 +103,7 @@ class Method:
         if self.signal in (HS_POS, HS_NEG, HS_ZONE):
             need.append("home_switch")
         if self.signal == HARD_STOP:
-            need.append("hard_stop_neg" if self.search < 0 else "hard_stop_pos")
+            need.append("neg_stop" if self.search < 0 else "pos_stop")
         if self.index:
             need.append("index_period")
         return need

@@ -22,8 +22,15 @@ How a drive runs a plan (``plcrt.devices.cia402.modes.Homing``):
    ``outcome = "error"``: the axis stops at once; bit 13 (HCFA §7.5.4).
    ``fault``: (603Fh, alarm, why) is raised (e.g. 62, 63).
 4. Bit 4 falling, halt (bit 8), leaving OPERATION ENABLED, a mode change or
-   the time limit P03.07 end the plan; it is not told (a new start makes a new
-   plan).  Limit switches do not stop the axis while homing (HCFA safety note
+   the time limit P03.07 end the plan; it is not told (a new start makes a
+   new plan).
+5. A plan may carry a ``timer`` attribute, ``(t_us, name)`` or None: the
+   drive reports ``name`` at ``t_us`` (a standing phase, e.g. the stall of
+   Kinco -17 / -18 while the demand pushes on against a mechanical end).
+   Mechanical ends (:class:`~.plant.DrivePlant` ``neg_stop`` / ``pos_stop``)
+   hold the axis in homing as in every mode (:mod:`.stops`); a plan whose
+   ``stop_watch`` attribute is true is told ``"hard_stop"`` at the µs the
+   demand reaches one.  Limit switches do not stop the axis while homing (HCFA safety note
    §1: POT/NOT are not limit stops during homing); a plan watches them itself.
 
 Positions in watches, ``"position"`` motions and events are in the plant's
@@ -60,6 +67,9 @@ class HomingRequest:
     offset_mode: int = 0  #: Kinco 6099h:05 (§2.3-3)
     blind_zone: int = 0   #: Kinco 6099h:06 (§2.4)
     timeout_ms: int = 0   #: HCFA P03.07 (§8.2), 0 = off
+    following_error_window: int = 0  #: 6065h (Kinco -17/-18 stall criterion 1, §2.5)
+    max_current: int = 0             #: Kinco 6099h:04 (stall criterion 2, §2.5)
+    velocity_window: int = 0         #: Kinco 60F9h:0A (stall criterion 3, §2.5)
 
 
 @dataclass(frozen=True, slots=True)

@@ -370,7 +370,9 @@ class Homing(Mode):
                             d.param(0x609A), d.param(0x607C), d.axis.position(t),
                             d.axis.mechanical(t), t, d.plant,
                             offset_mode=d.param(0x6099, 5), blind_zone=d.param(0x6099, 6),
-                            timeout_ms=d.param(0x2003, 7))
+                            timeout_ms=d.param(0x2003, 7),
+                            following_error_window=d.param(0x6065),
+                            max_current=d.param(0x6099, 4), velocity_window=d.param(0x60F9, 10))
         zero = [n for n, x in (("6099h:01", req.fast), ("6099h:02", req.slow),
                                ("609Ah", req.accel)) if x == 0]
         if zero and method not in (35, 37):

@@ -307,7 +307,7 @@ def test_kinco_hard_stop_homes_on_the_mechanical_end(n, stop, crit, delay):
 def test_kinco_velocity_window_is_armed_after_the_ramp():
     """A stop reached during the acceleration ramp is detected by the
     velocity window only when the ramp would end (digest §4.4)."""
-    plant = HomingPlant(hard_stop_neg=-400)
+    plant = HomingPlant(neg_stop=-400)
     result, _ = home(KINCO, -17, 0, plant, velocity_window=10)
     assert result.home_point == -400
     assert result.t == V_HIGH * 10**6 // ACC

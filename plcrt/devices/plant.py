@@ -24,6 +24,8 @@
     home_switch = [-1000, 1000] # home switch active in this closed range
     index_period = 10000        # one index pulse per period ...
     index_phase = 0             # ... at this position (and +/- periods)
+    neg_stop = -60000           # mechanical ends (hard stops), beyond the limits
+    pos_stop = 60000
     params = { "6099:01" = 20000, "6099:02" = 2000 }   # written by SDO at start-up
 
 Only this module reads the format; it returns plain dataclasses that the

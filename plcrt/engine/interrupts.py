@@ -95,8 +95,10 @@ class Interrupts:
     generated code); *warn(message, key)* reports a diagnostic once."""
 
     def __init__(self, sm: bytearray, run_routine: Callable[[int], None],
-                 warn: Callable[[str, str], None]) -> None:
+                 warn: Callable[[str, str], None],
+                 set_time: Callable[[int], None] = lambda t: None) -> None:
         self.sm = sm
+        self.set_time = set_time                     #: tells the engine the routines' time
         self.run_routine = run_routine
         self.warn = warn
         self.attached: dict[int, int] = {}          #: event -> INT number
@@ -225,6 +227,13 @@ class Interrupts:
                 self.timed_next[event] = t + self.timed_period[event]
                 self.timed_fired.add(event)
                 self.post(event, t)
+
+    def fire(self, t: int) -> None:
+        """The scheduler's call (:class:`plcrt.engine.events.EventSource`):
+        the timed occurrences due at *t*, then the routines, at *t*."""
+        self.set_time(t)
+        self.fire_timed(t)
+        self.dispatch(t)
 
     def state(self) -> dict[str, Any]:
         """What the tools show: attached events, enabled, queued, counts."""

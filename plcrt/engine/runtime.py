@@ -35,6 +35,7 @@ from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
 from .access import AddressAccess
+from .events import Scheduler
 from .interrupts import Interrupts
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
@@ -106,7 +107,10 @@ class Plc(AddressAccess):
         self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0, 0]
         self.devices: list[Any] = []
         #: the interrupt system; routines run through _run_interrupt
-        self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn)
+        self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn,
+                                     self._irq_time)
+        #: one time line for the scan interval: event sources in priority order
+        self.scheduler = Scheduler(self, [self.interrupts])
         self._irq_t = 0            #: the time the running code executes at (µs)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
@@ -237,7 +241,7 @@ class Plc(AddressAccess):
             if self._ob1 is not None:
                 self._ob1(l_ob1)
             if irq.timed_next:
-                self._events(now, now + self.scan_us)
+                self.scheduler.run(now, now + self.scan_us)
             elif self.devices:
                 t_to = now + self.scan_us
                 for dev in self.devices:
@@ -261,26 +265,6 @@ class Plc(AddressAccess):
             for fn in self.observers:
                 fn(self)
 
-    def _events(self, t_from: int, t_to: int) -> None:
-        """The scan interval (t_from, t_to] in time order: at every timed
-        interrupt the devices are advanced to its time and its routine runs
-        there; then the devices go on to t_to."""
-        irq, devices = self.interrupts, self.devices
-        t = t_from
-        while True:
-            te = irq.next_time(t, t_to)
-            if te is None:
-                break
-            for dev in devices:
-                dev.step(self, t, te)
-            self._irq_t = te
-            irq.fire_timed(te)
-            irq.dispatch(te)
-            t = te
-        if t < t_to:
-            for dev in devices:
-                dev.step(self, t, t_to)
-
     def _run_interrupt(self, number: int) -> None:
         """Run INT *number* now.  The CPU saves and restores the
         accumulators and the status bits SMB1 around a routine (System
@@ -295,6 +279,9 @@ class Plc(AddressAccess):
         finally:
             acc[:] = saved_ac
             sm[1] = saved_sm1
+
+    def _irq_time(self, t: int) -> None:
+        self._irq_t = t
 
     def _irq_warn(self, message: str, key: str) -> None:
         self.warn(message, None, key)

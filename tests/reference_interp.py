@@ -195,6 +195,9 @@ class ReferencePlc:
         scan_ms = min(self.scan_us // 1000, 0xFFFF)
         for offset in (22, 24, 26):
             self.mem["SM"][offset:offset + 2] = scan_ms.to_bytes(2, "big")
+        # SM66.7 / SM76.7: both pulse outputs idle (no PLS in these programs)
+        if self.scans == 0:
+            self.mem["SM"][66] = self.mem["SM"][76] = 0x80
 
     # -- operands -------------------------------------------------------------
     def address(self, text: str) -> Addr | None:

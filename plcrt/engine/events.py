@@ -41,9 +41,17 @@ class EventSource(Protocol):
 class Scheduler:
     """The sources and devices of one PLC, run in time order."""
 
-    def __init__(self, plc: Any, sources: list[EventSource]) -> None:
+    def __init__(self, plc: Any, sources: list[EventSource],
+                 after: Any = None) -> None:
         self.plc = plc
         self.sources = sources
+        #: called once after the events of one instant fired (the interrupt
+        #: system runs the routines they posted)
+        self.after = after
+
+    def busy(self, t_from: int, t_to: int) -> bool:
+        """Whether a source has an event in (t_from, t_to]."""
+        return any(src.next_time(t_from, t_to) is not None for src in self.sources)
 
     def run(self, t_from: int, t_to: int) -> None:
         """Run (t_from, t_to]: events in time order, devices advanced to each."""
@@ -51,16 +59,23 @@ class Scheduler:
         t = t_from
         while True:
             best: Optional[int] = None
-            first: Any = None
-            for src in sources:     # sources in priority order win ties
+            due: list[Any] = []
+            for src in sources:     # in priority order: ties fire in this order
                 te = src.next_time(t, t_to)
-                if te is not None and (best is None or te < best):
-                    best, first = te, src
+                if te is None:
+                    continue
+                if best is None or te < best:
+                    best, due = te, [src]
+                elif te == best:
+                    due.append(src)
             if best is None:
                 break
             for dev in devices:
                 dev.step(plc, t, best)
-            first.fire(best)
+            for src in due:
+                src.fire(best)
+            if self.after is not None:
+                self.after(best)
             t = best
         if t < t_to:
             for dev in devices:

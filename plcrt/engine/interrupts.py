@@ -230,9 +230,13 @@ class Interrupts:
 
     def fire(self, t: int) -> None:
         """The scheduler's call (:class:`plcrt.engine.events.EventSource`):
-        the timed occurrences due at *t*, then the routines, at *t*."""
-        self.set_time(t)
+        post the timed occurrences due at *t* (the routines run in
+        :meth:`run_at`, once every source of the instant has fired)."""
         self.fire_timed(t)
+
+    def run_at(self, t: int) -> None:
+        """Run what is queued, at time *t*."""
+        self.set_time(t)
         self.dispatch(t)
 
     def state(self) -> dict[str, Any]:

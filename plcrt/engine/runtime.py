@@ -37,6 +37,7 @@ from .timers import TimerBank
 from .access import AddressAccess
 from .events import Scheduler
 from .interrupts import Interrupts
+from .pulse import make_outputs
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
 
@@ -109,8 +110,11 @@ class Plc(AddressAccess):
         #: the interrupt system; routines run through _run_interrupt
         self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn,
                                      self._irq_time)
+        #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
+        self.pulse = make_outputs(self)
         #: one time line for the scan interval: event sources in priority order
-        self.scheduler = Scheduler(self, [self.interrupts])
+        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse],
+                                   self.interrupts.run_at)
         self._irq_t = 0            #: the time the running code executes at (µs)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
@@ -240,7 +244,7 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            if irq.timed_next:
+            if irq.timed_next or self._pulse_busy():
                 self.scheduler.run(now, now + self.scan_us)
             elif self.devices:
                 t_to = now + self.scan_us
@@ -254,6 +258,14 @@ class Plc(AddressAccess):
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
+        if self._pulse_running():
+            # a running generator drives its terminal, not the image bit
+            t_end = now + self.scan_us
+            for po in self.pulse:
+                if po.running:
+                    bit = 1 << po.number
+                    pq[0] = pq[0] | bit if po.level(t_end) else pq[0] & ~bit & 0xFF
+                    po.update_segment(t_end)
         self.scans = scans + 1
         self._t_us = now + self.scan_us
         if self.stop_requested:
@@ -279,6 +291,18 @@ class Plc(AddressAccess):
         finally:
             acc[:] = saved_ac
             sm[1] = saved_sm1
+
+    def _pulse_busy(self) -> bool:
+        p0, p1 = self.pulse
+        return bool(p0.trains or p1.trains) or p0.pwm_next is not None \
+            or p1.pwm_next is not None
+
+    def _pulse_running(self) -> bool:
+        p0, p1 = self.pulse
+        return p0.running or p1.running
+
+    def _pls(self, number: int) -> None:
+        self.pulse[number].pls(self._irq_t)
 
     def _irq_time(self, t: int) -> None:
         self._irq_t = t
@@ -480,7 +504,8 @@ class Plc(AddressAccess):
             memo[id(buf)] = dareas[k]
         pairs: list[tuple[Any, Any]] = [(self.timers, dst.timers),
                                         (self.counters, dst.counters),
-                                        (self.interrupts, dst.interrupts)]
+                                        (self.interrupts, dst.interrupts),
+                                        *zip(self.pulse, dst.pulse)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
             other = dst.unit.bindings.get(name)

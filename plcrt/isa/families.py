@@ -11,3 +11,4 @@ from . import timers  # noqa: F401
 from . import counters  # noqa: F401
 from . import control  # noqa: F401
 from . import interrupts  # noqa: F401
+from . import highspeed  # noqa: F401

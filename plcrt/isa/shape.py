@@ -112,6 +112,8 @@ _LAD: dict[str, tuple[str, str]] = {
     "RETI": ("(RETI)", ""),
     "ATCH": ("ATCH", "INT=0 EVNT=1"), "DTCH": ("DTCH", "EVNT=0"),
     "CEVNT": ("CLR_EVNT", "EVNT=0"),
+    # high-speed outputs (System Manual, PLS: the box's Q0.X input)
+    "PLS": ("PLS", "Q0.X=0"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),
     # rail elements: coils, or boxes (a name without parentheses)

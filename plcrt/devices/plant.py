@@ -12,6 +12,9 @@
     z_offset = 1000             # ... at this mechanical position (and +/- periods)
     events = [ { at = 2.5, input = "STF", value = true } ]   # scripted inputs
 
+    [cpu]
+    wire = { "I0.0" = "Q0.0" }  # the pulse output Q0.0 drives the input I0.0
+
     [module.1]                  # a fieldbus master module with CiA 402 drives
     kind = "FIELDBUS"
     v = 1000                    # the drives' images from VB1000, 80 bytes each
@@ -84,6 +87,8 @@ class ModuleConfig:
 class Plant:
     modules: dict[int, ModuleConfig]
     file: str = "<plant>"
+    #: CPU input bit number (I0.0 = 0, I1.2 = 10) -> pulse output (0 Q0.0, 1 Q0.1)
+    wiring: dict[int, int] = field(default_factory=dict)
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -121,10 +126,11 @@ def _build(data: dict, file: str) -> Plant:
     modules: dict[int, ModuleConfig] = {}
     # A misspelt table ([modules.0]) would otherwise give a plant without
     # modules and only run-time warnings: reject unknown keys at every level.
-    unknown = set(data) - {"module"}
+    unknown = set(data) - {"module", "cpu"}
     if unknown:
         raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(a plant file has [module.N] tables)")
+                             f"(a plant file has [module.N] tables and a [cpu] table)")
+    wiring = _cpu(data.get("cpu", {}), file)
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -162,7 +168,36 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file)
+    return Plant(modules, file, wiring)
+
+
+_BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
+
+
+def _cpu(cpu: Any, file: str) -> dict[int, int]:
+    """``[cpu] wire = { "I0.0" = "Q0.0" }``: a pulse output drives an input
+    (the bench set-up of a PTO counted by a high-speed counter)."""
+    where = f"{file}: cpu"
+    if not isinstance(cpu, dict):
+        raise PlcConfigError(f"{where} must be a table")
+    unknown = set(cpu) - {"wire"}
+    if unknown:
+        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} (known: wire)")
+    wire = cpu.get("wire", {})
+    if not isinstance(wire, dict):
+        raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
+    out: dict[int, int] = {}
+    for dst, src in wire.items():
+        m_in, m_out = _BIT_RE.fullmatch(str(dst)), _BIT_RE.fullmatch(str(src))
+        if m_in is None or m_in.group(1).upper() != "I" or int(m_in.group(2)) > 1:
+            raise PlcConfigError(f"{where}.wire: {str(dst)[:20]!r} is not one of the CPU's "
+                                 f"inputs I0.0..I1.7")
+        if m_out is None or m_out.group(1).upper() != "Q" or int(m_out.group(2)) != 0 \
+                or int(m_out.group(3)) > 1:
+            raise PlcConfigError(f"{where}.wire: {str(dst)} takes a pulse output, Q0.0 or "
+                                 f"Q0.1, got {str(src)[:20]!r}")
+        out[int(m_in.group(2)) * 8 + int(m_in.group(3))] = int(m_out.group(3))
+    return out
 
 
 def _axis(ax: dict, where: str) -> AxisPlant:

@@ -272,6 +272,19 @@ class PulseOutput:
         """Rising edges in (t0, t1] (a counter wired to the output)."""
         return self.pulses_until(t1) - self.pulses_until(t0)
 
+    def time_of_pulse(self, k: int) -> Optional[int]:
+        """The time of the *k*-th rising edge since power-up, if a running
+        train makes it (closed form)."""
+        k -= self.sent
+        for tr in self.trains:
+            if k <= 0:
+                return None
+            if k <= tr.count:
+                j = k - 1
+                return tr.start + j * tr.c0 + tr.delta * j * (j - 1) // 2
+            k -= tr.count
+        return None
+
     def pulses_until(self, t: int) -> int:
         return self.sent + sum(tr.pulses_started(t) for tr in self.trains)
 

@@ -37,6 +37,7 @@ from .timers import TimerBank
 from .access import AddressAccess
 from .events import Scheduler
 from .interrupts import Interrupts
+from .hsc import make_counters
 from .pulse import make_outputs
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
@@ -112,10 +113,15 @@ class Plc(AddressAccess):
                                      self._irq_time)
         #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
         self.pulse = make_outputs(self)
+        #: input bit number (I0.0 = 0) -> the pulse output wired to it in the plant
+        self.wiring: dict[int, int] = dict(getattr(plant, "wiring", None) or {})
+        #: the high-speed counters HSC0..HSC5 (HDEF, HSC)
+        self.hsc = make_counters(self)
         #: one time line for the scan interval: event sources in priority order
-        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse],
-                                   self.interrupts.run_at)
+        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse, *self.hsc],
+                                   self._instant)
         self._irq_t = 0            #: the time the running code executes at (µs)
+        self._hsc_any = False      #: an HDEF ran (perf: counters cost nothing before)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
         if system_symbols is None:
@@ -207,6 +213,9 @@ class Plc(AddressAccess):
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
         irq = self.interrupts
+        if self._hsc_defined:
+            for c in self.hsc:
+                c.scan_start(pi, now)
         pi0 = pi[0] & 0x0F
         if pi0 != self._pi0 or irq.queues[0] or irq.queues[1] or irq.queues[2]:
             # input edges from the outside world: their routines run at the
@@ -266,6 +275,9 @@ class Plc(AddressAccess):
                     bit = 1 << po.number
                     pq[0] = pq[0] | bit if po.level(t_end) else pq[0] & ~bit & 0xFF
                     po.update_segment(t_end)
+            for inp, out in self.wiring.items():      # the plant's wires to inputs
+                bit, level = 1 << (inp % 8), pq[0] >> out & 1
+                pi[inp // 8] = pi[inp // 8] | bit if level else pi[inp // 8] & ~bit & 0xFF
         self.scans = scans + 1
         self._t_us = now + self.scan_us
         if self.stop_requested:
@@ -296,6 +308,24 @@ class Plc(AddressAccess):
         p0, p1 = self.pulse
         return bool(p0.trains or p1.trains) or p0.pwm_next is not None \
             or p1.pwm_next is not None
+
+    @property
+    def _hsc_defined(self) -> bool:
+        return self._hsc_any
+
+    def _instant(self, t: int) -> None:
+        """After the events of one instant: counters current, then the routines."""
+        if self._hsc_any:
+            for c in self.hsc:
+                c.sync(t)
+        self.interrupts.run_at(t)
+
+    def _hdef(self, number: int, mode: int) -> None:
+        self._hsc_any = True
+        self.hsc[number].hdef(mode, self._irq_t)
+
+    def _hsc(self, number: int) -> None:
+        self.hsc[number].hsc(self._irq_t)
 
     def _pulse_running(self) -> bool:
         p0, p1 = self.pulse
@@ -505,7 +535,8 @@ class Plc(AddressAccess):
         pairs: list[tuple[Any, Any]] = [(self.timers, dst.timers),
                                         (self.counters, dst.counters),
                                         (self.interrupts, dst.interrupts),
-                                        *zip(self.pulse, dst.pulse)]
+                                        *zip(self.pulse, dst.pulse),
+                                        *zip(self.hsc, dst.hsc)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
             other = dst.unit.bindings.get(name)
@@ -535,7 +566,7 @@ class Plc(AddressAccess):
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
-                     "_irq_t", "_pi0"):
+                     "_irq_t", "_pi0", "_hsc_any"):
             setattr(dst, name, getattr(self, name))
         dst._warned = set(self._warned)
         dst.diagnostics = list(self.diagnostics)

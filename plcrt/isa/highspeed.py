@@ -3,7 +3,9 @@
 PLS (S7-200 System Manual, "Pulse Output (PLS)"): acts on the control byte
 of Q0.0 (SMB67) or Q0.1 (SMB77) and starts, updates or stops the output's
 PTO or PWM generator, :class:`plcrt.engine.pulse.PulseOutput`.  HDEF and
-HSC (the high-speed counters) are not built yet.
+HSC ("High-Speed Counter instructions") define a counter's mode and apply
+its control byte, :class:`plcrt.engine.hsc.HighSpeedCounter`; the modes a
+counter has are checked when the program is loaded.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from ..compiler.emit import Gen
 from ..compiler.operands import Const
 from ..compiler.resolve import ResolveError
 from ..isa.registry import insn
+from ..engine.hsc import MODES
 from ..safetext import excerpt
 
 F = "high-speed"
@@ -37,3 +40,41 @@ def _pls(g: Gen, insn_ir, resolver, *_ops) -> None:
     pls = g.bind(g.unit.hooks["plc"]._pls, "pls")
     with g.box():
         g.line(f"{pls}({number})")
+
+
+def _const(g: Gen, resolver, text: str, what: str, allowed) -> int:
+    try:
+        op = resolver.parse(text)
+    except ResolveError as e:
+        g.fail(f"{what}: {e}")
+    if not isinstance(op, Const) or op.is_real or not isinstance(op.value, int):
+        g.fail(f"{what} must be a constant, got '{excerpt(text)}'")
+    if op.value not in allowed:
+        g.fail(f"{what} {op.value} is not one of {', '.join(map(str, allowed))}")
+    return int(op.value)
+
+
+@insn("HDEF", family=F, summary="define the mode of a high-speed counter", variadic=True)
+def _hdef(g: Gen, insn_ir, resolver, *_ops) -> None:
+    ops = [o.text for o in insn_ir.operands]
+    if len(ops) != 2:
+        g.fail(f"HDEF takes a counter and a mode (HDEF HSC, MODE), got {len(ops)} operand(s)")
+    if g.unit.current.pou.kind == "INT":
+        g.fail("HDEF is not allowed in an interrupt routine")
+    n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
+    mode = _const(g, resolver, ops[1], f"HSC{n} mode", MODES[n])
+    hdef = g.bind(g.unit.hooks["plc"]._hdef, "hdef")
+    with g.box():
+        g.line(f"{hdef}({n}, {mode})")
+
+
+@insn("HSC", family=F, summary="apply the control byte of a high-speed counter",
+      variadic=True)
+def _hsc(g: Gen, insn_ir, resolver, *_ops) -> None:
+    ops = [o.text for o in insn_ir.operands]
+    if len(ops) != 1:
+        g.fail(f"HSC takes the counter number, got {len(ops)} operand(s)")
+    n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
+    hsc = g.bind(g.unit.hooks["plc"]._hsc, "hsc")
+    with g.box():
+        g.line(f"{hsc}({n})")

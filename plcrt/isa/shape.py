@@ -114,6 +114,7 @@ _LAD: dict[str, tuple[str, str]] = {
     "CEVNT": ("CLR_EVNT", "EVNT=0"),
     # high-speed outputs (System Manual, PLS: the box's Q0.X input)
     "PLS": ("PLS", "Q0.X=0"),
+    "HDEF": ("HDEF", "HSC=0 MODE=1"), "HSC": ("HSC", "N=0"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),
     # rail elements: coils, or boxes (a name without parentheses)

@@ -1,0 +1,252 @@
+"""The CPU's high-speed counters HSC0–HSC5 (HDEF and HSC).
+
+What it is: :class:`HighSpeedCounter`, one per counter (System Manual,
+"High-Speed Counter instructions", tables of modes, inputs and SM bytes)::
+
+    counter  status  control  new CV  new PV   inputs (clock/up/A, dir/down/B, reset, start)
+    HSC0     SMB36   SMB37    SMD38   SMD42    I0.0 I0.1 I0.2 -
+    HSC1     SMB46   SMB47    SMD48   SMD52    I0.6 I0.7 I1.0 I1.1
+    HSC2     SMB56   SMB57    SMD58   SMD62    I1.2 I1.3 I1.4 I1.5
+    HSC3     SMB136  SMB137   SMD138  SMD142   I0.1 -    -    -
+    HSC4     SMB146  SMB147   SMD148  SMD152   I0.3 I0.4 I0.5 -
+    HSC5     SMB156  SMB157   SMD158  SMD162   I0.4 -    -    -
+
+Modes (``HDEF HSC, MODE``): 0–2 one clock, direction from control bit 3;
+3–5 one clock, direction from the second input; 6–8 up and down clocks;
+9–11 A/B quadrature (×4, or ×1 with control bit 2); the second and third
+of each family add the reset input, the third the start input; 12 counts
+the pulses of the pulse output (HSC0: Q0.0, HSC3: Q0.1).  Control byte:
+.0 reset active low, .1 start active low, .2 quadrature ×1, .3 direction up,
+.4 update the direction, .5 update PV, .6 update CV, .7 enable.  Status:
+.5 counting up, .6 CV = PV, .7 CV > PV.
+
+Where the counts come from:
+
+* a pulse output (mode 12, or a clock input wired to Q0.0/Q0.1 in the
+  plant): counted in closed form from the generator, and CV = PV happens at
+  the exact µs of the pulse that reaches it — an event of the scan's time
+  line;
+* any other input signal changes between scans (``--set``, the harness,
+  stimuli): its edges are counted at the next scan's start, where their
+  events happen too.
+
+What it is not: no encoder simulation yet (frequency-driven inputs), no
+wizard code.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Optional
+
+__all__ = ["HighSpeedCounter", "SM_HSC", "INPUTS", "MODES", "make_counters"]
+
+#: counter -> (status byte, control byte, new CV dword, new PV dword)
+SM_HSC = {0: (36, 37, 38, 42), 1: (46, 47, 48, 52), 2: (56, 57, 58, 62),
+          3: (136, 137, 138, 142), 4: (146, 147, 148, 152), 5: (156, 157, 158, 162)}
+#: counter -> its inputs (clock/up/A, direction/down/B, reset, start) as I bit numbers
+INPUTS: dict[int, tuple[Optional[int], ...]] = {
+    0: (0, 1, 2, None), 1: (6, 7, 8, 9), 2: (10, 11, 12, 13),
+    3: (1, None, None, None), 4: (3, 4, 5, None), 5: (4, None, None, None)}
+#: counter -> the modes it has
+MODES: dict[int, tuple[int, ...]] = {
+    0: (0, 1, 3, 4, 6, 7, 9, 10, 12), 1: tuple(range(12)), 2: tuple(range(12)),
+    3: (0, 12), 4: (0, 1, 3, 4, 6, 7, 9, 10), 5: (0,)}
+#: counter -> interrupt events (CV=PV, direction changed, external reset)
+EVENTS: dict[int, tuple[Optional[int], ...]] = {
+    0: (12, 27, 28), 1: (13, 14, 15), 2: (16, 17, 18), 3: (32, None, None),
+    4: (29, 30, 31), 5: (33, None, None)}
+#: mode 12: the pulse output a counter counts
+INTERNAL_PTO = {0: 0, 3: 1}
+
+UP, EQUAL, GREATER = 0x20, 0x40, 0x80
+_I32 = 2**31
+
+
+def _wrap(v: int) -> int:
+    return (v + _I32) % 2**32 - _I32
+
+
+class HighSpeedCounter:
+    """HSC*number*: its mode, current and preset value, direction, source."""
+
+    def __init__(self, number: int, plc: Any) -> None:
+        self.number = number
+        self.plc = plc
+        self.sm, self.hc = plc.mem.areas["SM"], plc.mem.areas["HC"]
+        self.status, self.control, self.new_cv, self.new_pv = SM_HSC[number]
+        self.mode: Optional[int] = None
+        self.enabled = False
+        self.cv = 0
+        self.pv = 0
+        self.direction = 1
+        self.pulse: Any = None           #: the pulse output counted (mode 12 / wired)
+        self.base = 0                    #: pulses of that output at the last sync
+        self.inputs = 0                  #: the input bits as last sampled (4 bits)
+        self.reset_held = False
+
+    # ------------------------------------------------------------ helpers
+    def _dword(self, offset: int) -> int:
+        return int.from_bytes(self.sm[offset:offset + 4], "big", signed=True)
+
+    def _bit(self, pi: bytearray, k: int) -> int:
+        bit = INPUTS[self.number][k]
+        return 0 if bit is None else pi[bit // 8] >> (bit % 8) & 1
+
+    def _publish(self) -> None:
+        self.hc[4 * self.number:4 * self.number + 4] = (self.cv & 0xFFFFFFFF).to_bytes(4, "big")
+        st = UP if self.direction > 0 else 0
+        if self.cv == self.pv:
+            st |= EQUAL
+        elif self.cv > self.pv:
+            st |= GREATER
+        self.sm[self.status] = self.sm[self.status] & 0x1F | st
+
+    def _post(self, k: int, t: int) -> None:
+        event = EVENTS[self.number][k]
+        if event is not None:
+            self.plc.interrupts.post(event, t)
+
+    # ------------------------------------------------------------ instructions
+    def hdef(self, mode: int, t: int) -> None:
+        """HDEF: the counter's mode (once per counter after RUN)."""
+        if self.mode is not None:
+            self.plc._irq_warn(f"HDEF of HSC{self.number} executed again: the mode is set "
+                               f"once after RUN (it stays {self.mode}; System Manual, HDEF "
+                               f"error 000A)", f"hdef-{self.number}")
+            return
+        self.mode = mode
+        source = INTERNAL_PTO.get(self.number) if mode == 12 else \
+            self.plc.wiring.get(INPUTS[self.number][0])
+        if mode == 12 or (source is not None and mode < 9):
+            self.pulse = self.plc.pulse[source]
+        self.inputs = self._sample(self.plc.mem.areas["PI"])
+
+    def hsc(self, t: int) -> None:
+        """HSC: apply the control byte."""
+        if self.mode is None:
+            self.plc._irq_warn(f"HSC {self.number} before HDEF: the counter has no mode; "
+                               f"nothing happens (System Manual, HSC)", f"hsc-nodef-{self.number}")
+            return
+        self.sync(t)
+        ctrl = self.sm[self.control]
+        if not ctrl & 0x80:
+            self.enabled = False
+            self._publish()
+            return
+        if ctrl & 0x10 and (self.mode in (0, 1, 2, 12)):
+            new = 1 if ctrl & 0x08 else -1
+            if new != self.direction:
+                self.direction = new
+        if ctrl & 0x20:
+            self.pv = self._dword(self.new_pv)
+        if ctrl & 0x40:
+            self.cv = self._dword(self.new_cv)
+        if not self.enabled:
+            self.enabled = True
+            self.inputs = self._sample(self.plc.mem.areas["PI"])
+            if self.mode in (3, 4, 5):          # the direction input's level now
+                self.direction = 1 if self.inputs & 2 else -1
+            if self.pulse is not None:
+                self.base = self.pulse.pulses_until(t)
+        self._publish()
+
+    # ------------------------------------------------------------ counting
+    def counting(self) -> bool:
+        """Whether the start input (modes 2, 5, 8, 11) lets it count."""
+        if self.mode is None or self.mode == 12 or self.mode % 3 != 2:
+            return True
+        active_low = self.sm[self.control] & 0x02
+        return bool(self.inputs >> 3 & 1) != bool(active_low)
+
+    def sync(self, t: int) -> None:
+        """Count the wired pulse output's pulses up to *t*."""
+        if self.pulse is None or not self.enabled:
+            return
+        now = self.pulse.pulses_until(t)
+        if now != self.base and self.counting() and not self.reset_held:
+            self.cv = _wrap(self.cv + self.direction * (now - self.base))
+        self.base = now
+        self._publish()
+
+    def next_time(self, after: int, until: int) -> Optional[int]:
+        """When a counted pulse output brings CV to PV, in (*after*, *until*]."""
+        if self.pulse is None or not self.enabled or not self.counting() or self.reset_held:
+            return None
+        self.sync(after)
+        steps = (self.pv - self.cv) * self.direction
+        if steps <= 0:
+            return None
+        te = self.pulse.time_of_pulse(self.base + steps)
+        return te if te is not None and after < te <= until else None
+
+    def fire(self, t: int) -> None:
+        self.sync(t)
+        if self.cv == self.pv:
+            self._post(0, t)
+
+    def _sample(self, pi: bytearray) -> int:
+        return sum(self._bit(pi, k) << k for k in range(4))
+
+    def scan_start(self, pi: bytearray, t: int) -> None:
+        """Edges of the counter's inputs since the last scan (the outside
+        world changes them between scans), counted at *t*."""
+        if self.mode is None:
+            return
+        new = self._sample(pi)
+        old, self.inputs = self.inputs, new
+        if not self.enabled:
+            return
+        self.sync(t)
+        mode = self.mode
+        if mode != 12 and mode % 3 >= 1:                 # the reset input
+            active_low = self.sm[self.control] & 0x01
+            active = bool(new >> 2 & 1) != bool(active_low)
+            if active and not self.reset_held:
+                self.cv = 0
+                self._post(2, t)
+            self.reset_held = active
+        if self.reset_held or not self.counting() or old == new or mode == 12:
+            self._publish()
+            return
+        delta = 0
+        family = mode // 3
+        if family == 0 and self.pulse is None:
+            delta = self.direction if (new & 1) and not (old & 1) else 0
+        elif family == 1:
+            direction = 1 if new & 2 else -1
+            if direction != self.direction:
+                self.direction = direction
+                self._post(1, t)
+            if self.pulse is None and (new & 1) and not (old & 1):
+                delta = direction
+        elif family == 2:
+            delta = (1 if (new & 1) and not (old & 1) else 0) - \
+                (1 if (new & 2) and not (old & 2) else 0)
+        elif family == 3:
+            delta = self._quadrature(old & 3, new & 3, t)
+        if delta:
+            self.cv = _wrap(self.cv + delta)
+            if self.cv == self.pv:
+                self._post(0, t)
+        self._publish()
+
+    def _quadrature(self, old: int, new: int, t: int) -> int:
+        """A/B phase: the Gray step from *old* to *new* (bit 0 A, bit 1 B)."""
+        order = (0, 1, 3, 2)            # A leads B: 00 -> 01 -> 11 -> 10 counts up
+        step = (order.index(new) - order.index(old)) % 4
+        if step == 2:
+            self.plc._irq_warn(f"HSC{self.number}: A and B changed together between two "
+                               f"scans; the step cannot be counted (change them one at a "
+                               f"time)", f"hsc-ab-{self.number}")
+            return 0
+        direction = 1 if step == 1 else -1
+        if direction != self.direction:
+            self.direction = direction
+            self._post(1, t)
+        if self.sm[self.control] & 0x04:             # ×1: A rising only
+            return direction if (new & 1) and not (old & 1) else 0
+        return direction
+
+
+def make_counters(plc: Any) -> list[HighSpeedCounter]:
+    return [HighSpeedCounter(n, plc) for n in range(plc.model.hsc)]

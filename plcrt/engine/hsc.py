@@ -158,25 +158,31 @@ class HighSpeedCounter:
         active_low = self.sm[self.control] & 0x02
         return bool(self.inputs >> 3 & 1) != bool(active_low)
 
+    def live(self) -> bool:
+        """Whether it counts a running pulse output (it has events to come)."""
+        return self.enabled and self.pulse is not None and bool(self.pulse.trains)
+
     def sync(self, t: int) -> None:
         """Count the wired pulse output's pulses up to *t*."""
         if self.pulse is None or not self.enabled:
             return
         now = self.pulse.pulses_until(t)
-        if now != self.base and self.counting() and not self.reset_held:
-            self.cv = _wrap(self.cv + self.direction * (now - self.base))
-        self.base = now
-        self._publish()
+        if now != self.base:
+            if self.counting() and not self.reset_held:
+                self.cv = _wrap(self.cv + self.direction * (now - self.base))
+            self.base = now
+            self._publish()
 
     def next_time(self, after: int, until: int) -> Optional[int]:
         """When a counted pulse output brings CV to PV, in (*after*, *until*]."""
-        if self.pulse is None or not self.enabled or not self.counting() or self.reset_held:
+        if self.pulse is None or not self.enabled or self.reset_held or not self.counting():
             return None
-        self.sync(after)
-        steps = (self.pv - self.cv) * self.direction
+        # perf: CV at *after* without publishing it
+        cv = self.cv + self.direction * (self.pulse.pulses_until(after) - self.base)
+        steps = (self.pv - cv) * self.direction
         if steps <= 0:
             return None
-        te = self.pulse.time_of_pulse(self.base + steps)
+        te = self.pulse.time_of_pulse(self.pulse.pulses_until(after) + steps)
         return te if te is not None and after < te <= until else None
 
     def fire(self, t: int) -> None:

@@ -125,6 +125,10 @@ class PulseOutput:
     def _dword(self, offset: int) -> int:
         return int.from_bytes(self.sm[offset:offset + 4], "big")
 
+    def live(self) -> bool:
+        """Whether it has events to come (a train, a synchronous PWM update)."""
+        return bool(self.trains) or self.pwm_next is not None
+
     @property
     def running(self) -> bool:
         return bool(self.trains) or self.mode == "PWM"
@@ -286,7 +290,12 @@ class PulseOutput:
         return None
 
     def pulses_until(self, t: int) -> int:
-        return self.sent + sum(tr.pulses_started(t) for tr in self.trains)
+        n = self.sent
+        for tr in self.trains:          # perf: no generator on the event path
+            if t < tr.start:
+                break
+            n += tr.pulses_started(t)
+        return n
 
     def level(self, t: int) -> int:
         """The terminal's level at *t*."""

@@ -118,12 +118,13 @@ class Plc(AddressAccess):
         #: the high-speed counters HSC0..HSC5 (HDEF, HSC)
         self.hsc = make_counters(self)
         #: one time line for the scan interval: event sources in priority order
-        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse, *self.hsc],
-                                   self._instant)
+        #: (a counter joins when HDEF gives it a pulse output to count)
+        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse], self._instant)
         self._irq_t = 0            #: the time the running code executes at (µs)
         self._hsc_any = False      #: an HDEF ran (perf: counters cost nothing before)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
+        self._acc_sm = (self.mem.areas["AC"], self.mem.areas["SM"])
         if system_symbols is None:
             from ..lang.symbols import SYSTEM_SYMBOLS
             system_symbols = dict(SYSTEM_SYMBOLS)
@@ -165,6 +166,8 @@ class Plc(AddressAccess):
         a = self.mem.areas
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
+        self._int_fns = {p.number: ns[f"pou_INT{p.number}"] for p in program.pous
+                         if p.kind == "INT" and f"pou_INT{p.number}" in ns}
         if data is not None:
             data.apply(self.mem.areas["V"])
         # SMW22/24/26: last, minimum and maximum scan time in ms.  SMB0..29
@@ -293,10 +296,10 @@ class Plc(AddressAccess):
         """Run INT *number* now.  The CPU saves and restores the
         accumulators and the status bits SMB1 around a routine (System
         Manual, "System support for interrupts")."""
-        fn = self._ns.get(f"pou_INT{number}")
+        fn = self._int_fns.get(number)
         if fn is None:
             return
-        acc, sm = self.mem.areas["AC"], self.mem.areas["SM"]
+        acc, sm = self._acc_sm
         saved_ac, saved_sm1 = bytes(acc), sm[1]
         try:
             fn(self._int_l)
@@ -317,12 +320,16 @@ class Plc(AddressAccess):
         """After the events of one instant: counters current, then the routines."""
         if self._hsc_any:
             for c in self.hsc:
-                c.sync(t)
+                if c.pulse is not None:
+                    c.sync(t)
         self.interrupts.run_at(t)
 
     def _hdef(self, number: int, mode: int) -> None:
         self._hsc_any = True
-        self.hsc[number].hdef(mode, self._irq_t)
+        counter = self.hsc[number]
+        counter.hdef(mode, self._irq_t)
+        if counter.pulse is not None and counter not in self.scheduler.sources:
+            self.scheduler.sources.append(counter)
 
     def _hsc(self, number: int) -> None:
         self.hsc[number].hsc(self._irq_t)
@@ -565,6 +572,8 @@ class Plc(AddressAccess):
             b.__dict__.update(state)
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
+        dst.scheduler.sources[:] = [dst.interrupts, *dst.pulse,
+                                    *(c for c in dst.hsc if c.pulse is not None)]
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_hsc_any"):
             setattr(dst, name, getattr(self, name))

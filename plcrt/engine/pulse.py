@@ -50,7 +50,9 @@ SM_BASE = {0: (66, 168, 166), 1: (76, 178, 176)}
 COMPLETE_EVENT = {0: 19, 1: 20}
 
 IDLE, USER_ABORT, OVERFLOW, DELTA_ERROR = 0x80, 0x20, 0x40, 0x10
-MIN_CYCLE_US = 50          #: shortest PTO/PWM cycle at the 1 µs time base (CPU 22x)
+MIN_CYCLE_US = 50          #: shortest PTO/PWM cycle at the 1 µs time base (CPU 22x: 20 kHz)
+#: CPUs whose Q0.0/Q0.1 make 100 kHz (data sheet: CPU 224XP high-speed outputs)
+FAST_OUTPUTS = {"CPU224XP": 10}
 
 
 @dataclass
@@ -104,8 +106,10 @@ class PulseOutput:
     a diagnostic once."""
 
     def __init__(self, number: int, sm: bytearray, v: bytearray,
-                 post: Callable[[int, int], None], warn: Callable[[str, str], None]) -> None:
+                 post: Callable[[int, int], None], warn: Callable[[str, str], None],
+                 min_cycle_us: int = MIN_CYCLE_US) -> None:
         self.number = number
+        self.min_cycle = min_cycle_us
         self.sm, self.v = sm, v
         self.post, self.warn = post, warn
         self.status, self.profile, self.segment_byte = SM_BASE[number]
@@ -156,9 +160,9 @@ class PulseOutput:
 
     def _cycle(self, ctrl: int, unit: int, what: str) -> Optional[int]:
         cycle = self._word(self.control + 1) * unit
-        if cycle < MIN_CYCLE_US:
+        if cycle < self.min_cycle:
             self.warn(f"Q0.{self.number} {what}: cycle time {cycle} µs is below the "
-                      f"{MIN_CYCLE_US} µs the outputs can make; nothing is started "
+                      f"{self.min_cycle} µs the outputs can make; nothing is started "
                       f"(SMW{self.control + 1})", f"pls-cycle-{self.number}")
             return None
         return cycle
@@ -216,10 +220,10 @@ class PulseOutput:
             delta = int.from_bytes(v[off + 2:off + 4], "big", signed=True) * unit
             count = int.from_bytes(v[off + 4:off + 8], "big") or 1
             last = c0 + (count - 1) * delta
-            if c0 < MIN_CYCLE_US or last < MIN_CYCLE_US or last > 65535 * unit:
+            if c0 < self.min_cycle or last < self.min_cycle or last > 65535 * unit:
                 self.sm[self.status] |= DELTA_ERROR | IDLE
                 self.warn(f"Q0.{self.number}: segment {k} of the profile at VB{base} takes "
-                          f"its cycle from {c0} to {last} µs, outside {MIN_CYCLE_US}.."
+                          f"its cycle from {c0} to {last} µs, outside {self.min_cycle}.."
                           f"{65535 * unit} µs: the profile is aborted (SM{self.status}.4, "
                           f"delta calculation error)", f"pls-delta-{self.number}")
                 return []
@@ -321,4 +325,5 @@ class PulseOutput:
 def make_outputs(plc: Any) -> list[PulseOutput]:
     """Both pulse outputs of *plc*'s CPU, posting to its interrupts."""
     sm, v = plc.mem.areas["SM"], plc.mem.areas["V"]
-    return [PulseOutput(n, sm, v, plc.interrupts.post, plc._irq_warn) for n in (0, 1)]
+    fast = FAST_OUTPUTS.get(plc.model.name, MIN_CYCLE_US)
+    return [PulseOutput(n, sm, v, plc.interrupts.post, plc._irq_warn, fast) for n in (0, 1)]

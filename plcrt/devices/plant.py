@@ -13,7 +13,7 @@
     events = [ { at = 2.5, input = "STF", value = true } ]   # scripted inputs
 
     [cpu]
-    wire = { "I0.0" = "Q0.0" }  # the pulse output Q0.0 drives the input I0.0
+    wire = { "I0.0" = "Q0.0" }  # the output Q0.0 (or its pulses) drives the input I0.0
 
     [module.1]                  # a fieldbus master module with CiA 402 drives
     kind = "FIELDBUS"
@@ -87,7 +87,7 @@ class ModuleConfig:
 class Plant:
     modules: dict[int, ModuleConfig]
     file: str = "<plant>"
-    #: CPU input bit number (I0.0 = 0, I1.2 = 10) -> pulse output (0 Q0.0, 1 Q0.1)
+    #: CPU input bit number (I0.0 = 0, I1.2 = 10) -> output bit number (Q0.0 = 0, Q1.1 = 9)
     wiring: dict[int, int] = field(default_factory=dict)
 
 
@@ -175,8 +175,9 @@ _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
 
 
 def _cpu(cpu: Any, file: str) -> dict[int, int]:
-    """``[cpu] wire = { "I0.0" = "Q0.0" }``: a pulse output drives an input
-    (the bench set-up of a PTO counted by a high-speed counter)."""
+    """``[cpu] wire = { "I0.0" = "Q0.0" }``: an output of the CPU drives one
+    of its inputs (the bench set-up of a PTO counted by a high-speed counter,
+    or an output that triggers an edge interrupt)."""
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
@@ -192,11 +193,11 @@ def _cpu(cpu: Any, file: str) -> dict[int, int]:
         if m_in is None or m_in.group(1).upper() != "I" or int(m_in.group(2)) > 1:
             raise PlcConfigError(f"{where}.wire: {str(dst)[:20]!r} is not one of the CPU's "
                                  f"inputs I0.0..I1.7")
-        if m_out is None or m_out.group(1).upper() != "Q" or int(m_out.group(2)) != 0 \
-                or int(m_out.group(3)) > 1:
-            raise PlcConfigError(f"{where}.wire: {str(dst)} takes a pulse output, Q0.0 or "
-                                 f"Q0.1, got {str(src)[:20]!r}")
-        out[int(m_in.group(2)) * 8 + int(m_in.group(3))] = int(m_out.group(3))
+        if m_out is None or m_out.group(1).upper() != "Q" or int(m_out.group(2)) > 1:
+            raise PlcConfigError(f"{where}.wire: {str(dst)} takes one of the CPU's outputs "
+                                 f"Q0.0..Q1.7, got {str(src)[:20]!r}")
+        out[int(m_in.group(2)) * 8 + int(m_in.group(3))] = \
+            int(m_out.group(2)) * 8 + int(m_out.group(3))
     return out
 
 

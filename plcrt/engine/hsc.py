@@ -117,7 +117,8 @@ class HighSpeedCounter:
         self.mode = mode
         source = INTERNAL_PTO.get(self.number) if mode == 12 else \
             self.plc.wiring.get(INPUTS[self.number][0])
-        if mode == 12 or (source is not None and mode < 9):
+        if mode == 12 or (source in (0, 1) and mode < 9):
+            # a pulse output (Q0.0 / Q0.1) on the clock: counted in closed form
             self.pulse = self.plc.pulse[source]
         self.inputs = self._sample(self.plc.mem.areas["PI"])
 

@@ -113,7 +113,7 @@ class Plc(AddressAccess):
                                      self._irq_time)
         #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
         self.pulse = make_outputs(self)
-        #: input bit number (I0.0 = 0) -> the pulse output wired to it in the plant
+        #: input bit number (I0.0 = 0) -> the output bit (Q0.0 = 0) wired to it in the plant
         self.wiring: dict[int, int] = dict(getattr(plant, "wiring", None) or {})
         #: the high-speed counters HSC0..HSC5 (HDEF, HSC)
         self.hsc = make_counters(self)
@@ -278,8 +278,10 @@ class Plc(AddressAccess):
                     bit = 1 << po.number
                     pq[0] = pq[0] | bit if po.level(t_end) else pq[0] & ~bit & 0xFF
                     po.update_segment(t_end)
-            for inp, out in self.wiring.items():      # the plant's wires to inputs
-                bit, level = 1 << (inp % 8), pq[0] >> out & 1
+
+        if self.wiring:
+            for inp, out in self.wiring.items():      # the plant's wires: output -> input
+                bit, level = 1 << (inp % 8), pq[out // 8] >> (out % 8) & 1
                 pi[inp // 8] = pi[inp // 8] | bit if level else pi[inp // 8] & ~bit & 0xFF
         self.scans = scans + 1
         self._t_us = now + self.scan_us

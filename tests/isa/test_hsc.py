@@ -186,10 +186,25 @@ def test_what_the_cpu_refuses_is_a_compile_error(ob1, message):
 
 @pytest.mark.parametrize("wire, message", [
     ('{ "I2.0" = "Q0.0" }', "inputs I0.0..I1.7"),
-    ('{ "I0.0" = "Q0.2" }', "takes a pulse output"),
+    ('{ "I0.0" = "Q2.0" }', "takes one of the CPU's outputs"),
     ('{ "Q0.0" = "Q0.1" }', "inputs I0.0..I1.7"),
 ])
 def test_bad_wiring_in_the_plant_is_a_located_error(wire, message):
     with pytest.raises(PlcConfigError) as e:
         plcrt.load(program("LD SM0.0\n= Q0.2"), plant=f"[cpu]\nwire = {wire}\n")
     assert message in str(e.value) and "cpu.wire" in str(e.value)
+
+
+def test_an_ordinary_output_wired_to_an_input_gives_edge_interrupts_next_scan():
+    """Q0.5 wired to I0.0: the program's own output, copied to the terminal
+    at the scan's end, is the input at the next scan start, where its edge
+    interrupt (event 0) runs."""
+    ob1 = "LD SM0.1\nATCH INT_0, 0\nENI\n\nLD M0.0\n= Q0.5"
+    plc = plcrt.load(program(ob1, "LD SM0.0\nINCW VW0"),
+                     plant='[cpu]\nwire = { "I0.0" = "Q0.5" }\n')
+    plc.scan()
+    plc["M0.0"] = 1
+    plc.scan()                      # Q0.5 on at this scan's end
+    assert plc["VW0"] == 0 and plc["I0.0"] == 0
+    plc.scan()                      # the edge, at this scan's start
+    assert plc["VW0"] == 1 and plc["I0.0"] == 1

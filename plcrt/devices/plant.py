@@ -89,6 +89,8 @@ class Plant:
     file: str = "<plant>"
     #: CPU input bit number (I0.0 = 0, I1.2 = 10) -> output bit number (Q0.0 = 0, Q1.1 = 9)
     wiring: dict[int, int] = field(default_factory=dict)
+    #: encoder signals: dicts of plcrt.engine.hsc.Encoder's arguments
+    encoders: list[dict[str, Any]] = field(default_factory=list)
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -130,7 +132,7 @@ def _build(data: dict, file: str) -> Plant:
     if unknown:
         raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
                              f"(a plant file has [module.N] tables and a [cpu] table)")
-    wiring = _cpu(data.get("cpu", {}), file)
+    wiring, encoders = _cpu(data.get("cpu", {}), file)
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -168,22 +170,23 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring)
+    return Plant(modules, file, wiring, encoders)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
 
 
-def _cpu(cpu: Any, file: str) -> dict[int, int]:
+def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
     """``[cpu] wire = { "I0.0" = "Q0.0" }``: an output of the CPU drives one
     of its inputs (the bench set-up of a PTO counted by a high-speed counter,
     or an output that triggers an edge interrupt)."""
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
-    unknown = set(cpu) - {"wire"}
+    unknown = set(cpu) - {"wire", "encoder"}
     if unknown:
-        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} (known: wire)")
+        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+                             f"(known: wire, encoder)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
@@ -198,6 +201,65 @@ def _cpu(cpu: Any, file: str) -> dict[int, int]:
                                  f"Q0.0..Q1.7, got {str(src)[:20]!r}")
         out[int(m_in.group(2)) * 8 + int(m_in.group(3))] = \
             int(m_out.group(2)) * 8 + int(m_out.group(3))
+    return out, _encoders(cpu.get("encoder", []), where, out)
+
+
+_ENCODER_KEYS = {"inputs", "hz", "start", "stop", "direction"}
+
+
+def _input(text: Any, where: str) -> int:
+    m = _BIT_RE.fullmatch(str(text))
+    if m is None or m.group(1).upper() != "I" or int(m.group(2)) > 1:
+        raise PlcConfigError(f"{where}: {str(text)[:20]!r} is not one of the CPU's inputs "
+                             f"I0.0..I1.7")
+    return int(m.group(2)) * 8 + int(m.group(3))
+
+
+def _encoders(raw: Any, where: str, wired: dict[int, int]) -> list[dict[str, Any]]:
+    """``[[cpu.encoder]]``: inputs = ["I0.0", "I0.1"] (A, and B for
+    quadrature), hz (cycles per second), start / stop (s), direction "up" |
+    "down" (A leads B, or B leads A)."""
+    if not isinstance(raw, list):
+        raise PlcConfigError(f"{where}.encoder must be an array of tables ([[cpu.encoder]])")
+    out, used = [], set(wired)
+    for i, enc in enumerate(raw):
+        ew = f"{where}.encoder[{i}]"
+        if not isinstance(enc, dict):
+            raise PlcConfigError(f"{ew} must be a table")
+        unknown = set(enc) - _ENCODER_KEYS
+        if unknown:
+            raise PlcConfigError(f"{ew}: unknown key(s) {', '.join(sorted(unknown))} "
+                                 f"(known: {', '.join(sorted(_ENCODER_KEYS))})")
+        inputs = enc.get("inputs")
+        if not isinstance(inputs, list) or not 1 <= len(inputs) <= 2:
+            raise PlcConfigError(f"{ew}.inputs must be [\"I0.0\"] or [\"I0.0\", \"I0.1\"] "
+                                 f"(A, and B for quadrature)")
+        bits = [_input(x, f"{ew}.inputs") for x in inputs]
+        for b in bits:
+            if b in used:
+                raise PlcConfigError(f"{ew}.inputs: I{b // 8}.{b % 8} is already driven "
+                                     f"(a wire or another encoder)")
+            used.add(b)
+        hz = enc.get("hz")
+        if isinstance(hz, bool) or not isinstance(hz, int) or not 1 <= hz <= 1_000_000:
+            raise PlcConfigError(f"{ew}.hz must be a whole number of cycles per second, "
+                                 f"1..1000000, got {hz!r}")
+        times = []
+        for key in ("start", "stop"):
+            v = enc.get(key, 0.0 if key == "start" else None)
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
+                                  or not math.isfinite(v) or v < 0):
+                raise PlcConfigError(f"{ew}.{key} must be seconds (0 or more), got {v!r}")
+            times.append(None if v is None else int(round(v * 1e6)))
+        if times[1] is not None and times[1] < times[0]:
+            raise PlcConfigError(f"{ew}: stop is before start")
+        direction = enc.get("direction", "up")
+        if direction not in ("up", "down"):
+            raise PlcConfigError(f"{ew}.direction must be \"up\" or \"down\", got "
+                                 f"{str(direction)[:20]!r}")
+        out.append({"a": bits[0], "b": bits[1] if len(bits) > 1 else None, "hz": hz,
+                    "start": times[0], "stop": times[1],
+                    "direction": 1 if direction == "up" else -1})
     return out
 
 

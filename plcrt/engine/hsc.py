@@ -30,15 +30,19 @@ Where the counts come from:
   stimuli): its edges are counted at the next scan's start, where their
   events happen too.
 
-What it is not: no encoder simulation yet (frequency-driven inputs), no
-wizard code.
+* an encoder of the plant (``[[cpu.encoder]]``: inputs, frequency, start,
+  stop, direction) on the clock input, or on A/B in the quadrature modes:
+  its edges come at exact times (edge k of a segment at start + k / rate),
+  counted in closed form, CV = PV at the exact µs as well.
+
+What it is not: no wizard code; a PWM on a wired clock is not counted.
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
-__all__ = ["HighSpeedCounter", "SM_HSC", "INPUTS", "MODES", "make_counters"]
+__all__ = ["HighSpeedCounter", "Encoder", "SM_HSC", "INPUTS", "MODES", "make_counters"]
 
 #: counter -> (status byte, control byte, new CV dword, new PV dword)
 SM_HSC = {0: (36, 37, 38, 42), 1: (46, 47, 48, 52), 2: (56, 57, 58, 62),
@@ -64,6 +68,46 @@ _I32 = 2**31
 
 def _wrap(v: int) -> int:
     return (v + _I32) % 2**32 - _I32
+
+
+class Encoder:
+    """A plant signal on a counter's inputs: *hz* cycles per second of the
+    clock (A) from *start* until *stop* (µs, None: for ever), *direction* +1
+    (A leads B) or -1.  Its edges, as a counter counts them, come in closed
+    form: ``per_cycle`` edges per cycle (1; 4 for quadrature ×4)."""
+
+    def __init__(self, a: int, b: Optional[int], hz: int, start: int, stop: Optional[int],
+                 direction: int) -> None:
+        self.a, self.b = a, b
+        self.hz, self.start, self.stop, self.direction = hz, start, stop, direction
+        self.per_cycle = 1
+
+    def _edges(self, t: int) -> int:
+        """Counted edges in [start, t], the first at start (integer arithmetic)."""
+        if t < self.start:
+            return 0
+        if self.stop is not None and t > self.stop:
+            t = self.stop
+        rate = self.hz * self.per_cycle
+        return (t - self.start) * rate // 1_000_000 + 1
+
+    def pulses_until(self, t: int) -> int:
+        return self._edges(t)
+
+    def time_of_pulse(self, k: int) -> Optional[int]:
+        """The time of counted edge *k* (1 = the first), if the signal makes it."""
+        rate = self.hz * self.per_cycle
+        te = self.start + (-(-(k - 1) * 1_000_000 // rate))      # ceil
+        if k < 1 or (self.stop is not None and te > self.stop):
+            return None
+        return te
+
+    def live(self) -> bool:
+        return True
+
+    @property
+    def trains(self) -> list:        # the interface of a pulse output the counter reads
+        return [self]
 
 
 class HighSpeedCounter:
@@ -115,11 +159,14 @@ class HighSpeedCounter:
                                f"error 000A)", f"hdef-{self.number}")
             return
         self.mode = mode
-        source = INTERNAL_PTO.get(self.number) if mode == 12 else \
-            self.plc.wiring.get(INPUTS[self.number][0])
+        clock = INPUTS[self.number][0]
+        source = INTERNAL_PTO.get(self.number) if mode == 12 else self.plc.wiring.get(clock)
+        encoder = self.plc.encoders.get(clock)
         if mode == 12 or (source in (0, 1) and mode < 9):
             # a pulse output (Q0.0 / Q0.1) on the clock: counted in closed form
             self.pulse = self.plc.pulse[source]
+        elif encoder is not None and mode not in (6, 7, 8):
+            self.pulse = encoder
         self.inputs = self._sample(self.plc.mem.areas["PI"])
 
     def hsc(self, t: int) -> None:
@@ -138,6 +185,10 @@ class HighSpeedCounter:
             new = 1 if ctrl & 0x08 else -1
             if new != self.direction:
                 self.direction = new
+        if isinstance(self.pulse, Encoder) and self.mode is not None and self.mode >= 9:
+            # quadrature from an encoder: its direction, x4 or x1 (control bit 2)
+            self.pulse.per_cycle = 1 if ctrl & 0x04 else 4
+            self.direction = self.pulse.direction
         if ctrl & 0x20:
             self.pv = self._dword(self.new_pv)
         if ctrl & 0x40:
@@ -160,7 +211,7 @@ class HighSpeedCounter:
         return bool(self.inputs >> 3 & 1) != bool(active_low)
 
     def live(self) -> bool:
-        """Whether it counts a running pulse output (it has events to come)."""
+        """Whether it counts a running pulse output or an encoder (events to come)."""
         return self.enabled and self.pulse is not None and bool(self.pulse.trains)
 
     def sync(self, t: int) -> None:
@@ -229,7 +280,7 @@ class HighSpeedCounter:
         elif family == 2:
             delta = (1 if (new & 1) and not (old & 1) else 0) - \
                 (1 if (new & 2) and not (old & 2) else 0)
-        elif family == 3:
+        elif family == 3 and self.pulse is None:
             delta = self._quadrature(old & 3, new & 3, t)
         if delta:
             self.cv = _wrap(self.cv + delta)

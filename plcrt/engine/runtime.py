@@ -115,6 +115,12 @@ class Plc(AddressAccess):
         self.pulse = make_outputs(self)
         #: input bit number (I0.0 = 0) -> the output bit (Q0.0 = 0) wired to it in the plant
         self.wiring: dict[int, int] = dict(getattr(plant, "wiring", None) or {})
+        #: input bit number -> the plant's encoder signal on it
+        self.encoders: dict[int, Any] = {}
+        for spec in getattr(plant, "encoders", None) or ():
+            from .hsc import Encoder
+            enc = Encoder(**spec)
+            self.encoders[enc.a] = enc
         #: the high-speed counters HSC0..HSC5 (HDEF, HSC)
         self.hsc = make_counters(self)
         #: one time line for the scan interval: event sources in priority order
@@ -256,7 +262,9 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            if irq.timed_next or self._pulse_busy():
+            # perf: the time line only when a source can have events (a timed
+            # interrupt, a pulse output running, a counter on a pulse source)
+            if irq.timed_next or self._pulse_busy() or len(self.scheduler.sources) > 3:
                 self.scheduler.run(now, now + self.scan_us)
             elif self.devices:
                 t_to = now + self.scan_us

@@ -113,7 +113,7 @@ _LAD: dict[str, tuple[str, str]] = {
     "ATCH": ("ATCH", "INT=0 EVNT=1"), "DTCH": ("DTCH", "EVNT=0"),
     "CEVNT": ("CLR_EVNT", "EVNT=0"),
     # high-speed outputs (System Manual, PLS: the box's Q0.X input)
-    "PLS": ("PLS", "Q0.X=0"),
+    "PLS": ("PLS", "Q0_X=0"),
     "HDEF": ("HDEF", "HSC=0 MODE=1"), "HSC": ("HSC", "N=0"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),

@@ -208,3 +208,48 @@ def test_an_ordinary_output_wired_to_an_input_gives_edge_interrupts_next_scan():
     assert plc["VW0"] == 0 and plc["I0.0"] == 0
     plc.scan()                      # the edge, at this scan's start
     assert plc["VW0"] == 1 and plc["I0.0"] == 1
+
+
+ENCODER = """
+[[cpu.encoder]]
+inputs = ["I0.0", "I0.1"]
+hz = 1000
+start = 0.1
+stop = 0.5
+direction = "{direction}"
+"""
+
+
+@pytest.mark.parametrize("mode, control, direction, expected", [
+    (0, "16#F8", "up", 401),     # one clock edge per cycle from 0.1 s to 0.5 s
+    (9, "16#F8", "up", 1601),    # quadrature x4: four edges per cycle
+    (9, "16#FC", "up", 401),     # quadrature x1
+    (9, "16#F8", "down", -1601),
+])
+def test_an_encoder_of_the_plant_is_counted_in_closed_form(mode, control, direction, expected):
+    plc = plcrt.load(program(counter(mode, control, pv=10**6)),
+                     plant=ENCODER.format(direction=direction))
+    plc.run("1s")
+    assert plc["HC0"] == expected
+
+
+def test_cv_pv_from_an_encoder_comes_at_its_exact_edge():
+    """1000 Hz from 0.1 s, mode 0: edge k at 0.1 s + (k-1) ms; PV 250 at 0.349 s."""
+    plc = plcrt.load(program(counter(0, pv=250)), plant=ENCODER.format(direction="up"))
+    plc.scan()
+    assert plc.hsc[0].next_time(plc.now_us, 10**7) == 349_000
+    plc.run("1s")
+    assert (plc["VW0"], plc["VD10"]) == (1, 250)
+
+
+@pytest.mark.parametrize("encoder, message", [
+    ('inputs = ["I0.0"]\nhz = 0', "hz must be a whole number"),
+    ('inputs = ["I5.0"]\nhz = 10', "is not one of the CPU's inputs"),
+    ('inputs = ["I0.0"]\nhz = 10\nstart = 2\nstop = 1', "stop is before start"),
+    ('inputs = ["I0.0"]\nhz = 10\ndirection = "left"', "direction must be"),
+    ('inputs = ["I0.0"]\nhz = 10\nspeed = 1', "unknown key(s) speed"),
+])
+def test_bad_encoders_are_located_errors(encoder, message):
+    with pytest.raises(PlcConfigError) as e:
+        plcrt.load(program("LD SM0.0\n= Q0.2"), plant=f"[[cpu.encoder]]\n{encoder}\n")
+    assert message in str(e.value) and "cpu.encoder[0]" in str(e.value)

@@ -113,6 +113,7 @@ class Interrupts:
         self.timed_fired: set[int] = set()           #: timed events that fired since ATCH
         self.counts: dict[int, int] = {}             #: event -> routines run (for tools)
         self.lost: dict[int, int] = {}               #: event -> occurrences lost
+        self.timers: Any = None                      #: the timer bank (events 21, 22)
 
     @property
     def active(self) -> bool:
@@ -215,15 +216,22 @@ class Interrupts:
 
     # ------------------------------------------------------------ timed
     def live(self) -> bool:
-        """Whether a timed interrupt runs (the scheduler asks only live sources)."""
-        return bool(self.timed_next)
+        """Whether a timed interrupt runs, or T32/T96 CT=PT is attached (the
+        scheduler asks only live sources)."""
+        return bool(self.timed_next) or 21 in self.attached or 22 in self.attached
 
     def next_time(self, after: int, until: int) -> Optional[int]:
         """The first timed occurrence in (*after*, *until*], if any."""
-        if not self.timed_next:
-            return None
-        te = min(self.timed_next.values())   # perf: always after the last one fired
-        return te if after < te <= until else None
+        best = None
+        if self.timed_next:
+            te = min(self.timed_next.values())   # perf: always after the last one fired
+            if after < te <= until:
+                best = te
+        if 21 in self.attached or 22 in self.attached:
+            te = self._timer_next(after, until)
+            if te is not None and (best is None or te < best):
+                best = te
+        return best
 
     def fire_timed(self, t: int) -> None:
         """Post the timed occurrences due at *t* and schedule their next ones."""
@@ -232,6 +240,10 @@ class Interrupts:
             if timed.get(event) == t:
                 timed[event] = t + self.timed_period[event]
                 self.timed_fired.add(event)
+                self.post(event, t)
+        for event, n in ((21, 32), (22, 96)):
+            if event in self.attached and self.timers.ct_pt_time(n) == t:
+                self.timers.refresh_1ms(t)       # CV = PT now: no second event
                 self.post(event, t)
 
     def fire(self, t: int) -> None:
@@ -244,6 +256,19 @@ class Interrupts:
         """Run what is queued, at time *t*."""
         self.set_time(t)
         self.dispatch(t)
+
+    def attach_timer_events(self, timers: Any) -> None:
+        """Events 21 / 22: T32 / T96 CT=PT, from the timer bank."""
+        self.timers = timers
+
+    def _timer_next(self, after: int, until: int) -> Optional[int]:
+        best = None
+        for event, n in ((21, 32), (22, 96)):
+            if event in self.attached:
+                te = self.timers.ct_pt_time(n)
+                if te is not None and after < te <= until and (best is None or te < best):
+                    best = te
+        return best
 
     def state(self) -> dict[str, Any]:
         """What the tools show: attached events, enabled, queued, counts."""

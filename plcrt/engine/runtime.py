@@ -111,6 +111,7 @@ class Plc(AddressAccess):
         #: the interrupt system; routines run through _run_interrupt
         self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn,
                                      self._irq_time)
+        self.interrupts.attach_timer_events(self.timers)
         #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
         self.pulse = make_outputs(self)
         #: input bit number (I0.0 = 0) -> the output bit (Q0.0 = 0) wired to it in the plant
@@ -232,6 +233,7 @@ class Plc(AddressAccess):
             # routine runs when the edge occurs; the image changes next scan)
             self._irq_t = now
             try:
+                self.timers.refresh_1ms(now)
                 irq.edges(self._pi0, pi0, now)
                 self._pi0 = pi0
                 irq.dispatch(now)
@@ -264,7 +266,8 @@ class Plc(AddressAccess):
                 self._ob1(l_ob1)
             # perf: the time line only when a source can have events (a timed
             # interrupt, a pulse output running, a counter on a pulse source)
-            if irq.timed_next or self._pulse_busy() or len(self.scheduler.sources) > 3:
+            if irq.timed_next or self._pulse_busy() or len(self.scheduler.sources) > 3 \
+                    or 21 in irq.attached or 22 in irq.attached:
                 self.scheduler.run(now, now + self.scan_us)
             elif self.devices:
                 t_to = now + self.scan_us
@@ -327,7 +330,9 @@ class Plc(AddressAccess):
         return self._hsc_any
 
     def _instant(self, t: int) -> None:
-        """After the events of one instant: counters current, then the routines."""
+        """After the events of one instant: 1 ms timers and counters current,
+        then the routines."""
+        self.timers.refresh_1ms(t)
         if self._hsc_any:
             for c in self.hsc:
                 if c.pulse is not None:

@@ -27,7 +27,9 @@ Update rules, as plcrt implements them (time is integer microseconds):
   the instruction only starts, stops or resets them.
 * 1 ms: on the hardware they advance every millisecond, asynchronously.
   Simulated program execution takes no time, so the milliseconds of a scan
-  are applied at its start, like the 10 ms timers (see docs/decisions.md).
+  are applied at its start, like the 10 ms timers, and also at the time of
+  every interrupt inside the scan interval (:meth:`TimerBank.refresh_1ms`),
+  so a routine reads the value of its moment (see docs/decisions.md).
 
 The visible state (current value words ``TV`` and bits ``TB``) lives in the
 memory image, so ``LD T37`` and ``MOVW T37, VW0`` are plain reads; this class
@@ -73,6 +75,7 @@ class TimerBank:
         self.res = [resolution_ms(n) for n in range(count)]
         self.d1 = self.d10 = self.d100 = 0  #: ticks since previous scan start
         self._fast: set[int] = set()        #: running 1 ms / 10 ms timers
+        self.ms1: int | None = None         #: the ms the 1 ms timers are advanced to
 
     # -- engine side ----------------------------------------------------
     def start_scan(self, prev_us: int | None, now_us: int) -> None:
@@ -80,12 +83,34 @@ class TimerBank:
         if prev_us is None or now_us == prev_us:
             self.d1 = self.d10 = self.d100 = 0
         else:
-            self.d1 = now_us // 1000 - prev_us // 1000
+            # the 1 ms timers may have been advanced inside the interval already
+            self.d1 = now_us // 1000 - (prev_us // 1000 if self.ms1 is None else self.ms1)
             self.d10 = now_us // 10000 - prev_us // 10000
             self.d100 = now_us // 100000 - prev_us // 100000
+        self.ms1 = now_us // 1000
         if self._fast:
             for n in list(self._fast):
                 self._advance(n, self.d1 if self.res[n] == 1 else self.d10)
+
+    def refresh_1ms(self, t_us: int) -> None:
+        """Advance the running 1 ms timers to *t_us* (an interrupt's time:
+        on the CPU they count every millisecond, whatever the program does)."""
+        if self.ms1 is None or not self._fast:
+            return
+        d = t_us // 1000 - self.ms1
+        if d <= 0:
+            return
+        self.ms1 = t_us // 1000
+        for n in list(self._fast):
+            if self.res[n] == 1:
+                self._advance(n, d)
+
+    def ct_pt_time(self, n: int) -> int | None:
+        """When running 1 ms timer *n* reaches its preset (µs), if it will."""
+        if not self.running[n] or self.res[n] != 1 or self.ms1 is None:
+            return None
+        left = self.preset[n] - self._cv(n)
+        return (self.ms1 + left) * 1000 if left > 0 else None
 
     def _set(self, n: int, cv: int, bit: int) -> None:
         _UH.pack_into(self.tv, n * 2, cv & 0xFFFF)

@@ -231,3 +231,29 @@ def test_coverage_counts_the_networks_of_interrupt_routines():
     plc.run("20ms")
     ran = plc.coverage.data()["networks"]
     assert ran["INT0/1"] == 1 and ran["INT1/1"] == 0 and ran["OB1/1"] == 1
+
+
+def test_t32_ct_pt_interrupts_at_the_exact_millisecond_and_reads_pt():
+    """Event 21: T32 (1 ms TON) started at 0 with PT 25 reaches it at 25 ms,
+    inside the third 10 ms scan; the routine reads T32 = 25 (1 ms timers
+    count every ms), and the main program sees the bit at the next scan."""
+    ob1 = "LD SM0.1\nATCH INT_0, 21\nENI\n\nLD SM0.0\nTON T32, +25"
+    plc = plcrt.load(program(ob1, "LD SM0.0\nINCW VW0\nMOVW T32, VW2\nMOVW VW2, VW4"))
+    plc.scan(2)
+    assert plc["VW0"] == 0
+    plc.scan()                       # interval (20, 30] ms holds 25 ms
+    assert (plc["VW0"], plc["VW2"]) == (1, 25)
+    plc.scan(3)
+    assert plc["VW0"] == 1 and plc["T32"] == 50   # once; the timer counts on (50 ms scan)
+    assert plc["T32:BIT"] == 1
+
+
+def test_a_routine_reads_the_1ms_timers_of_its_own_time():
+    ob1 = ("LD SM0.1\nMOVB 3, SMB34\nATCH INT_0, 10\nENI\n\n"
+           "LD SM0.0\nTON T96, +1000")
+    plc = plcrt.load(program(ob1, "LD SM0.0\nMOVW T96, VW2"), scan_ms=10)
+    plc.scan(2)
+    # routines at 3, 6, 9, 12, 15, 18 ms; T96 started at 0 ms
+    assert plc["VW2"] == 18
+    plc.scan()
+    assert plc["T96"] == 30 and plc["VW2"] == 30   # the routine at 30 ms, the end of (20, 30]

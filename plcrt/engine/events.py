@@ -27,6 +27,8 @@ from typing import Any, Optional, Protocol
 
 __all__ = ["EventSource", "Scheduler"]
 
+_NEVER = 1 << 62    #: "no limit" for a source's next event
+
 
 class EventSource(Protocol):
     """Something that has events at exact times."""
@@ -51,6 +53,13 @@ class Scheduler:
         #: called once after the events of one instant fired (the interrupt
         #: system runs the routines they posted)
         self.after = after
+        #: bumped by whatever may move a source's next event (an instruction
+        #: such as PLS, HSC or ATCH; the end of a pulse train)
+        self.gen = 0
+
+    def touch(self) -> None:
+        """A source's next event may have moved: ask them all again."""
+        self.gen += 1
 
     def busy(self, t_from: int, t_to: int) -> bool:
         """Whether a source has an event in (t_from, t_to]."""
@@ -60,14 +69,21 @@ class Scheduler:
         """Run (t_from, t_to]: events in time order, devices advanced to each."""
         plc, devices = self.plc, self.plc.devices
         t = t_from
+        # perf: a source's next event is asked once and kept until it fires
+        # or something touches the sources (cache: source -> (gen, time))
+        cache: dict[int, tuple[int, Optional[int]]] = {}
         while True:
-            # perf: only the live sources are asked (a routine may wake others)
-            live = [src for src in self.sources if src.live()]
             best: Optional[int] = None
             due: list[Any] = []
-            for src in live:        # in priority order: ties fire in this order
-                te = src.next_time(t, t_to)
-                if te is None:
+            gen = self.gen
+            for src in self.sources:   # in priority order: ties fire in this order
+                hit = cache.get(id(src))
+                if hit is not None and hit[0] == gen and src.cacheable:
+                    te = hit[1]
+                else:
+                    te = src.next_time(t, _NEVER) if src.live() else None
+                    cache[id(src)] = (gen, te)
+                if te is None or te > t_to:
                     continue
                 if best is None or te < best:
                     best, due = te, [src]
@@ -78,7 +94,10 @@ class Scheduler:
             for dev in devices:
                 dev.step(plc, t, best)
             for src in due:
+                cache.pop(id(src), None)
                 src.fire(best)
+                if getattr(src, "moves_others", False):
+                    self.gen += 1      # e.g. a train ended: a counter on it moves too
             if self.after is not None:
                 self.after(best)
             t = best

@@ -210,6 +210,9 @@ class HighSpeedCounter:
         active_low = self.sm[self.control] & 0x02
         return bool(self.inputs >> 3 & 1) != bool(active_low)
 
+    #: its next event changes only by HDEF/HSC, the scan start or its own events
+    cacheable = True
+
     def live(self) -> bool:
         """Whether it counts a running pulse output or an encoder (events to come)."""
         return self.enabled and self.pulse is not None and bool(self.pulse.trains)

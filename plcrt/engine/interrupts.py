@@ -215,6 +215,9 @@ class Interrupts:
                 self.post(rise if new >> bit & 1 else fall, t)
 
     # ------------------------------------------------------------ timed
+    #: its next event is asked anew each time (a routine's TON moves T32's CT=PT)
+    cacheable = False
+
     def live(self) -> bool:
         """Whether a timed interrupt runs, or T32/T96 CT=PT is attached (the
         scheduler asks only live sources)."""

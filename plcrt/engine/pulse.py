@@ -129,6 +129,11 @@ class PulseOutput:
     def _dword(self, offset: int) -> int:
         return int.from_bytes(self.sm[offset:offset + 4], "big")
 
+    #: its events change what counters on it will do (the scheduler asks them again)
+    moves_others = True
+    #: its next event changes only by PLS or its own events (the scheduler keeps it)
+    cacheable = True
+
     def live(self) -> bool:
         """Whether it has events to come (a train, a synchronous PWM update)."""
         return bool(self.trains) or self.pwm_next is not None

@@ -343,11 +343,13 @@ class Plc(AddressAccess):
         self._hsc_any = True
         counter = self.hsc[number]
         counter.hdef(mode, self._irq_t)
+        self.scheduler.touch()
         if counter.pulse is not None and counter not in self.scheduler.sources:
             self.scheduler.sources.append(counter)
 
     def _hsc(self, number: int) -> None:
         self.hsc[number].hsc(self._irq_t)
+        self.scheduler.touch()
 
     def _pulse_running(self) -> bool:
         p0, p1 = self.pulse
@@ -355,6 +357,7 @@ class Plc(AddressAccess):
 
     def _pls(self, number: int) -> None:
         self.pulse[number].pls(self._irq_t)
+        self.scheduler.touch()
 
     def _irq_time(self, t: int) -> None:
         self._irq_t = t
@@ -364,6 +367,11 @@ class Plc(AddressAccess):
 
     def _irq_attach(self, number: int, event: int) -> None:
         self.interrupts.attach(number, event, self._irq_t)
+        self.scheduler.touch()
+
+    def _irq_detach(self, event: int) -> None:
+        self.interrupts.detach(event)
+        self.scheduler.touch()
 
     def _irq_enable(self) -> None:
         self.interrupts.enable(self._irq_t)

@@ -74,7 +74,7 @@ def _atch(g: Gen, insn_ir, resolver, *_ops) -> None:
 def _dtch(g: Gen, insn_ir, resolver, *_ops) -> None:
     evnt, = _operands(g, insn_ir, 1, "an event (DTCH EVNT)")
     event = _event(g, resolver, evnt)
-    detach = g.bind(g.unit.hooks["plc"].interrupts.detach, "dtch")
+    detach = g.bind(g.unit.hooks["plc"]._irq_detach, "dtch")
     with _guarded(g):
         g.line(f"{detach}({event})")
 

@@ -244,6 +244,10 @@ _PARAM_ROLE = {
     ("OUT", 0): Role.BIT_W, ("OUT", 1): Role.B_W, ("OUT", 2): Role.W_W, ("OUT", 4): Role.D_W,
 }
 _KIND = {1: "B", 2: "WU", 4: "DU"}
+#: types whose IN parameter also takes an address ``&VB100`` (a pointer):
+#: Micro/WIN passes a pointer to a DWORD input (System Manual, "Pointers"
+#: and "Subroutine parameters"), never to a DINT or REAL one
+_POINTER_TYPES = ("DWORD",)
 
 
 @insn("CALL", family=F, summary="call a subroutine with parameters", variadic=True,
@@ -276,7 +280,10 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         sections = ("IN",) if decl.section == "IN" else ("OUT",) if decl.section == "OUT" \
             else ("IN", "OUT")
         try:
-            ops = {s: check_role(resolver.parse(op_ir.text), _PARAM_ROLE[(s, width)],
+            ops = {s: check_role(resolver.parse(op_ir.text),
+                                 Role.D_PTR if s == "IN" and decl.section == "IN"
+                                 and decl.type.upper() in _POINTER_TYPES
+                                 else _PARAM_ROLE[(s, width)],
                                  op_ir.text, g.unit.model) for s in sections}
         except ResolveError as e:
             g.fail(f"parameter #{excerpt(decl.name)} ({decl.type}, {decl.section}): {e}")

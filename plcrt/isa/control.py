@@ -13,7 +13,7 @@ leaves the POU).  POUs without control flow pay nothing for it.
 from __future__ import annotations
 
 from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const
+from ..compiler.operands import Addr, Const, Pointer
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role, insn
 from ..safetext import excerpt
@@ -280,11 +280,11 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         sections = ("IN",) if decl.section == "IN" else ("OUT",) if decl.section == "OUT" \
             else ("IN", "OUT")
         try:
-            ops = {s: check_role(resolver.parse(op_ir.text),
-                                 Role.D_PTR if s == "IN" and decl.section == "IN"
-                                 and decl.type.upper() in _POINTER_TYPES
-                                 else _PARAM_ROLE[(s, width)],
-                                 op_ir.text, g.unit.model) for s in sections}
+            op = resolver.parse(op_ir.text)
+            ops = {s: op if s == "IN" and isinstance(op, Pointer) and decl.section == "IN"
+                   and decl.type.upper() in _POINTER_TYPES
+                   else check_role(op, _PARAM_ROLE[(s, width)], op_ir.text, g.unit.model)
+                   for s in sections}
         except ResolveError as e:
             g.fail(f"parameter #{excerpt(decl.name)} ({decl.type}, {decl.section}): {e}")
         if "IN" in ops:

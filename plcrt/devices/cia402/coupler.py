@@ -162,7 +162,7 @@ class FieldbusModule:
                 drive.write(index, sub, value)
             except SdoAbort as e:
                 raise PlcConfigError(f"{where}: the drive refuses {index:04X}h:{sub:02X} = "
-                                     f"{value}: {e}") from None
+                                     f"{value}: {e.message}") from None
         for state in (EsmState.SAFEOP, EsmState.OP):
             res = drive.request_esm(state)
             if drive.esm.state is not state:
@@ -241,7 +241,7 @@ class FieldbusModule:
             port.abort = e.code
             port.flags = ERROR
             self.plc.warn(f"fieldbus slot {self.slot} node {port.node}: SDO {what} at "
-                          f"{t / 1e6:.6f} s aborted with 0x{e.code:08X}: {e}",
+                          f"{t / 1e6:.6f} s aborted: {e.message}",
                           None, f"sdo-{self.slot}-{port.node}-{t}")
 
     def _report(self, port: _Port) -> None:

@@ -94,6 +94,12 @@ IN_LAYOUT: tuple[tuple[int, Optional[int], str], ...] = (
 _OUT = struct.Struct(">" + "".join(c for _, _, c in OUT_LAYOUT))
 _IN = struct.Struct(">" + "".join(c for _, _, c in IN_LAYOUT))
 _RX_OBJECTS = tuple(i for _, i, _ in OUT_LAYOUT if i is not None)
+#: the order in which a bus cycle applies the received objects (6040h comes
+#: last in any case): the profile first, then the mode and the targets, so
+#: that a PV start or a set-point written in the same scan as its ramps
+#: runs on those ramps, not on the ones before
+_APPLY_ORDER = (0x6081, 0x6083, 0x6084, 0x6098, 0x6060, 0x607A, 0x60FF, 0x6040)
+assert sorted(_APPLY_ORDER) == sorted(_RX_OBJECTS)
 _TX_OBJECTS = tuple(i for _, i, _ in IN_LAYOUT if i is not None)
 assert _OUT.size == 32 and _IN.size == 32
 
@@ -120,7 +126,7 @@ class _Port:
         self.data = 0
         self.abort = 0
         self.seen = 0                         #: drive log entries reported so far
-        self.rx_keys = tuple((i, 0) for i in _RX_OBJECTS if drive.od.find(i, 0) is not None)
+        self.rx_keys = tuple((i, 0) for i in _APPLY_ORDER if drive.od.find(i, 0) is not None)
         self.tx = tuple((i, drive.od.find(i, 0) is not None) for i in _TX_OBJECTS)
 
 

@@ -159,6 +159,19 @@ def test_a_scan_s_outputs_act_at_the_next_bus_cycle(scan_ms, cycle_ms, extra, sc
     assert [e.t_us for e in taken] == [taken_us]
 
 
+def test_ramps_written_with_their_target_in_one_scan_act_on_that_target():
+    """6083h and 60FFh written in the same scan: the bus cycle applies the
+    profile before the target, so PV ramps on the new 6083h (100000
+    counts/s²: 900 counts/s after the 9 ms from the cycle at 31 ms to the
+    one at 40 ms), not at once on the old 0."""
+    plc = load()
+    enable(plc, mode=3)
+    plc.write(f"VD{IMG + 16}", 100000)
+    plc.write(f"VD{IMG + 8}", 10000)
+    plc.scan()
+    assert plc.drive(1).velocity == 900 and plc.read(f"VD{IMG + 40}") == 900
+
+
 def test_without_a_bus_cycle_between_two_scans_the_input_half_stands_still():
     """With a 4 ms bus cycle and 1 ms scans the statusword changes only
     in the scan after a cycle: a program reads the drive's answer to a

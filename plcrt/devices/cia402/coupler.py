@@ -46,8 +46,9 @@ offset type   object   meaning
 
 Timing: the output half is sampled once, after the program's scan; the
 drives are cycled at every multiple of the bus cycle up to the next scan's
-start with those values; the input half then holds the drive's objects after
-the last of those cycles.  An SDO request seen after a scan is served at the
+start with those values (the profile 6081h/6083h/6084h first, then 6098h,
+6060h, the targets, and 6040h last); the input half then holds the drive's
+objects after the last of those cycles.  An SDO request seen after a scan is served at the
 second bus cycle after it (``SDO_CYCLES``); busy, then done or error, show in
 the module status; done and error stay until the program drops REQ.
 

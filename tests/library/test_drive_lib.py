@@ -61,7 +61,7 @@ class Rig:
 
     def enable(self) -> None:
         self.h["I0.0"] = 1
-        self.h.run_until("M0.0", timeout=1)
+        self.h.run_until("M0.0", timeout=2)
 
     def run_block(self, execute: str, done: str, error: str, timeout: float = 30) -> str:
         """Raise *execute*, wait for done or error, drop it; which came."""
@@ -91,18 +91,21 @@ class Rig:
         return self.run_block("I0.5", "M4.1", "M4.2")
 
 
-@pytest.fixture(params=MODELS)
-def rig(request, plc_factory) -> Rig:
-    model = request.param
+def make_rig(plc_factory, model: str, scan_ms: float = 10, cycle_ms: float = 1) -> Rig:
     params = {"6099:01": 20000, "6099:02": 2000, "609A": 200000, **PLANT[model]}
-    plant = {"module": {"0": {"kind": "FIELDBUS", "drive": {"1": {
+    plant = {"module": {"0": {"kind": "FIELDBUS", "cycle_ms": cycle_ms, "drive": {"1": {
         "model": model, "image": 1000, "neg_limit": -100000, "pos_limit": 200000,
         "home_switch": [10000, 12000], "index_period": 2000, "index_phase": 500,
         "params": params}}}}}
-    h = plc_factory([RIG, str(LIB)], plant=plant,
+    h = plc_factory([RIG, str(LIB)], plant=plant, scan_ms=scan_ms,
                     watch=["M0.0", "M1.1", "M2.1", "VW1000", "VW1032", "VD1036"])
     h.scan()
     return Rig(h, model)
+
+
+@pytest.fixture(params=MODELS)
+def rig(request, plc_factory) -> Rig:
+    return make_rig(plc_factory, request.param)
 
 
 # ---------------------------------------------------------------- DRV_POWER
@@ -135,7 +138,7 @@ def test_power_off_disables_voltage_and_keeps_the_motion_bits(rig):
 
 def test_the_library_leaves_the_accumulators_and_the_free_image_bytes_alone(rig):
     h = rig.h
-    for i in range(75, 80):
+    for i in range(77, 80):
         h[f"VB{1000 + i}"] = 0xA0 + i
     rig.enable()
     assert rig.home(19) == "M1.1"
@@ -145,7 +148,7 @@ def test_the_library_leaves_the_accumulators_and_the_free_image_bytes_alone(rig)
     assert [u16(h[f"VD{a}"] >> 16) for a in (80, 84, 88, 92)] == \
         [0x0A0A, 0x1B1B, 0x2C2C, 0x3D3D]
     assert [h[f"VD{a}"] & 0xFFFF for a in (80, 84, 88, 92)] == [0x0A0A, 0x1B1B, 0x2C2C, 0x3D3D]
-    assert [h[f"VB{1000 + i}"] for i in range(75, 80)] == [0xA0 + i for i in range(75, 80)]
+    assert [h[f"VB{1000 + i}"] for i in range(77, 80)] == [0xA0 + i for i in range(77, 80)]
 
 
 # ---------------------------------------------------------------- DRV_HOME
@@ -208,6 +211,22 @@ def test_home_on_an_active_limit_the_method_does_not_use_is_a_homing_error(plc_f
     assert rig.drive.state == "OPERATION ENABLED" and rig.image("cw") & 0x10 == 0
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_with_scans_faster_than_the_bus_cycle_a_second_homing_still_runs(plc_factory, model):
+    """1 ms scans, 4 ms bus cycle: the scan after bit 4 rose still reads
+    the attained word of the first homing; the block waits for the bus
+    cycle counter to move, so the second homing runs (the drive logs two
+    starts) and ends on the same home point."""
+    rig = make_rig(plc_factory, model, scan_ms=1, cycle_ms=4)
+    rig.enable()
+    assert rig.home(19) == "M1.1"
+    first = rig.h.time
+    assert rig.home(19) == "M1.1"
+    starts = [e for e in rig.sim.log if "homing method 19 started" in e.text]
+    assert len(starts) == 2 and starts[1].t_us > first * 1e6
+    assert rig.drive.position == 0 and rig.drive.statusword == HOMED[model]
+
+
 # ---------------------------------------------------------------- DRV_MOVE
 def test_absolute_then_relative_moves_end_exactly_on_their_targets(rig):
     rig.enable()
@@ -250,6 +269,19 @@ def test_a_move_into_a_limit_switch_ends_in_error(rig):
     assert rig.drive.position == 200000 and rig.drive.statusword & 0x0C00 == 0x0C00
     assert rig.move(210000) == "M2.2"
     assert rig.drive.position == 200000
+    assert rig.move(150000) == "M2.1"
+    assert rig.drive.position == 150000
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_with_scans_faster_than_the_bus_cycle_a_move_off_a_limit_is_done(plc_factory, model):
+    """1 ms scans, 4 ms bus cycle: after a stop at PLS the statusword
+    shows bit 11 until the drive has taken the move away from it; the
+    block judges the refusal bits only after a bus cycle, so the move is
+    done, not refused."""
+    rig = make_rig(plc_factory, model, scan_ms=1, cycle_ms=4)
+    rig.enable()
+    assert rig.move(250000) == "M2.2"
     assert rig.move(150000) == "M2.1"
     assert rig.drive.position == 150000
 

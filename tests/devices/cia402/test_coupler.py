@@ -101,13 +101,14 @@ def test_the_output_half_reaches_the_drive_most_significant_byte_first():
 
 def test_the_input_half_mirrors_the_drive_after_the_scan():
     """After every scan the input half holds 6041h, 6061h, the module
-    status, 6064h, 606Ch, 603Fh, 0, 60F4h, 60FDh, the SDO data and abort,
+    status, 6064h, 606Ch, 603Fh, the bus cycle counter (10 per 10 ms scan),
+    60F4h, 60FDh, the SDO data and abort,
     big-endian; 60FDh has bit 0 (NLS) and bit 2 (home switch) from the
     plant at position 0."""
     plc = load(neg_limit=0, pos_limit=100000, home_switch="[-10, 10]")
     plc.scan()
     fields = struct.unpack(">HbBiiHHiIiI", vbytes(plc, 32, 32))
-    assert fields == (0x0250, 8, 0x01, 0, 0, 0, 0, 0, 0b101, 0, 0)
+    assert fields == (0x0250, 8, 0x01, 0, 0, 0, 10, 0, 0b101, 0, 0)
     assert vbytes(plc, 32, 2) == b"\x02\x50"
     enable(plc)
     for name, value in (("6081", 50000), ("6083", 100000), ("6084", 100000)):
@@ -120,7 +121,7 @@ def test_the_input_half_mirrors_the_drive_after_the_scan():
         get = d.store.get
         fields = struct.unpack(">HbBiiHHiIiI", vbytes(plc, 32, 32))
         assert fields == (get(0x6041), get(0x6061), 0x01, get(0x6064), get(0x606C),
-                          get(0x603F), 0, get(0x60F4), get(0x60FD), 0, 0)
+                          get(0x603F), plc.scans * 10, get(0x60F4), get(0x60FD), 0, 0)
     plc.scan(300)
     assert plc.drive(1).position == 0x12345
     assert vbytes(plc, 36, 4) == b"\x00\x01\x23\x45"
@@ -185,6 +186,21 @@ def test_without_a_bus_cycle_between_two_scans_the_input_half_stands_still():
     # the scan at 0 ms; cycle at 4 ms, seen after the scan at 3 ms (t_to = 4 ms)
     assert seen == [(1, 0x0250), (2, 0x0250), (3, 0x0250), (4, 0x0631), (5, 0x0631),
                     (6, 0x0631)]
+
+
+def test_the_bus_cycle_counter_counts_cycles_and_wraps():
+    """Offset 46 counts the bus cycles up to the next scan's start: with a
+    4 ms cycle and 1 ms scans it moves after the scans at 3 and 7 ms; it
+    wraps from 65535 to 0."""
+    plc = load(scan_ms=1, cycle_ms=4)
+    seen = []
+    for _ in range(8):
+        plc.scan()
+        seen.append(plc.read(f"VW{IMG + 46}"))
+    assert seen == [0, 0, 0, 1, 1, 1, 1, 2]
+    plc.module(0).cycles = 65535
+    plc.scan(4)
+    assert plc.read(f"VW{IMG + 46}") == 0
 
 
 # ---------------------------------------------------------------- SDO mailbox

@@ -443,3 +443,29 @@ def test_a_fault_that_needs_a_power_cycle_keeps_reset_busy_until_execute_falls(r
     h.scan()
     assert (h["M6.0"], h["M6.1"], rig.image("cw") & 0x80) == (0, 0, 0)
     assert rig.drive.state == "FAULT"
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_with_scans_faster_than_the_bus_cycle_a_reset_retried_at_once_reaches_the_drive(
+        plc_factory, model):
+    """1 ms scans, 4 ms bus cycle, a fault only a power cycle clears:
+    reset pressed (bit 7 high), dropped in the scan at 22 ms and pressed
+    again at 23 ms, before the next cycle.  The block raises bit 7 again
+    only after the cycle at 24 ms has carried it low, so the drive sees a
+    second 0->1 edge at 28 ms (and refuses it again, saying why)."""
+    rig = make_rig(plc_factory, model, scan_ms=1, cycle_ms=4)
+    rig.enable()
+    h = rig.h
+    rig.sim.fault(rig.sim.now, 20704, 20704, "over-current (test)")
+    h.run_until("M0.1", timeout=1)
+    assert round(h.time * 1000) == 17                 # the next scan begins at 17 ms
+    trace = []
+    for i in range(12):
+        h["I0.7"] = int(i != 5)
+        h.scan()
+        trace.append((round(h.time * 1000) - 1, h["M6.0"], rig.image("cw") & 0x80))
+    assert trace == [(17, 1, 0x80), (18, 1, 0x80), (19, 1, 0x80), (20, 1, 0x80), (21, 1, 0x80),
+                     (22, 0, 0), (23, 1, 0), (24, 1, 0x80), (25, 1, 0x80), (26, 1, 0x80),
+                     (27, 1, 0x80), (28, 1, 0x80)]
+    refused = [e.t_us for e in rig.sim.log if "Fault reset refused" in e.text]
+    assert refused == [20_000, 28_000]

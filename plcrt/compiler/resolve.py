@@ -89,10 +89,16 @@ class Resolver:
     def parse(self, text: str) -> Resolved:
         t = text.strip()
         if t.startswith("#"):
-            var = self.locals.get(t[1:].upper())
-            if var is None:
-                raise ResolveError(f"unknown local variable '{excerpt(t)}'")
-            return var.addr
+            return self._local(t).addr
+        if t.startswith("*#"):
+            # *#Ptr: the symbolic form of *LDn, a pointer held in a DWORD
+            # local (Micro/WIN shows local addresses by their names)
+            var = self._local(t[1:])
+            if var.addr.width != 4:
+                raise ResolveError(f"{excerpt(t)}: indirect addressing needs a pointer in a "
+                                   f"double-word local, and #{excerpt(var.decl.name)} is "
+                                   f"{excerpt(var.decl.type)}")
+            return Indirect(var.addr, t)
         try:
             op = parse_operand(t, self.model)
         except OperandError as e:
@@ -100,6 +106,12 @@ class Resolver:
         if isinstance(op, Name):
             return self._symbol(op, t)
         return op
+
+    def _local(self, t: str) -> LocalVar:
+        var = self.locals.get(t[1:].upper())
+        if var is None:
+            raise ResolveError(f"unknown local variable '{excerpt(t)}'")
+        return var
 
     def _symbol(self, op: Name, text: str) -> Resolved:
         target = None

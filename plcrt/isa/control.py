@@ -13,7 +13,7 @@ leaves the POU).  POUs without control flow pay nothing for it.
 from __future__ import annotations
 
 from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const
+from ..compiler.operands import Addr, Const, Pointer
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role, insn
 from ..safetext import excerpt
@@ -244,6 +244,10 @@ _PARAM_ROLE = {
     ("OUT", 0): Role.BIT_W, ("OUT", 1): Role.B_W, ("OUT", 2): Role.W_W, ("OUT", 4): Role.D_W,
 }
 _KIND = {1: "B", 2: "WU", 4: "DU"}
+#: types whose IN parameter also takes an address ``&VB100`` (a pointer):
+#: Micro/WIN passes a pointer to a DWORD input (System Manual, "Pointers"
+#: and "Subroutine parameters"), never to a DINT or REAL one
+_POINTER_TYPES = ("DWORD",)
 
 
 @insn("CALL", family=F, summary="call a subroutine with parameters", variadic=True,
@@ -276,8 +280,11 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         sections = ("IN",) if decl.section == "IN" else ("OUT",) if decl.section == "OUT" \
             else ("IN", "OUT")
         try:
-            ops = {s: check_role(resolver.parse(op_ir.text), _PARAM_ROLE[(s, width)],
-                                 op_ir.text, g.unit.model) for s in sections}
+            op = resolver.parse(op_ir.text)
+            ops = {s: op if s == "IN" and isinstance(op, Pointer) and decl.section == "IN"
+                   and decl.type.upper() in _POINTER_TYPES
+                   else check_role(op, _PARAM_ROLE[(s, width)], op_ir.text, g.unit.model)
+                   for s in sections}
         except ResolveError as e:
             g.fail(f"parameter #{excerpt(decl.name)} ({decl.type}, {decl.section}): {e}")
         if "IN" in ops:

@@ -33,7 +33,7 @@ offset type   object   meaning
 36     DINT   6064h    position actual value
 40     DINT   606Ch    velocity actual value
 44     WORD   603Fh    error code
-46     WORD            0 (reserved)
+46     WORD            bus cycle counter: +1 at every bus cycle, wraps
 48     DINT   60F4h    following error actual value
 52     DWORD  60FDh    digital inputs (bit 0 NLS, 1 PLS, 2 home switch)
 56     DINT            SDO response: the value read
@@ -46,8 +46,12 @@ offset type   object   meaning
 
 Timing: the output half is sampled once, after the program's scan; the
 drives are cycled at every multiple of the bus cycle up to the next scan's
-start with those values; the input half then holds the drive's objects after
-the last of those cycles.  An SDO request seen after a scan is served at the
+start with those values (the profile 6081h/6083h/6084h first, then 6098h,
+6060h, the targets, and 6040h last); the input half then holds the drive's
+objects after the last of those cycles.  The bus cycle counter (offset 46) tells a
+program whether a bus cycle has passed since it wrote a command: with a
+scan shorter than the bus cycle, the input half of the next scan may still
+be the one from before the command.  An SDO request seen after a scan is served at the
 second bus cycle after it (``SDO_CYCLES``); busy, then done or error, show in
 the module status; done and error stay until the program drops REQ.
 
@@ -94,6 +98,12 @@ IN_LAYOUT: tuple[tuple[int, Optional[int], str], ...] = (
 _OUT = struct.Struct(">" + "".join(c for _, _, c in OUT_LAYOUT))
 _IN = struct.Struct(">" + "".join(c for _, _, c in IN_LAYOUT))
 _RX_OBJECTS = tuple(i for _, i, _ in OUT_LAYOUT if i is not None)
+#: the order in which a bus cycle applies the received objects (6040h comes
+#: last in any case): the profile first, then the mode and the targets, so
+#: that a PV start or a set-point written in the same scan as its ramps
+#: runs on those ramps, not on the ones before
+_APPLY_ORDER = (0x6081, 0x6083, 0x6084, 0x6098, 0x6060, 0x607A, 0x60FF, 0x6040)
+assert sorted(_APPLY_ORDER) == sorted(_RX_OBJECTS)
 _TX_OBJECTS = tuple(i for _, i, _ in IN_LAYOUT if i is not None)
 assert _OUT.size == 32 and _IN.size == 32
 
@@ -120,7 +130,7 @@ class _Port:
         self.data = 0
         self.abort = 0
         self.seen = 0                         #: drive log entries reported so far
-        self.rx_keys = tuple((i, 0) for i in _RX_OBJECTS if drive.od.find(i, 0) is not None)
+        self.rx_keys = tuple((i, 0) for i in _APPLY_ORDER if drive.od.find(i, 0) is not None)
         self.tx = tuple((i, drive.od.find(i, 0) is not None) for i in _TX_OBJECTS)
 
 
@@ -135,6 +145,7 @@ class FieldbusModule:
         if self.slot >= model.max_modules:
             raise PlcConfigError(f"{cfg.where}: the {model.name} takes {model.max_modules} "
                                  f"expansion module(s); a module in slot {self.slot} is not possible")
+        self.cycles = 0                        #: bus cycles so far, modulo 2**16
         self.ports: dict[int, _Port] = {}
         for node, dc in sorted(cfg.drives.items()):
             if dc.image + IMAGE_BYTES > model.v_bytes:
@@ -192,6 +203,7 @@ class FieldbusModule:
                     self._serve(port, t)
                     req = None
             self._report(port)
+        self.cycles = (self.cycles + len(range(first, t_to + 1, period))) & 0xFFFF
         self._write_inputs()
 
     @staticmethod
@@ -269,9 +281,9 @@ class FieldbusModule:
             status = port.flags | (ONLINE if port.drive.esm.state is EsmState.OP else 0)
             if port.flags & (DONE | ERROR):
                 port.shown = True
-            # 6041h, 6061h, status, 6064h, 606Ch, 603Fh, reserved, 60F4h, 60FDh, data, abort
+            # 6041h, 6061h, status, 6064h, 606Ch, 603Fh, cycles, 60F4h, 60FDh, data, abort
             _IN.pack_into(v, port.image + 32, vals[0], vals[1], status, vals[2], vals[3],
-                          vals[4], 0, vals[5], vals[6], port.data, port.abort)
+                          vals[4], self.cycles, vals[5], vals[6], port.data, port.abort)
 
     # ------------------------------------------------------------------ state
     def snapshot(self, t: int) -> list[AxisState]:

@@ -18,7 +18,7 @@ def test_an_invalid_homing_method_faults_the_drive_and_reset_clears_it(enabled, 
     plc[axis["HomeMethod"]] = 15
     press(plc, axis["Home_PB"], axis["Error_L"])
     plc.scan()
-    d = plc.plc.drive(axis.node)
+    d = plc.drive(axis.node)
     assert (d.state, d.error_code) == ("FAULT", 62)
     assert plc[f"VW{axis.image + 44}"] == 62                     # 603Fh in the image
     assert plc.values(axis["Fault_L"], axis["Ready_L"], axis["Homed_L"]) == \
@@ -26,14 +26,14 @@ def test_an_invalid_homing_method_faults_the_drive_and_reset_clears_it(enabled, 
     assert any(f"node {axis.node}:" in m.message and "invalid homing method" in m.message
                for m in plc.diagnostics)
     press(plc, axis["Reset_PB"], axis["Ready_L"], timeout=1)
-    d = plc.plc.drive(axis.node)
+    d = plc.drive(axis.node)
     assert (d.state, d.error_code) == ("OPERATION ENABLED", 0)
     assert plc.values(axis["Fault_L"], axis["Error_L"]) == {axis["Fault_L"]: 0,
                                                            axis["Error_L"]: 0}
     # the drive works again: homing with the panel's own method
     plc[axis["HomeMethod"]] = 19 if axis.node == 1 else 5
     press(plc, axis["Home_PB"], axis["Homed_L"])
-    assert plc.plc.drive(axis.node).position == 0
+    assert plc.drive(axis.node).position == 0
 
 
 def test_a_fault_on_one_drive_leaves_the_other_running(enabled):
@@ -43,4 +43,4 @@ def test_a_fault_on_one_drive_leaves_the_other_running(enabled):
     plc.run_until("D2_InVel_L", timeout=2)
     plc["D1_HomeMethod"] = 15
     press(plc, "D1_Home_PB", "D1_Fault_L")
-    assert plc.plc.drive(2).velocity == 25000 and plc["D2_InVel_L"] == 1
+    assert plc.drive(2).velocity == 25000 and plc["D2_InVel_L"] == 1

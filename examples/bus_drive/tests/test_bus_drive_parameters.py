@@ -48,5 +48,5 @@ def test_a_refused_write_lights_the_error_lamp_with_the_abort_code(enabled, axis
     assert plc[axis["ParDone_L"]] == 0
     assert any(f"node {axis.node}: SDO write 6041h:00" in d.message and "read-only" in d.message
                for d in plc.diagnostics)
-    assert plc.plc.drive(axis.node).state == "OPERATION ENABLED"
+    assert plc.drive(axis.node).state == "OPERATION ENABLED"
     press(plc, axis["Reset_PB"], f"not {axis['Error_L']}")

@@ -36,7 +36,7 @@ from .homing_plan import HomingPlan, homing_plans
 from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, ProfileVelocity,
                     MODE_NAMES)
 from .od import ObjectDictionary, SdoAbort
-from .pdo import ASSIGN, RX_MAPS, TX_MAPS, PdoConfig, pack, unpack
+from .pdo import ASSIGN, MapLayout, PdoConfig, pack, unpack
 from .plant import DrivePlant
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
@@ -86,7 +86,8 @@ class Drive:
         self.log: list[DriveEvent] = []
         self.axis = Axis(0)
         self.controlword = int(self.store.get(0x6040))
-        self.pdo = PdoConfig(self._lookup, lambda: self.esm.state, self._default_maps())
+        self.pdo = PdoConfig(self._lookup, lambda: self.esm.state, self._default_maps(),
+                             self._map_layout())
         self.esm = Esm(self.pdo.activate)
         mode = int(self.store.get(0x6060))
         self.sm = Drive402(model, t=t_us / 1e6, mode=mode or None)
@@ -137,20 +138,24 @@ class Drive:
         self.log.append(DriveEvent(t, source or MODE_NAMES.get(self.mode_number, "drive"),
                                    text, section))
 
+    def _map_layout(self) -> MapLayout:
+        """This model's mapping objects and limits, from its dictionary: a
+        CANopen model (Kinco) has no 1C12h/1C13h and maps of at most 8 bytes."""
+        od = self.od
+        rx = tuple(i for i in range(0x1600, 0x1800) if od.find(i, 0) is not None)
+        tx = tuple(i for i in range(0x1A00, 0x1C00) if od.find(i, 0) is not None)
+        return MapLayout(rx, tx, od.find(0x1C12, 0) is not None, od.pdo_max_entries,
+                         od.pdo_max_bytes, str(od.info.get("pdo_source", "HCFA §6.7.2")))
+
     def _default_maps(self) -> dict[int, tuple[int, ...]]:
-        """The power-up PDO maps and assignment of this model's object
-        dictionary.  A CANopen model (Kinco) has no 1C12h/1C13h: its first
-        RxPDO and TxPDO maps are the process data."""
+        """The power-up PDO maps and assignment of this model's object dictionary."""
         out: dict[int, tuple[int, ...]] = {}
-        for index in (*RX_MAPS, *TX_MAPS, *ASSIGN):
+        for index in (*range(0x1600, 0x1800), *range(0x1A00, 0x1C00), *ASSIGN):
             if self.od.find(index, 0) is None:
                 continue
             count = int(self.store.get(index, 0))
             out[index] = tuple(int(self.store.get(index, k)) for k in range(1, count + 1)
                                if self.od.find(index, k) is not None)
-        for assign, first in ((0x1C12, RX_MAPS[0]), (0x1C13, TX_MAPS[0])):
-            if assign not in out and first in out:
-                out[assign] = (first,)
         return out
 
     def _lookup(self, index: int, sub: int) -> Optional[tuple[int, str]]:
@@ -192,8 +197,7 @@ class Drive:
     # ---------------------------------------------------------------- master side
     def sdo_read(self, index: int, sub: int = 0) -> bytes:
         """SDO upload (the store's rules)."""
-        if index in ASSIGN or index in RX_MAPS or index in TX_MAPS:
-            self.od.entry(index, sub)
+        if index in self.pdo.entries:
             return self.od.entry(index, sub).encode(self.pdo.read(index, sub))
         return self.store.sdo_read(index, sub)
 
@@ -206,7 +210,7 @@ class Drive:
     def _sdo_write(self, index: int, sub: int, data: bytes) -> None:
         state = {EsmState.PREOP: "PREOP", EsmState.SAFEOP: "SAFEOP",
                  EsmState.OP: "OP"}.get(self.esm.state, "INIT")
-        if index in ASSIGN or index in RX_MAPS or index in TX_MAPS:
+        if index in self.pdo.entries:
             entry = self.od.entry(index, sub)
             if len(data) != entry.size:
                 self.store.sdo_write(index, sub, data, state=state)   # raises the length code

@@ -23,7 +23,8 @@ from .statemachine import Cia402Error
 
 __all__ = [
     "MapEntry", "RX_MAPS", "TX_MAPS", "MAX_ENTRIES", "MAX_BYTES", "DEFAULT_MAPS",
-    "DEFAULT_ASSIGN", "WriteResult", "PdoConfig", "pack", "unpack", "layout", "Lookup",
+    "DEFAULT_ASSIGN", "WriteResult", "PdoConfig", "MapLayout", "pack", "unpack", "layout",
+    "Lookup",
 ]
 
 Lookup = Callable[[int, int], "tuple[int, str] | None"]
@@ -90,6 +91,22 @@ DEFAULT_MAPS: dict[int, tuple[int, ...]] = {
 }
 #: Only 1600h and 1A00h are assigned by default (HCFA §8.2: 1C12h = 1600h, 1C13h = 1A00h).
 DEFAULT_ASSIGN: dict[int, tuple[int, ...]] = {0x1C12: (0x1600,), 0x1C13: (0x1A00,)}
+
+
+@dataclass(frozen=True, slots=True)
+class MapLayout:
+    """A model's mapping objects and their limits (from its object dictionary).
+
+    ``assign``: the model has the EtherCAT assignment objects 1C12h/1C13h
+    (HCFA §6.7.3); without them (a CANopen model, CiA 301) every map with
+    entries is in use and none is locked by an assignment."""
+
+    rx: tuple[int, ...] = RX_MAPS
+    tx: tuple[int, ...] = TX_MAPS
+    assign: bool = True
+    max_entries: int = MAX_ENTRIES
+    max_bytes: int = MAX_BYTES
+    source: str = "HCFA §6.7.2"
 
 
 @dataclass(frozen=True, slots=True)
@@ -160,17 +177,27 @@ class PdoConfig:
     and, when good, makes it the active mapping."""
 
     def __init__(self, lookup: Lookup, state: Callable[[], EsmState],
-                 defaults: dict[int, tuple[int, ...]] | None = None) -> None:
+                 defaults: dict[int, tuple[int, ...]] | None = None,
+                 layout: MapLayout | None = None) -> None:
         """``defaults``: the power-up maps and assignment by object index
-        (the model's object dictionary); missing ones are HCFA's."""
+        (the model's object dictionary); missing ones are HCFA's.
+        ``layout``: the model's mapping objects and limits (HCFA's)."""
         self.lookup = lookup
         self.state = state
+        self.layout = L = layout or MapLayout()
+        #: assignment object -> the maps it may name (none in a CANopen model)
+        self.owners: dict[int, tuple[int, ...]] = {0x1C12: L.rx, 0x1C13: L.tx} \
+            if L.assign else {}
         self.entries: dict[int, list[int]] = {}
         self.count: dict[int, int] = {}
-        start = {**DEFAULT_MAPS, **DEFAULT_ASSIGN, **(defaults or {})}
-        for index, rows in start.items():
-            size = MAX_ENTRIES if index in DEFAULT_MAPS else len(ASSIGN[index])
-            self.entries[index] = list(rows) + [0] * (size - len(rows))
+        defaults = defaults or {}
+        for index in (*L.rx, *L.tx):
+            rows = defaults.get(index, DEFAULT_MAPS.get(index, ()) if L.assign else ())
+            self.entries[index] = list(rows) + [0] * (L.max_entries - len(rows))
+            self.count[index] = len(rows)
+        for index, allowed in self.owners.items():
+            rows = defaults.get(index, DEFAULT_ASSIGN[index])
+            self.entries[index] = list(rows) + [0] * (len(allowed) - len(rows))
             self.count[index] = len(rows)
         self.active_rx: tuple[MapEntry, ...] = self._flatten(0x1C12)
         self.active_tx: tuple[MapEntry, ...] = self._flatten(0x1C13)
@@ -187,7 +214,7 @@ class PdoConfig:
         bad = self._check_object(index, sub, raise_=False)
         if bad:
             return self._abort(bad, where, "HCFA §6.7.2, §6.7.3")
-        limit = 0xFF if sub == 0 else (0xFFFFFFFF if index not in ASSIGN else 0xFFFF)
+        limit = 0xFF if sub == 0 else (0xFFFFFFFF if index not in self.owners else 0xFFFF)
         if not 0 <= value <= limit:
             return self._abort(0x06090030, where, f"{index:04X}h:{sub:02X} is a "
                                f"{'USINT' if sub == 0 else 'UDINT' if limit > 0xFFFF else 'UINT'}"
@@ -196,29 +223,30 @@ class PdoConfig:
         if state is not EsmState.PREOP:
             return self._abort(0x08000022, where, f"PDO mapping is written in PRE-OP only, the "
                                f"ESM is in {state.name} (HCFA §6.7.4 step A)")
-        if index in ASSIGN:
+        if index in self.owners:
             return self._write_assign(index, sub, value, where)
         return self._write_map(index, sub, value, where)
 
     def _write_map(self, index: int, sub: int, value: int, where: str) -> WriteResult:
-        side = "rx" if index in RX_MAPS else "tx"
+        L = self.layout
+        side = "rx" if index in L.rx else "tx"
         owner = 0x1C12 if side == "rx" else 0x1C13
-        if index in self._assigned(owner):
+        if L.assign and index in self._assigned(owner):
             return self._abort(0x06010003, where, f"{index:04X}h is assigned in {owner:04X}h "
                                f"(:00 = {self.count[owner]}); clear {owner:04X}:00 first "
                                "(HCFA §6.7.4 step B)")
         if sub == 0:
-            if value > MAX_ENTRIES:
-                return self._abort(0x06040042, where, f"at most {MAX_ENTRIES} entries per PDO "
-                                   "(HCFA §6.7.2)")
+            if value > L.max_entries:
+                return self._abort(0x06040042, where, f"at most {L.max_entries} entries per "
+                                   f"PDO ({L.source})")
             rows = [MapEntry.parse(r) for r in self.entries[index][:value]]
             if any(r.raw == 0 for r in rows):
                 return self._abort(0x06040043, where, f"entries :01–:{value:02X} are not all "
                                    "written (HCFA §6.7.4 step D before E)")
-            if sum(r.bits for r in rows) > MAX_BYTES * 8:
+            if sum(r.bits for r in rows) > L.max_bytes * 8:
                 return self._abort(0x06040042, where, f"the entries take "
                                    f"{sum(r.bits for r in rows) // 8} bytes, more than "
-                                   f"{MAX_BYTES} (HCFA §6.7.2)")
+                                   f"{L.max_bytes} ({L.source})")
             self.count[index] = value
             step = "step E" if value else "step C: the map is invalid while changed"
             return WriteResult(0, f"{where}: {index:04X}h maps {value} entries ({step})")
@@ -246,7 +274,7 @@ class PdoConfig:
         return WriteResult(0, f"{where}: entry {entry} (step D)")
 
     def _write_assign(self, index: int, sub: int, value: int, where: str) -> WriteResult:
-        allowed = ASSIGN[index]
+        allowed = self.owners[index]
         if sub == 0:
             if value > len(allowed):
                 return self._abort(0x06090031, where, f"{index:04X}h holds at most "
@@ -275,8 +303,9 @@ class PdoConfig:
         for owner, side in ((0x1C12, "outputs"), (0x1C13, "inputs")):
             for index in self._assigned(owner):
                 rows = [MapEntry.parse(r) for r in self.entries[index][:self.count[index]]]
-                if sum(r.bits for r in rows) > MAX_BYTES * 8:
-                    return MappingProblem(side, f"{index:04X}h exceeds {MAX_BYTES} bytes")
+                if sum(r.bits for r in rows) > self.layout.max_bytes * 8:
+                    return MappingProblem(side, f"{index:04X}h exceeds "
+                                          f"{self.layout.max_bytes} bytes")
                 for r in rows:
                     if r.index == 0:
                         continue
@@ -296,7 +325,11 @@ class PdoConfig:
 
     # ---------------------------------------------------------------- helpers
     def _assigned(self, owner: int) -> list[int]:
-        return self.entries[owner][:self.count[owner]]
+        if self.layout.assign:
+            return self.entries[owner][:self.count[owner]]
+        # CiA 301 (no assignment objects): every map with entries is in use
+        maps = self.layout.rx if owner == 0x1C12 else self.layout.tx
+        return [m for m in maps if self.count[m]]
 
     def _flatten(self, owner: int) -> tuple[MapEntry, ...]:
         return tuple(MapEntry.parse(r) for index in self._assigned(owner)

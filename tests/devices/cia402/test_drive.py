@@ -495,11 +495,13 @@ def test_homing_parameter_zero_refuses_the_start_with_bit_14():
 
 @pytest.mark.parametrize("model, first_tx", [("hcfa-am0520b", [0x6041, 0x603F, 0x6064, 0x606C,
                                                                 0x6061, 0x60B9, 0x60BA]),
-                                              ("kinco-servo", [0x6041])])
+                                              ("kinco-servo", [0x6041, 0x6041, 0x6061, 0x6041,
+                                                               0x6064, 0x6041, 0x606C])])
 def test_a_bus_cycle_uses_the_models_own_power_up_maps(model: str, first_tx: list[int]) -> None:
     """Each model's process data at power-up are the maps of its own object
-    dictionary (HCFA: 1C13h -> 1A00h; Kinco, CANopen: its first TxPDO map),
-    so a cycle of the Kinco drive never asks for an HCFA object."""
+    dictionary (HCFA: 1C13h -> 1A00h; Kinco, CANopen without assignment
+    objects: every TxPDO map with entries, in number order), so a cycle of
+    the Kinco drive never asks for an HCFA object."""
     d = Drive(model)
     tx = d.cycle(1000)
     assert [e.index for e in d.pdo.active_tx] == first_tx

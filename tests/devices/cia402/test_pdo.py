@@ -288,3 +288,55 @@ def test_pack_unpack_round_trip(rows):
 def test_values_outside_the_object_type_are_0x06090030(index, sub, value):
     cfg, _ = make()
     assert cfg.write(index, sub, value).abort == 0x06090030
+
+
+# -- a CANopen model: no assignment objects, 8-byte PDOs (CiA 301) ----------------
+
+from plcrt.devices.cia402.od import SdoAbort  # noqa: E402
+
+
+def _kinco_preop():
+    from plcrt.devices.cia402.drive import Drive
+    from plcrt.devices.cia402.esm import EsmState
+    d = Drive("kinco-servo")
+    d.request_esm(EsmState.PREOP)
+    return d
+
+
+def test_a_canopen_model_remaps_without_assignment_objects():
+    """Kinco: no 1C12h/1C13h, so a map is never locked by an assignment:
+    :00 := 0, the entries, :00 := n, as CiA 301 has it; the new map is in
+    use after the next start (PRE-OP -> SAFE-OP -> OP)."""
+    from plcrt.devices.cia402.esm import EsmState
+    d = _kinco_preop()
+    d.write(0x1600, 0, 0)
+    d.write(0x1600, 1, 0x60400010)
+    d.write(0x1600, 2, 0x60FF0020)
+    d.write(0x1600, 0, 2)
+    assert d.read(0x1600, 0) == 2 and d.read(0x1600, 2) == 0x60FF0020
+    d.request_esm(EsmState.SAFEOP)
+    assert [e.index for e in d.pdo.active_rx][:2] == [0x6040, 0x60FF]
+
+
+def test_a_canopen_pdo_holds_eight_bytes():
+    """CiA 301: a CAN frame carries 8 bytes; 6040h + 607Ah + 60FFh (10) is
+    refused with 0x06040042, the model's own rule named."""
+    d = _kinco_preop()
+    d.write(0x1600, 0, 0)
+    for k, raw in enumerate((0x60400010, 0x607A0020, 0x60FF0020), 1):
+        d.write(0x1600, k, raw)
+    with pytest.raises(SdoAbort) as e:
+        d.write(0x1600, 0, 3)
+    assert e.value.code == 0x06040042 and "more than 8" in e.value.message
+    assert "CiA 301" in e.value.message
+
+
+def test_a_canopen_model_has_no_1c12():
+    d = _kinco_preop()
+    with pytest.raises(SdoAbort) as e:
+        d.write(0x1C12, 0, 0)
+    assert e.value.code == 0x06020000
+    d.write(0x1A03, 0, 0)           # its fourth TxPDO map is a mapping object too
+    d.write(0x1A03, 1, 0x60640020)
+    d.write(0x1A03, 0, 1)
+    assert d.read(0x1A03, 1) == 0x60640020

@@ -561,7 +561,8 @@ def _print_devices(plc: Any) -> None:
         _print_table(_AXIS_COLUMNS, axis_rows(axes))
     if drives:
         _print_table(_DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
-    if not axes and not drives and plc.modules:
+    # a plant that only wires the CPU's own inputs has no axes to speak of
+    if not axes and not drives and (plc.modules or not (plc.wiring or plc.encoders)):
         print("axes: none configured in the plant")
 
 

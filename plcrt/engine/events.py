@@ -56,6 +56,11 @@ class Scheduler:
         #: bumped by whatever may move a source's next event (an instruction
         #: such as PLS, HSC or ATCH; the end of a pulse train)
         self.gen = 0
+        self._rows: list[list[Any]] = []
+
+    def _make_rows(self) -> list[list[Any]]:
+        return [[src, -1, None, src.cacheable, getattr(src, "moves_others", False)]
+                for src in self.sources]
 
     def touch(self) -> None:
         """A source's next event may have moved: ask them all again."""
@@ -67,40 +72,47 @@ class Scheduler:
 
     def run(self, t_from: int, t_to: int) -> None:
         """Run (t_from, t_to]: events in time order, devices advanced to each."""
-        plc, devices = self.plc, self.plc.devices
+        plc, devices, after = self.plc, self.plc.devices, self.after
         t = t_from
         # perf: a source's next event is asked once and kept until it fires
-        # or something touches the sources (cache: source -> (gen, time))
-        cache: dict[int, tuple[int, Optional[int]]] = {}
+        # or something touches the sources: one [source, gen, time, cacheable,
+        # moves others] row each, kept between scans; a new scan asks anew
+        # (its start may have moved a counter)
+        self.gen += 1
+        rows = self._rows
+        if len(rows) != len(self.sources):
+            rows = self._rows = self._make_rows()
         while True:
             best: Optional[int] = None
             due: list[Any] = []
             gen = self.gen
-            for src in self.sources:   # in priority order: ties fire in this order
-                hit = cache.get(id(src))
-                if hit is not None and hit[0] == gen and src.cacheable:
-                    te = hit[1]
+            for row in rows:           # in priority order: ties fire in this order
+                if row[1] == gen and row[3]:
+                    te = row[2]
                 else:
+                    src = row[0]
                     te = src.next_time(t, _NEVER) if src.live() else None
-                    cache[id(src)] = (gen, te)
+                    row[1], row[2] = gen, te
                 if te is None or te > t_to:
                     continue
                 if best is None or te < best:
-                    best, due = te, [src]
+                    best, due = te, [row]
                 elif te == best:
-                    due.append(src)
+                    due.append(row)
             if best is None:
                 break
             for dev in devices:
                 dev.step(plc, t, best)
-            for src in due:
-                cache.pop(id(src), None)
-                src.fire(best)
-                if getattr(src, "moves_others", False):
+            for row in due:
+                row[1] = -1
+                row[0].fire(best)
+                if row[4]:
                     self.gen += 1      # e.g. a train ended: a counter on it moves too
-            if self.after is not None:
-                self.after(best)
+            if after is not None:
+                after(best)
             t = best
+            if len(rows) != len(self.sources):   # HDEF in a routine added a counter
+                rows = self._rows = self._make_rows()
         if t < t_to:
             for dev in devices:
                 dev.step(plc, t, t_to)

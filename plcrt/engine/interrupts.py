@@ -184,23 +184,21 @@ class Interrupts:
         """Run the queued routines, highest priority first, if enabled."""
         if not self.enabled or self.running:
             return
-        queues = self.queues
-        q0, q1, q2 = queues
-        while q0 or q1 or q2:
-            q = q0 or q1 or q2          # perf: the highest group with an occurrence
-            _, event = q.popleft()
-            number = self.attached.get(event)
-            if number is None:
-                continue              # detached while queued
-            self.running = True
-            try:
-                self.counts[event] = self.counts.get(event, 0) + 1
-                self.run_routine(number)
-            finally:
-                self.running = False
-            if not self.enabled:
-                break                 # a routine cannot DISI; kept for safety
-        if not any(queues):
+        q0, q1, q2 = self.queues
+        attached, counts, run = self.attached, self.counts, self.run_routine
+        self.running = True
+        try:
+            while q0 or q1 or q2:
+                q = q0 or q1 or q2      # perf: the highest group with an occurrence
+                event = q.popleft()[1]
+                number = attached.get(event)
+                if number is None:
+                    continue            # detached while queued
+                counts[event] = counts.get(event, 0) + 1
+                run(number)
+        finally:
+            self.running = False
+        if not (q0 or q1 or q2):
             # System Manual: the overflow bits are reset when the queues are
             # empty and control returns to the main program
             self.sm[4] &= ~0x07 & 0xFF

@@ -595,6 +595,7 @@ class Plc(AddressAccess):
             b.__dict__.update(state)
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
+        dst.scheduler._rows = []
         dst.scheduler.sources[:] = [dst.interrupts, *dst.pulse,
                                     *(c for c in dst.hsc if c.pulse is not None)]
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",

@@ -76,9 +76,7 @@ class Scheduler:
         t = t_from
         # perf: a source's next event is asked once and kept until it fires
         # or something touches the sources: one [source, gen, time, cacheable,
-        # moves others] row each, kept between scans; a new scan asks anew
-        # (its start may have moved a counter)
-        self.gen += 1
+        # moves others] row each, kept between scans
         rows = self._rows
         if len(rows) != len(self.sources):
             rows = self._rows = self._make_rows()

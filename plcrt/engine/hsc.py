@@ -248,15 +248,20 @@ class HighSpeedCounter:
     def _sample(self, pi: bytearray) -> int:
         return sum(self._bit(pi, k) << k for k in range(4))
 
-    def scan_start(self, pi: bytearray, t: int) -> None:
+    def scan_start(self, pi: bytearray, t: int) -> bool:
         """Edges of the counter's inputs since the last scan (the outside
-        world changes them between scans), counted at *t*."""
+        world changes them between scans), counted at *t*; whether its
+        inputs changed (its next event may have moved)."""
         if self.mode is None:
-            return
+            return False
         new = self._sample(pi)
         old, self.inputs = self.inputs, new
         if not self.enabled:
-            return
+            return old != new
+        self._scan_start(old, new, t)
+        return old != new
+
+    def _scan_start(self, old: int, new: int, t: int) -> None:
         self.sync(t)
         mode = self.mode
         if mode != 12 and mode % 3 >= 1:                 # the reset input

@@ -225,7 +225,8 @@ class Plc(AddressAccess):
         irq = self.interrupts
         if self._hsc_defined:
             for c in self.hsc:
-                c.scan_start(pi, now)
+                if c.scan_start(pi, now):
+                    self.scheduler.touch()
         pi0 = pi[0] & 0x0F
         if pi0 != self._pi0 or irq.queues[0] or irq.queues[1] or irq.queues[2]:
             # input edges from the outside world: their routines run at the

@@ -257,3 +257,13 @@ def test_a_routine_reads_the_1ms_timers_of_its_own_time():
     assert plc["VW2"] == 18
     plc.scan()
     assert plc["T96"] == 30 and plc["VW2"] == 30   # the routine at 30 ms, the end of (20, 30]
+
+
+def test_a_trace_records_what_the_routines_did_in_each_scan():
+    """Samples are taken at the end of each scan: a 1 ms routine counting in
+    VW0 adds 10 per 10 ms scan."""
+    from plcrt.trace.recorder import Trace
+    plc = plcrt.load(program("LD SM0.1\nMOVB 1, SMB34\nATCH INT_0, 10\nENI", COUNT))
+    tr = Trace(plc, ["VW0"])
+    plc.run("50ms")
+    assert list(tr["VW0"]) == [10, 20, 30, 40, 50]

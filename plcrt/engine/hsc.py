@@ -300,6 +300,8 @@ class HighSpeedCounter:
         """A/B phase: the Gray step from *old* to *new* (bit 0 A, bit 1 B)."""
         order = (0, 1, 3, 2)            # A leads B: 00 -> 01 -> 11 -> 10 counts up
         step = (order.index(new) - order.index(old)) % 4
+        if step == 0:
+            return 0                    # A and B as they were (another input changed)
         if step == 2:
             self.plc._irq_warn(f"HSC{self.number}: A and B changed together between two "
                                f"scans; the step cannot be counted (change them one at a "

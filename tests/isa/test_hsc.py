@@ -253,3 +253,39 @@ def test_bad_encoders_are_located_errors(encoder, message):
     with pytest.raises(PlcConfigError) as e:
         plcrt.load(program("LD SM0.0\n= Q0.2"), plant=f"[[cpu.encoder]]\n{encoder}\n")
     assert message in str(e.value) and "cpu.encoder[0]" in str(e.value)
+
+
+def _steps(plc, *states):
+    """Set HSC1's inputs (clock/up/A, dir/down/B) scan by scan."""
+    for a, b in states:
+        plc["I0.6"], plc["I0.7"] = a, b
+        plc.scan()
+
+
+@pytest.mark.parametrize("mode", range(12))
+def test_every_mode_of_hsc1_counts_resets_and_starts_as_its_family(mode):
+    """HSC1 has every mode 0..11 (I0.6, I0.7, reset I1.0, start I1.1).  One
+    table: four counting steps up, then the reset input (modes 1, 2, 4, 5,
+    7, 8, 10, 11) clears, and the start input (2, 5, 8, 11) gates."""
+    family, extra = mode // 3, mode % 3
+    plc = plcrt.load(program(counter(mode, n=1, pv=10**6)))
+    if extra == 2:
+        plc["I1.1"] = 1                  # start active, or nothing counts
+    plc.scan()
+    up = {0: [(1, 0), (0, 0)] * 4,                      # clock, direction bit up
+          1: [(0, 1)] + [(1, 1), (0, 1)] * 4,          # clock, direction input high
+          2: [(1, 0), (0, 0)] * 4,                      # up clock
+          3: [(1, 0), (1, 1), (0, 1), (0, 0)]}[family]  # one A/B cycle: 4 at x4
+    _steps(plc, *up)
+    assert plc["HC1"] == 4
+    if extra >= 1:
+        plc["I1.0"] = 1
+        plc.scan()
+        assert plc["HC1"] == 0
+        plc["I1.0"] = 0
+        plc.scan()
+    if extra == 2:
+        plc["I1.1"] = 0
+        plc.scan()
+        _steps(plc, *up)
+        assert plc["HC1"] == 0             # start inactive: no counting

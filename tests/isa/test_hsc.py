@@ -289,3 +289,19 @@ def test_every_mode_of_hsc1_counts_resets_and_starts_as_its_family(mode):
         plc.scan()
         _steps(plc, *up)
         assert plc["HC1"] == 0             # start inactive: no counting
+
+
+def test_a_multi_segment_pto_wired_to_hsc0_reaches_pv_at_its_exact_pulse():
+    """Segment 0: 100 pulses from 1000 µs down by 5 µs per pulse; segment 1:
+    200 pulses of 500 µs.  PV = 150 is pulse 50 of segment 1: it rises at
+    (100·1000 − 5·100·99/2) + 49·500 = 75 250 + 24 500 = 99 750 µs."""
+    ob1 = (counter(0, pv=150) + "\nMOVB 2, VB500\n"
+           "MOVW +1000, VW501\nMOVW -5, VW503\nMOVD +100, VD505\n"
+           "MOVW +500, VW509\nMOVW +0, VW511\nMOVD +200, VD513\n"
+           "MOVB 16#A5, SMB67\nMOVW +500, SMW168\nPLS 0")
+    plc = plcrt.load(program(ob1, "LD SM0.0\nINCW VW0\nMOVD HC0, VD10"),
+                     plant='[cpu]\nwire = { "I0.0" = "Q0.0" }\n', scan_ms=1)
+    plc.scan()
+    assert plc.hsc[0].next_time(plc.now_us, 10**7) == 99_750
+    plc.run("0.2s")
+    assert (plc["VW0"], plc["VD10"], plc["HC0"]) == (1, 150, 300)

@@ -72,7 +72,7 @@ class Scheduler:
 
     def run(self, t_from: int, t_to: int) -> None:
         """Run (t_from, t_to]: events in time order, devices advanced to each."""
-        plc, devices, after = self.plc, self.plc.devices, self.after
+        plc, devices, on_instant = self.plc, self.plc.devices, self.after
         t = t_from
         # perf: a source's next event is asked once and kept until it fires
         # or something touches the sources: one [source, gen, time, cacheable,
@@ -80,6 +80,10 @@ class Scheduler:
         rows = self._rows
         if len(rows) != len(self.sources):
             rows = self._rows = self._make_rows()
+        # events that the program itself caused at the scan's instant (a
+        # pulse train started by PLS reaching a counter's PV at once) are
+        # asked for from just before it
+        after = t_from - 1
         while True:
             best: Optional[int] = None
             due: list[Any] = []
@@ -89,7 +93,7 @@ class Scheduler:
                     te = row[2]
                 else:
                     src = row[0]
-                    te = src.next_time(t, _NEVER) if src.live() else None
+                    te = src.next_time(after, _NEVER) if src.live() else None
                     row[1], row[2] = gen, te
                 if te is None or te > t_to:
                     continue
@@ -99,16 +103,18 @@ class Scheduler:
                     due.append(row)
             if best is None:
                 break
-            for dev in devices:
-                dev.step(plc, t, best)
+            if best > t:
+                for dev in devices:
+                    dev.step(plc, t, best)
+                t = best
             for row in due:
                 row[1] = -1
                 row[0].fire(best)
                 if row[4]:
                     self.gen += 1      # e.g. a train ended: a counter on it moves too
-            if after is not None:
-                after(best)
-            t = best
+            if on_instant is not None:
+                on_instant(best)
+            after = best
             if len(rows) != len(self.sources):   # HDEF in a routine added a counter
                 rows = self._rows = self._make_rows()
         if t < t_to:

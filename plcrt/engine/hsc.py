@@ -127,6 +127,7 @@ class HighSpeedCounter:
         self.base = 0                    #: pulses of that output at the last sync
         self.inputs = 0                  #: the input bits as last sampled (4 bits)
         self.reset_held = False
+        self.fired_at: Optional[int] = None   #: the time of the last CV=PV event
 
     # ------------------------------------------------------------ helpers
     def _dword(self, offset: int) -> int:
@@ -238,11 +239,14 @@ class HighSpeedCounter:
         if steps <= 0:
             return None
         te = self.pulse.time_of_pulse(self.pulse.pulses_until(after) + steps)
+        if te is not None and te == self.fired_at:
+            return None                 # this crossing has had its event
         return te if te is not None and after < te <= until else None
 
     def fire(self, t: int) -> None:
         self.sync(t)
         if self.cv == self.pv:
+            self.fired_at = t
             self._post(0, t)
 
     def _sample(self, pi: bytearray) -> int:

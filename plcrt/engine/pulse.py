@@ -119,6 +119,7 @@ class PulseOutput:
         self.pending: Optional[list[Train]] = None  #: the pipeline (single segment)
         self.pwm: tuple[int, int, int] = (0, 0, 0)  #: (start, cycle µs, width µs)
         self.pwm_next: Optional[tuple[int, int]] = None  #: a synchronous update
+        self.pwm_asked = 0                 #: when it was asked for
         self.sent = 0                      #: pulses of finished trains (for counters)
         self.sm[self.status] |= IDLE
 
@@ -248,6 +249,7 @@ class PulseOutput:
         width = self._word(self.control + 3) * unit
         if self.mode == "PWM" and ctrl & 0x10:
             self.pwm_next = (cycle, width)          # synchronous: at the end of this cycle
+            self.pwm_asked = t
             return
         self.mode = "PWM"
         self.pwm = (t, cycle, width)
@@ -262,7 +264,8 @@ class PulseOutput:
             return te if after < te <= until else None
         if self.pwm_next is not None:
             start, cycle, _ = self.pwm
-            te = start + ((after - start) // cycle + 1) * cycle
+            since = max(after, self.pwm_asked)      # the cycle end after the request
+            te = start + ((since - start) // cycle + 1) * cycle
             return te if te <= until else None
         return None
 

@@ -305,3 +305,24 @@ def test_a_multi_segment_pto_wired_to_hsc0_reaches_pv_at_its_exact_pulse():
     assert plc.hsc[0].next_time(plc.now_us, 10**7) == 99_750
     plc.run("0.2s")
     assert (plc["VW0"], plc["VD10"], plc["HC0"]) == (1, 150, 300)
+
+
+from hypothesis import given, settings, strategies as st  # noqa: E402
+
+
+@settings(max_examples=40, deadline=None)
+@given(count=st.integers(1, 3000), cycle=st.integers(50, 2000),
+       scan_ms=st.sampled_from([1, 2.5, 7, 10, 20]), data=st.data())
+def test_property_a_wired_pto_is_counted_exactly_and_pv_comes_at_its_pulse(count, cycle,
+                                                                            scan_ms, data):
+    """For any train and scan time: HC0 ends at the pulse count, and the
+    CV=PV routine runs once, at pulse PV's rising edge, (PV − 1) × cycle."""
+    pv = data.draw(st.integers(1, count))
+    ob1 = (counter(0, pv=pv) + f"\nMOVB 16#85, SMB67\nMOVW +{cycle}, SMW68\n"
+           f"MOVD +{count}, SMD72\nPLS 0")
+    plc = plcrt.load(program(ob1, "LD SM0.0\nINCW VW0\nMOVD HC0, VD10"),
+                     plant='[cpu]\nwire = { "I0.0" = "Q0.0" }\n', scan_ms=scan_ms)
+    plc.scan()
+    assert plc.hsc[0].next_time(0, 10**9) in (None, (pv - 1) * cycle)
+    plc.run((count * cycle) / 1e6 + 0.05)
+    assert (plc["VW0"], plc["VD10"], plc["HC0"]) == (1, pv, count)

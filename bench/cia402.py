@@ -8,11 +8,14 @@ Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
    image), the master sending a sine-like target each cycle, and reports
    simulated drive-seconds per wall second (drives x simulated seconds /
    wall seconds) as "x real time";
-2. runs the same PP move (one set-point, the positive limit switch crossed
+2. runs the same through ``Drive.exchange`` (object-level process data
+   ``{(index, sub): value}``, the path of a PLC's master module), one and
+   eight drives;
+3. runs the same PP move (one set-point, the positive limit switch crossed
    half-way through the window) at 10 kP/s and at 1 MP/s with 1 ms cycles and reports the ratio of their costs: the drive solves
    positions and crossings in closed form (plcrt.devices.motion), so the
    ratio stays near 1 although the speed differs a hundredfold;
-3. measures SDO round trips per second over python-can's ``virtual`` bus:
+4. measures SDO round trips per second over python-can's ``virtual`` bus:
    a canopen master uploads 6064h from a drive put on the bus with
    ``plcrt.cia402.attach`` (manual clock, so only the SDO path is timed).
 
@@ -72,6 +75,25 @@ def time_csp(n: int, seconds: float) -> float:
         image = targets[k]
         for d in drives:
             d.cycle(t, image)
+    wall = time.perf_counter() - start
+    return n * cycles * CYCLE_US / 1e6 / wall
+
+
+def time_csp_exchange(n: int, seconds: float) -> float:
+    """As :func:`time_csp`, the process data given by object (``Drive.exchange``)."""
+    drives = csp_drives(n)
+    cycles = int(seconds * 1e6) // CYCLE_US
+    t0 = drives[0].now
+    targets = [{(0x6040, 0): 0x0F,
+                (0x607A, 0): 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)}
+               for k in range(cycles)]
+    gc.collect()
+    start = time.perf_counter()
+    for k in range(cycles):
+        t = t0 + (k + 1) * CYCLE_US
+        values = targets[k]
+        for d in drives:
+            d.exchange(t, values)
     wall = time.perf_counter() - start
     return n * cycles * CYCLE_US / 1e6 / wall
 
@@ -142,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     one = max(time_csp(1, args.seconds) for _ in range(args.repeat))
     eight = max(time_csp(8, args.seconds / 4) for _ in range(args.repeat))
+    x_one = max(time_csp_exchange(1, args.seconds) for _ in range(args.repeat))
+    x_eight = max(time_csp_exchange(8, args.seconds / 4) for _ in range(args.repeat))
     slow = min(time_pp(10_000, args.seconds) for _ in range(args.repeat))
     fast = min(time_pp(1_000_000, args.seconds) for _ in range(args.repeat))
     sdo = max(sdo_round_trips() for _ in range(args.repeat))
@@ -151,6 +175,8 @@ def main(argv: list[str] | None = None) -> int:
            "calibration_1e6_adds_s": round(cal, 3),
            "csp_1_drive_x_real_time": round(one, 1),
            "csp_8_drives_x_real_time": round(eight, 1),
+           "csp_exchange_1_drive_x_real_time": round(x_one, 1),
+           "csp_exchange_8_drives_x_real_time": round(x_eight, 1),
            "pp_10kHz_wall_s": round(slow, 4), "pp_1MHz_wall_s": round(fast, 4),
            "pp_cost_ratio_fast_over_slow": round(fast / slow, 2),
            "sdo_round_trips_per_s": round(sdo)}
@@ -161,6 +187,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{args.repeat}; 10^6 Python additions take {cal * 1e3:.0f} ms here")
     print(f"  CSP, 1 drive:  {one:8.1f} x real time")
     print(f"  CSP, 8 drives: {eight:8.1f} x real time (drive-seconds per wall second)")
+    print(f"  CSP through Drive.exchange (process data by object), 1 drive:  {x_one:8.1f} x, "
+          f"8 drives: {x_eight:8.1f} x real time")
     print(f"  PP move at 10 kP/s: {slow * 1e3:.1f} ms wall, at 1 MP/s: {fast * 1e3:.1f} ms wall "
           f"(ratio {fast / slow:.2f}) for {args.seconds:g} s simulated")
     print(f"  SDO round trips over the virtual bus (canopen master, attach): {sdo:8.0f} /s")

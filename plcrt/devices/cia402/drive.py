@@ -23,8 +23,9 @@ What it is not: no bus.  The canopen port and the PLC coupler call
 from __future__ import annotations
 
 import struct
+from operator import itemgetter
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Callable, Iterable, Optional
 
 from ...errors import PlcError
 from .axis import Axis, LinLeg
@@ -43,10 +44,16 @@ from .store import Store, Write
 __all__ = ["Drive", "DriveEvent"]
 
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
+_OUTPUT_KEYS = tuple((i, 0) for i in _OUTPUTS)
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
 #: (no speed limit then) and no P03.07 (no homing time limit).
 _ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0}
 _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an error
+#: Objects whose write the drive's hook acts on whatever the mode (6040h
+#: controlword, 6060h mode, 605Ah/6084h/6085h read by the state machine).
+_HOOK_INDEXES = frozenset({0x6040, 0x6060, 0x605A, 0x6084, 0x6085})
+_CW = (0x6040, 0)
+_MISSING = object()
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,10 +105,17 @@ class Drive:
         self._signed = frozenset((e.index, e.sub) for e in self.od if e.dtype.startswith("I"))
         self._absent = {k: v for k, v in _ABSENT.items() if self.od.find(*k) is None}
         self._own = frozenset((i, 0) for i in _OUTPUTS if self.od.find(i, 0) is not None)
+        self._own_at = tuple(n for n, key in enumerate(_OUTPUT_KEYS) if key in self._own)
         self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
         self._batch = False
         self._rx_noted = False
-        self.store.on_write(self._on_write)
+        self._live = self.store.live          # perf: the store's values, read directly
+        self._rx_codec: tuple = ((), None)    # perf: (active_rx, codec) of the last cycle
+        self._tx_codec: tuple = ((), None)    # perf: (active_tx, (struct, [(dict, key)]))
+        self._published: tuple = ()           # perf: the values publish wrote last
+        self._hook = self._on_write
+        self._only_hook = ((), (self._hook,))
+        self.store.on_write(self._hook)
         self._mirror()
         self.publish()
 
@@ -113,6 +127,9 @@ class Drive:
     def param(self, index: int, sub: int = 0) -> int:
         """The active value of an object the drive acts on (an object the
         model lacks reads as its entry in ``_ABSENT``)."""
+        v = self._live.get((index, sub), _MISSING)
+        if v.__class__ is int:
+            return v            # perf: an integer object read without the entry check
         if (index, sub) in self._absent:
             return self._absent[(index, sub)]
         return int(self.store.get(index, sub))
@@ -313,7 +330,18 @@ class Drive:
         self._do(t, self.sm.raise_fault(code, alarm, why, t / 1e6))
 
     # ---------------------------------------------------------------- time
+    def _eventless(self) -> bool:
+        """No event can come, whatever the time: no homing (its time limit),
+        and the axis at rest, or on a CSP line with no switch to watch and
+        no quick stop waiting for its end (:meth:`_next_event` would find none)."""
+        legs = self.axis.legs
+        return self.mode_number != 6 and (not legs or (
+            not self._qs_wait and legs[-1].__class__ is LinLeg
+            and self.plant.pos_limit is None and self.plant.neg_limit is None))
+
     def _next_event(self, t_to: int) -> Optional[tuple[int, str, object]]:
+        if self._eventless():
+            return None       # perf: the search below would find nothing
         ax = self.axis
         if ax.version != self._cache_version:
             self._cache_version, self._cache = ax.version, {}
@@ -356,12 +384,12 @@ class Drive:
 
     def advance(self, t_us: int) -> None:
         """Move simulated time forward to *t_us* (integer µs), exactly."""
-        if t_us < self.now:
-            raise PlcError(f"drive time cannot go back: now {self.now} µs, asked {t_us} µs")
         with self.store.lock:          # a canopen port writes from its Notifier thread
             self._advance(t_us)
 
     def _advance(self, t_us: int) -> None:
+        if t_us < self.now:
+            raise PlcError(f"drive time cannot go back: now {self.now} µs, asked {t_us} µs")
         for _ in range(_MAX_EVENTS):
             ev = self._next_event(t_us)
             if ev is None:
@@ -407,36 +435,56 @@ class Drive:
         OP; objects before 6040h), evaluate the held controlword, run the
         mode's cycle, and return the TxPDO image."""
         with self.store.lock:
-            return self._cycle(t_us, rx)
+            self._step(t_us, rx, None)
+            tx = self.pdo.active_tx
+            entries, codec = self._tx_codec
+            if entries is not tx:
+                codec = self._tx_fast_codec(tx)     # perf: once per mapping
+                self._tx_codec = (tx, codec)
+            if codec is not None:
+                args: list[int] = []
+                for get, src in codec[1]:
+                    args += get(src)
+                return codec[0].pack(*args)
+            get, out = self.store.get, self._out
+            values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
+                      else int(get(e.index, e.sub)) for e in tx if e.index}
+            return pack(tx, values)
 
     def tick(self, t_us: int) -> None:
         """One bus cycle at *t_us* without process data (a CANopen port,
         whose PDOs are not the EtherCAT images): advance, evaluate the held
         controlword, run the mode's cycle."""
         with self.store.lock:
-            self._step(t_us, None)
+            self._step(t_us, None, None)
 
-    def _cycle(self, t_us: int, rx: Optional[bytes]) -> bytes:
-        self._step(t_us, rx)
-        get, out = self.store.get, self._out
-        codec = self._codec(self.pdo.active_tx)
-        if codec is not None:
-            return codec[0].pack(*[out[k] if k in out else int(get(*k)) for k in codec[1]])
-        values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
-                  else int(get(e.index, e.sub)) for e in self.pdo.active_tx if e.index}
-        return pack(self.pdo.active_tx, values)
-
-    def _step(self, t_us: int, rx: Optional[bytes]) -> None:
+    def _step(self, t_us: int, rx: Optional[bytes],
+              values: Optional[dict[tuple[int, int], int]]) -> None:
+        """One bus cycle (the caller holds the store's lock), the received
+        process data as an image *rx* or by object *values*."""
         self._batch = True
         try:
-            self.advance(t_us)
+            if t_us >= self.now and self._eventless():
+                self.now = t_us   # perf: what _advance does when no event can come
+            else:
+                self._advance(t_us)   # the lock is held: advance without taking it again
             if rx is not None:
                 self._apply_rx(t_us, rx)
-            if self.sm.state is not State.OPERATION_ENABLED:
+            elif values is not None:
+                if _CW in values:
+                    self._apply_values(t_us, values[_CW],
+                                       [kv for kv in values.items() if kv[0] != _CW], False)
+                else:
+                    self._apply_values(t_us, None, values.items(), False)
+            sm = self.sm
+            if sm.state is not State.OPERATION_ENABLED:
                 # in OE a held level can only hold OE: every other level acted when written
-                self._do(t_us, self.sm.cycle(t_us / 1e6))
-            if self.sm.state is State.OPERATION_ENABLED:
-                self.mode.cycle(t_us)
+                if sm.cycle_acts():
+                    self._do(t_us, sm.cycle(t_us / 1e6))
+                elif len(sm.log) != self._sm_seen:
+                    self._mirror()   # perf: a held level that changes nothing: no Result
+            if sm.state is State.OPERATION_ENABLED:
+                self.engines[self.mode_number].cycle(t_us)   # perf: self.mode, inline
         finally:
             self._batch = False
         self.publish()
@@ -462,6 +510,51 @@ class Drive:
         self._codecs[id(entries)] = (entries, codec)
         return codec
 
+    def _tx_fast_codec(self, entries: tuple) -> Optional[tuple]:
+        """For a byte-aligned TxPDO map: its struct, and the objects as runs
+        of (getter, source): the drive's own outputs (:attr:`_out`) or the
+        store's values, each getter giving a tuple."""
+        found = self._codec(entries)
+        if found is None:
+            return None
+        runs: list[tuple[list[tuple[int, int]], dict]] = []
+        for key in found[1]:
+            src = self._out if key in self._own else self._live
+            if runs and runs[-1][1] is src:
+                runs[-1][0].append(key)
+            else:
+                runs.append(([key], src))
+        return found[0], [(itemgetter(*keys) if len(keys) > 1 else
+                           (lambda values, key=keys[0]: (values[key],)), src)
+                          for keys, src in runs]
+
+    def _rx_fast_codec(self, entries: tuple) -> Optional[tuple]:
+        """For a byte-aligned RxPDO map without repeated objects: (image
+        size, a struct of the objects other than 6040h, their keys, a struct
+        of 6040h or None, its byte offset).  The first struct skips 6040h's
+        bytes, so the objects come out without building a dict."""
+        fmt, keys, cw, offset = "<", [], None, 0
+        for e in entries:
+            if e.bits not in (8, 16, 32):
+                return None
+            key, size = (e.index, e.sub), e.bits // 8
+            code = {8: "b", 16: "h", 32: "i"}[e.bits]
+            code = code if key in self._signed else code.upper()
+            if e.index == 0:
+                fmt += "x" * size
+            elif key == _CW:
+                if cw is not None:
+                    return None
+                fmt += "x" * size
+                cw = (struct.Struct("<" + code), offset)
+            else:
+                if key in keys:
+                    return None
+                fmt += code
+                keys.append(key)
+            offset += size
+        return (offset, struct.Struct(fmt), tuple(keys), *(cw or (None, 0)))
+
     def exchange(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
         """One bus cycle at *t_us* whose received process data are given
         by object, ``{(index, sub): value}``, instead of as a packed RxPDO
@@ -470,67 +563,93 @@ class Drive:
         before 6040h); the caller reads what it transmits from
         :attr:`store`."""
         with self.store.lock:
-            self._batch = True
-            try:
-                self.advance(t_us)
-                self._apply_values(t_us, dict(values))
-                if self.sm.state is not State.OPERATION_ENABLED:
-                    self._do(t_us, self.sm.cycle(t_us / 1e6))
-                if self.sm.state is State.OPERATION_ENABLED:
-                    self.mode.cycle(t_us)
-            finally:
-                self._batch = False
-            self.publish()
+            self._step(t_us, None, values)   # the same cycle as cycle()
 
     def _apply_rx(self, t_us: int, rx: bytes) -> None:
-        codec = self._codec(self.pdo.active_rx)
-        if codec is not None and len(rx) == codec[0].size:
-            values = dict(zip(codec[1], codec[0].unpack(rx)))
-        else:
-            values = unpack(self.pdo.active_rx, rx, self._signed)
-        self._apply_values(t_us, values)
+        rx_map = self.pdo.active_rx
+        entries, codec = self._rx_codec
+        if entries is not rx_map:
+            codec = self._rx_fast_codec(rx_map)     # perf: once per mapping
+            self._rx_codec = (rx_map, codec)
+        if codec is not None and len(rx) == codec[0]:
+            _, objects, keys, cw_st, at = codec
+            self._apply_values(t_us, None if cw_st is None else cw_st.unpack_from(rx, at)[0],
+                               zip(keys, objects.unpack(rx)), True)
+            return
+        values = unpack(rx_map, rx, self._signed)
+        cw = values.pop(_CW, None)
+        self._apply_values(t_us, cw, values.items(), True)
 
-    def _apply_values(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
+    def _apply_values(self, t_us: int, cw: Optional[int],
+                      items: Iterable[tuple[tuple[int, int], int]], known: bool) -> None:
+        """Apply received objects *items*, then the controlword *cw* (None:
+        not received).  *known*: the values come from an image, unpacked at
+        each object's own width and signedness."""
         if not self.esm.outputs:
             if not self._rx_noted:
                 self._rx_noted = True
                 self.note(t_us, "HCFA §6.5", f"RxPDO ignored in {self.esm.state.name}: "
                           "outputs act in OP only", "drive")
             return
-        cw = values.pop((0x6040, 0), None)
-        for key, v in values.items():               # objects first, then 6040h
-            if self._stored(key) != v:
-                self.store.set(key[0], key[1], v, source="pdo")
+        live, store = self._live, self.store
+        for key, v in items:                        # objects first, then 6040h
+            if live.get(key, _MISSING) == v:
+                continue        # perf: an unchanged object: no store write, no hook
+            if key[0] in _HOOK_INDEXES or not (
+                    # perf: no Write and no hook dispatch for a value nobody
+                    # acts on: the drive's own hook is the only one and does
+                    # nothing with this object now (outside OPERATION
+                    # ENABLED, or a mode without parameter(); inside a
+                    # cycle, which publishes once at its end)
+                    store.hooked == self._only_hook
+                    and (self.sm.state is not State.OPERATION_ENABLED
+                         or not self.engines[self.mode_number].takes_parameters)):
+                store.set(key[0], key[1], v, source="pdo")
+            elif known:
+                store.set_known(key, v)
+            else:
+                store.set(key[0], key[1], v)
         if cw is not None and cw != self.controlword:
-            self.store.set(0x6040, 0, cw, source="pdo")
-
-    def _stored(self, key: tuple[int, int]) -> int:
-        return int(self.store.get(*key))
+            store.set(0x6040, 0, cw, source="pdo")
 
     # ---------------------------------------------------------------- outputs
     def publish(self) -> None:
         """Write the drive's own objects for the present time."""
         t = self.now
-        if self.sm.state is State.OPERATION_ENABLED:
-            bits = self.mode.bits(t)
+        ax, sm = self.axis, self.sm
+        if sm.state is State.OPERATION_ENABLED:
+            bits = self.engines[self.mode_number].bits(t)    # perf: self.mode, inline
             if bits is not None:
-                self.sm.set_mode_bits(bits)
-        pos = self.axis.position(t)
-        csp = self.engines[8]
-        assert isinstance(csp, CyclicPosition)
-        fe = csp.following_error if self.mode_number == 8 else 0
-        demand = csp.demand if self.mode_number == 8 and self.sm.state is \
-            State.OPERATION_ENABLED else pos
-        values = {0x6041: self.sm.statusword, 0x6061: self.mode_number, 0x6062: demand,
-                  0x6064: pos, 0x606C: self.axis.velocity(t), 0x603F: self.sm.error_code,
-                  0x1001: self.sm.error_register, 0x60F4: fe,
-                  0x60FD: self.plant.inputs(self.axis.mechanical(t))}
+                sm.set_mode_bits(bits)
+        mech = ax.mechanical(t)
+        pos = mech + ax.shift                      # axis.position(t)
+        if self.mode_number == 8:
+            csp = self.engines[8]
+            assert isinstance(csp, CyclicPosition)
+            fe = csp.following_error
+            demand = csp.demand if sm.state is State.OPERATION_ENABLED else pos
+        else:
+            fe, demand = 0, pos
+        values = (sm.statusword, self.mode_number, demand, pos, ax.velocity(t),
+                  sm.error_code, sm.error_register, fe, self.plant.inputs(mech))
+        last = self._published
+        if values == last:
+            return          # perf: nothing changed since the last publish
+        if last:
+            # perf: the last values stand for _out (each own one was written)
+            changed = {}
+            for i in self._own_at:
+                if values[i] != last[i]:
+                    changed[_OUTPUT_KEYS[i]] = values[i]
+        else:
+            out, own = self._out, self._own
+            changed = {key: v for key, v in zip(_OUTPUT_KEYS, values)
+                       if out.get(key) != v and key in own}
         out = self._out
-        changed = {(i, 0): v for i, v in values.items()
-                   if out.get((i, 0)) != v and (i, 0) in self._own}
         if changed:
             self.store.set_status(changed)
             out.update(changed)
+        self._published = values
 
     @property
     def statusword(self) -> int:

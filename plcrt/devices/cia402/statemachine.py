@@ -245,6 +245,21 @@ class Drive402:
         return self._evaluate(cmd, t, f"6040h = 0x{self.controlword:04X} held",
                               log_refusal=False)
 
+    def cycle_acts(self) -> bool:
+        """Whether :meth:`cycle` would change anything now: a transition the
+        held controlword makes, or the end of a fault reaction (14).  A held
+        level that holds its state or is refused changes nothing (a cycle
+        logs no refusal), so a caller may skip that cycle."""
+        # perf: the bus cycle asks this first; :meth:`cycle` builds the
+        # explanation of a refusal and a Result, which nobody reads then
+        state = self.state
+        if state is S.FAULT_REACTION_ACTIVE:
+            return True
+        cw = self.controlword
+        cmd = decode_controlword(cw, cw)
+        n = TRANSITIONS.get((state, cmd))
+        return n is not None and self._guard(state, cmd, n) is None
+
     def command(self, cmd: Command, t: float, source: str) -> Result:
         """Apply *cmd* on the drive's own account (e.g. the EtherCAT bus
         leaving OP), without changing the held controlword."""

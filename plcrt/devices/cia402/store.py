@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ...errors import PlcConfigError
-from .od import ESM_STATES, Entry, ObjectDictionary, SdoAbort, is_assign, is_map, obj
+from .od import DTYPES, ESM_STATES, Entry, ObjectDictionary, SdoAbort, is_assign, is_map, obj
 
 Value = int | str
 
@@ -67,11 +67,27 @@ class Store:
         self.length_abort = length_abort
         self._active: dict[tuple[int, int], Value] = {(e.index, e.sub): e.default for e in od}
         self._pending: dict[tuple[int, int], Value] = {}
-        self._check_hooks: list[Hook] = []
-        self._write_hooks: list[Hook] = []
+        # perf: the hooks as tuples, rebuilt when one (un)subscribes: a write
+        # iterates a snapshot without copying a list
+        self._check_hooks: tuple[Hook, ...] = ()
+        self._write_hooks: tuple[Hook, ...] = ()
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
+        # perf: (entry, low, high) per key, low None for a string, found once
+        self._types: dict[tuple[int, int], tuple[Entry, int | None, int]] = {}
+
+    @property
+    def live(self) -> dict[tuple[int, int], Value]:
+        """The active values by (index, sub), the store's own dict (read it,
+        never write it): the bus cycle reads many objects without the entry
+        check of :meth:`get`."""
+        return self._active
+
+    @property
+    def hooked(self) -> tuple[tuple[Hook, ...], tuple[Hook, ...]]:
+        """The check hooks and the write hooks subscribed now."""
+        return self._check_hooks, self._write_hooks
 
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:
@@ -99,18 +115,40 @@ class Store:
             SdoAbort: unknown object or subindex.
             PlcConfigError: the value does not fit the entry's type.
         """
-        entry = self.od.entry(index, sub)
-        self._check_type(entry, value)
+        key = (index, sub)
+        known = self._types.get(key)
+        if known is None:
+            entry = self.od.entry(index, sub)
+            lo, hi = (None, 0) if entry.dtype == "STR" else DTYPES[entry.dtype][1:]
+            known = self._types[key] = (entry, lo, hi)
+        entry, lo, hi = known
+        # perf: a plain int in range is the common case; anything else takes
+        # the full check (bool and str values, out-of-range numbers)
+        if lo is None or value.__class__ is not int or not lo <= value <= hi:
+            self._check_type(entry, value)
         with self.lock:
-            write = Write(entry, value, self.stored(index, sub), False, source)
-            if source != "drive":
-                for hook in list(self._check_hooks):
-                    hook(write)
-            self._active[(index, sub)] = value
-            self._pending.pop((index, sub), None)
-            if source != "drive":
-                for hook in list(self._write_hooks):
-                    hook(write)
+            if source == "drive":
+                # perf: no Write is built when no hook will see it
+                self._active[key] = value
+                if self._pending:
+                    self._pending.pop(key, None)
+                return
+            write = Write(entry, value, self._pending.get(key, self._active[key]), False, source)
+            for hook in self._check_hooks:
+                hook(write)
+            self._active[key] = value
+            self._pending.pop(key, None)
+            for hook in self._write_hooks:
+                hook(write)
+
+    def set_known(self, key: tuple[int, int], value: int) -> None:
+        """Set an object's value from the drive side when its type is known
+        to fit (an RxPDO field unpacked at the mapped object's own width and
+        signedness): no checks, no hooks.  The caller holds :attr:`lock`."""
+        # perf: the bus cycle's path for an RxPDO object no hook needs to see
+        self._active[key] = value
+        if self._pending:
+            self._pending.pop(key, None)
 
     def set_status(self, values: dict[tuple[int, int], int]) -> None:
         """Set the drive's own integer status objects (6041h, 6064h, ...)
@@ -119,7 +157,7 @@ class Store:
         Raises:
             PlcConfigError: a value outside its entry's type range.
         """
-        bounds = self._bounds
+        bounds, active, pending = self._bounds, self._active, self._pending
         with self.lock:
             for key, value in values.items():
                 b = bounds.get(key)
@@ -129,9 +167,9 @@ class Store:
                 if not b[0] <= value <= b[1]:
                     entry = self.od.entry(*key)
                     raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
-                self._active[key] = value
-                if self._pending:
-                    self._pending.pop(key, None)
+                active[key] = value
+                if pending:
+                    pending.pop(key, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.
@@ -176,14 +214,22 @@ class Store:
     def on_check(self, callback: Hook) -> Callable[[], None]:
         """Call ``callback(write)`` before a master's write is stored; it may
         raise :class:`SdoAbort` to refuse it.  Returns an unsubscribe function."""
-        self._check_hooks.append(callback)
-        return lambda: self._check_hooks.remove(callback)
+        with self.lock:
+            self._check_hooks = (*self._check_hooks, callback)
+        return lambda: self._unsubscribe("_check_hooks", callback)
 
     def on_write(self, callback: Hook) -> Callable[[], None]:
         """Call ``callback(write)`` after a master's write is stored.
         Returns an unsubscribe function."""
-        self._write_hooks.append(callback)
-        return lambda: self._write_hooks.remove(callback)
+        with self.lock:
+            self._write_hooks = (*self._write_hooks, callback)
+        return lambda: self._unsubscribe("_write_hooks", callback)
+
+    def _unsubscribe(self, which: str, callback: Hook) -> None:
+        with self.lock:
+            hooks = list(getattr(self, which))
+            hooks.remove(callback)          # ValueError when not subscribed, as list.remove
+            setattr(self, which, tuple(hooks))
 
     # -- SDO ---------------------------------------------------------------
     def sdo_read(self, index: int, sub: int) -> bytes:
@@ -230,7 +276,7 @@ class Store:
             self._check_mapping(entry, value)
             self._check_range(entry, value)
             write = Write(entry, value, self.stored(index, sub), entry.effect == "power-up", "sdo")
-            for hook in list(self._check_hooks):
+            for hook in self._check_hooks:
                 hook(write)
             key = (index, sub)
             if write.pending and value != self._active[key]:
@@ -242,7 +288,7 @@ class Store:
             else:
                 self._pending.pop(key, None)
                 self._active[key] = value
-            for hook in list(self._write_hooks):
+            for hook in self._write_hooks:
                 hook(write)
 
     # -- rules -------------------------------------------------------------
@@ -291,7 +337,6 @@ class Store:
         if entry.dtype == "STR":
             ok = isinstance(value, str)
         else:
-            from .od import DTYPES
             lo, hi = DTYPES[entry.dtype][1:]
             ok = isinstance(value, int) and not isinstance(value, bool) and lo <= value <= hi
         if not ok:

@@ -75,6 +75,9 @@ class Axis:
         self.shift = 0              #: count - mechanical position (set by homing)
         self._dir = 1
         self.legs: list[AnyLeg] = []
+        # perf: the plan's only leg when it is a CSP line (else None): the
+        # bus cycle's questions answered without looking through legs
+        self._line: Optional[LinLeg] = None
         self.evaluations = 0        #: polynomial evaluations (for cost tests)
         self.version = 0            #: changes whenever the plan changes
         self._memo: tuple = (None, None, None)
@@ -126,28 +129,27 @@ class Axis:
     def mechanical(self, t: int) -> int:
         """Whole counts in the plant's frame (switch positions), which
         homing does not move."""
-        legs = self.legs
-        if not legs:
-            return self._count          # perf: floor of the rest position, kept
-        leg = legs[-1]
-        if leg.__class__ is LinLeg and len(legs) == 1:   # CSP: integers only
+        leg = self._line
+        if leg is not None:                             # CSP: integers only
             if t >= leg.t1:
                 return leg.x1
             tt = leg.t0 if t < leg.t0 else t
             return leg.x0 + (leg.x1 - leg.x0) * (tt - leg.t0) // (leg.t1 - leg.t0)
+        if not self.legs:
+            return self._count          # perf: floor of the rest position, kept
         x = self.exact(t)[0]
         return x.numerator // x.denominator
 
     def velocity(self, t: int) -> int:
         """606Ch: whole P/s, truncated toward 0."""
-        if not self.legs:
-            return 0
-        leg = self.legs[-1]
-        if isinstance(leg, LinLeg) and len(self.legs) == 1:      # CSP: integers only
+        leg = self._line
+        if leg is not None:                                       # CSP: integers only
             if t >= leg.t1 or t < leg.t0:
                 return 0
             num, den = (leg.x1 - leg.x0) * US, leg.t1 - leg.t0
             return num // den if num >= 0 else -(-num // den)
+        if not self.legs:
+            return 0
         return int(self.exact(t)[1])
 
     def end_time(self) -> Optional[int]:
@@ -157,6 +159,8 @@ class Axis:
         return self.legs[-1].t_end
 
     def moving(self, t: int) -> bool:
+        if self._line is not None:
+            return t < self._line.t1        # perf: a CSP line
         if not self.legs:
             return False
         end = self.legs[-1].t_end
@@ -188,6 +192,7 @@ class Axis:
         rest = self._rest
         self._count = rest if rest.__class__ is int else rest.numerator // rest.denominator
         self.legs = legs
+        self._line = legs[0] if len(legs) == 1 and legs[0].__class__ is LinLeg else None
         self.version += 1
 
     # ---------------------------------------------------------------- planning
@@ -291,7 +296,8 @@ class Axis:
             # perf: _set(x0, [line]) written out: the rest is x1, an int
             self._dir = 1 if x1 > x0 else -1
             self._rest = self._count = x1
-            self.legs = [LinLeg(t0, t1, x0, x1)]
+            self._line = line = LinLeg(t0, t1, x0, x1)
+            self.legs = [line]
             self.version += 1
 
     # ---------------------------------------------------------------- crossings

@@ -45,6 +45,8 @@ __all__ = ["Drive", "DriveEvent"]
 
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
 _OUTPUT_KEYS = tuple((i, 0) for i in _OUTPUTS)
+_MOTION_KEYS = ((0x6062, 0), (0x6064, 0), (0x606C, 0), (0x60F4, 0))
+_STATE_KEYS = ((0x6041, 0), (0x6061, 0), (0x603F, 0), (0x1001, 0), (0x60FD, 0))
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
 #: (no speed limit then) and no P03.07 (no homing time limit).
 _ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0}
@@ -53,6 +55,10 @@ _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an er
 #: controlword, 6060h mode, 605Ah/6084h/6085h read by the state machine).
 _HOOK_INDEXES = frozenset({0x6040, 0x6060, 0x605A, 0x6084, 0x6085})
 _CW = (0x6040, 0)
+# perf: enum members as module constants (a class attribute of an Enum costs
+# ten times a global on Python 3.11, EnumType.__getattr__)
+_OE = State.OPERATION_ENABLED
+_ESM_OP = EsmState.OP
 _MISSING = object()
 
 
@@ -105,14 +111,13 @@ class Drive:
         self._signed = frozenset((e.index, e.sub) for e in self.od if e.dtype.startswith("I"))
         self._absent = {k: v for k, v in _ABSENT.items() if self.od.find(*k) is None}
         self._own = frozenset((i, 0) for i in _OUTPUTS if self.od.find(i, 0) is not None)
-        self._own_at = tuple(n for n, key in enumerate(_OUTPUT_KEYS) if key in self._own)
         self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
         self._batch = False
         self._rx_noted = False
         self._live = self.store.live          # perf: the store's values, read directly
         self._rx_codec: tuple = ((), None)    # perf: (active_rx, codec) of the last cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, (struct, [(dict, key)]))
-        self._published: tuple = ()           # perf: the values publish wrote last
+        self._published: tuple = (None, None)  # perf: the groups publish wrote last
         self._hook = self._on_write
         self._only_hook = ((), (self._hook,))
         self.store.on_write(self._hook)
@@ -477,13 +482,13 @@ class Drive:
                 else:
                     self._apply_values(t_us, None, values.items(), False)
             sm = self.sm
-            if sm.state is not State.OPERATION_ENABLED:
+            if sm.state is not _OE:
                 # in OE a held level can only hold OE: every other level acted when written
                 if sm.cycle_acts():
                     self._do(t_us, sm.cycle(t_us / 1e6))
                 elif len(sm.log) != self._sm_seen:
                     self._mirror()   # perf: a held level that changes nothing: no Result
-            if sm.state is State.OPERATION_ENABLED:
+            if sm.state is _OE:
                 self.engines[self.mode_number].cycle(t_us)   # perf: self.mode, inline
         finally:
             self._batch = False
@@ -585,7 +590,7 @@ class Drive:
         """Apply received objects *items*, then the controlword *cw* (None:
         not received).  *known*: the values come from an image, unpacked at
         each object's own width and signedness."""
-        if not self.esm.outputs:
+        if self.esm.state is not _ESM_OP:          # perf: esm.outputs (OP only)
             if not self._rx_noted:
                 self._rx_noted = True
                 self.note(t_us, "HCFA §6.5", f"RxPDO ignored in {self.esm.state.name}: "
@@ -602,7 +607,7 @@ class Drive:
                     # ENABLED, or a mode without parameter(); inside a
                     # cycle, which publishes once at its end)
                     store.hooked == self._only_hook
-                    and (self.sm.state is not State.OPERATION_ENABLED
+                    and (self.sm.state is not _OE
                          or not self.engines[self.mode_number].takes_parameters)):
                 store.set(key[0], key[1], v, source="pdo")
             elif known:
@@ -617,7 +622,7 @@ class Drive:
         """Write the drive's own objects for the present time."""
         t = self.now
         ax, sm = self.axis, self.sm
-        if sm.state is State.OPERATION_ENABLED:
+        if sm.state is _OE:
             bits = self.engines[self.mode_number].bits(t)    # perf: self.mode, inline
             if bits is not None:
                 sm.set_mode_bits(bits)
@@ -627,29 +632,39 @@ class Drive:
             csp = self.engines[8]
             assert isinstance(csp, CyclicPosition)
             fe = csp.following_error
-            demand = csp.demand if sm.state is State.OPERATION_ENABLED else pos
+            demand = csp.demand if sm.state is _OE else pos
         else:
             fe, demand = 0, pos
-        values = (sm.statusword, self.mode_number, demand, pos, ax.velocity(t),
-                  sm.error_code, sm.error_register, fe, self.plant.inputs(mech))
-        last = self._published
-        if values == last:
-            return          # perf: nothing changed since the last publish
-        if last:
-            # perf: the last values stand for _out (each own one was written)
-            changed = {}
-            for i in self._own_at:
-                if values[i] != last[i]:
-                    changed[_OUTPUT_KEYS[i]] = values[i]
+        # perf: two groups, each written only when one of its values changed
+        # (the motion values change every cycle of a move, the state values
+        # seldom); a group is written whole, unchanged values as they are
+        vel, inputs = ax.velocity(t), self.plant.inputs(mech)
+        motion = (demand, pos, vel, fe)
+        state = (sm.statusword, self.mode_number, sm.error_code, sm.error_register, inputs)
+        last_motion, last_state = self._published
+        new_motion, new_state = motion != last_motion, state != last_state
+        if not (new_motion or new_state):
+            return
+        store, out = self.store, self._out
+        if len(self._own) == len(_OUTPUTS) \
+                and (not new_motion or store.fits_group(_MOTION_KEYS, motion)) \
+                and (not new_state or store.fits_group(_STATE_KEYS, state)):
+            if new_motion:
+                store.set_status_group(_MOTION_KEYS, motion)
+                out.update(zip(_MOTION_KEYS, motion))
+            if new_state:
+                store.set_status_group(_STATE_KEYS, state)
+                out.update(zip(_STATE_KEYS, state))
         else:
-            out, own = self._out, self._own
+            # each changed value in the order of _OUTPUTS, up to one out of range
+            values = (state[0], state[1], demand, pos, vel, state[2], state[3], fe, inputs)
+            own = self._own
             changed = {key: v for key, v in zip(_OUTPUT_KEYS, values)
                        if out.get(key) != v and key in own}
-        out = self._out
-        if changed:
-            self.store.set_status(changed)
-            out.update(changed)
-        self._published = values
+            if changed:
+                store.set_status(changed)
+                out.update(changed)
+        self._published = (motion, state)
 
     @property
     def statusword(self) -> int:

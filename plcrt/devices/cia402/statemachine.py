@@ -40,6 +40,9 @@ __all__ = [
 ]
 
 S = State
+# perf: members read on every bus cycle, as module constants (an Enum class
+# attribute goes through EnumType.__getattr__ on Python 3.11)
+_NOT_READY, _QSA, _FRA = S.NOT_READY_TO_SWITCH_ON, S.QUICK_STOP_ACTIVE, S.FAULT_REACTION_ACTIVE
 
 # --------------------------------------------------------------------------- the drive
 
@@ -180,7 +183,7 @@ class Drive402:
     def statusword(self) -> int:
         """6041h: the state's word (HCFA §7.2), the idle mode bits of §7.3 or
         the mode layer's bits, bit 10 at rest in QSA, Kinco's bit 15."""
-        if self.state is S.NOT_READY_TO_SWITCH_ON:
+        if self.state is _NOT_READY:
             return 0
         base = STATUSWORD[self.state]
         if self._mode_bits is not None:
@@ -189,7 +192,7 @@ class Drive402:
             extra = IDLE_STATUSWORD.get((self.mode, self.state), base) & ~base
         else:
             extra = 0
-        if self.state is S.QUICK_STOP_ACTIVE and self.at_rest_in_quick_stop:
+        if self.state is _QSA and self.at_rest_in_quick_stop:
             extra |= 0x0400
         if self.personality.bit15 == "reference-found":
             extra = (extra & ~0x8000) | (0x8000 if self.homed else 0)
@@ -253,7 +256,7 @@ class Drive402:
         # perf: the bus cycle asks this first; :meth:`cycle` builds the
         # explanation of a refusal and a Result, which nobody reads then
         state = self.state
-        if state is S.FAULT_REACTION_ACTIVE:
+        if state is _FRA:
             return True
         cw = self.controlword
         cmd = decode_controlword(cw, cw)

@@ -76,6 +76,8 @@ class Store:
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
         # perf: (entry, low, high) per key, low None for a string, found once
         self._types: dict[tuple[int, int], tuple[Entry, int | None, int]] = {}
+        # perf: the (low, high) all objects of a status group share, (1, 0) if none
+        self._groups: dict[tuple[tuple[int, int], ...], tuple[int, int]] = {}
 
     @property
     def live(self) -> dict[tuple[int, int], Value]:
@@ -160,16 +162,37 @@ class Store:
         bounds, active, pending = self._bounds, self._active, self._pending
         with self.lock:
             for key, value in values.items():
-                b = bounds.get(key)
-                if b is None:
+                try:
+                    low, high = bounds[key]
+                except KeyError:
                     entry = self.od.entry(*key)
-                    b = bounds[key] = (entry.low, entry.high)
-                if not b[0] <= value <= b[1]:
+                    low, high = bounds[key] = (entry.low, entry.high)
+                if not low <= value <= high:
                     entry = self.od.entry(*key)
                     raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
                 active[key] = value
                 if pending:
                     pending.pop(key, None)
+
+    def fits_group(self, keys: tuple[tuple[int, int], ...], values: tuple[int, ...]) -> bool:
+        """Whether the status objects *keys* (a constant tuple) all share one
+        integer range and *values* (in the same order) all lie in it."""
+        common = self._groups.get(keys)
+        if common is None:
+            bounds = {(e.low, e.high) for e in (self.od.entry(*k) for k in keys)}
+            common = self._groups[keys] = bounds.pop() if len(bounds) == 1 else (1, 0)
+        # perf: one range check by the extremes instead of one per object
+        return common[0] <= min(values) and max(values) <= common[1]
+
+    def set_status_group(self, keys: tuple[tuple[int, int], ...],
+                         values: tuple[int, ...]) -> None:
+        """Set status objects *keys* to *values* that :meth:`fits_group`
+        found in range (no further check, no hooks)."""
+        with self.lock:
+            self._active.update(zip(keys, values))
+            if self._pending:
+                for key in keys:
+                    self._pending.pop(key, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.

@@ -60,6 +60,11 @@ _CW = (0x6040, 0)
 _OE = State.OPERATION_ENABLED
 _ESM_OP = EsmState.OP
 _MISSING = object()
+#: Objects the CSP cycle reads besides 607Ah (HCFA §7.5.1): a received one
+#: that changes takes the general cycle.
+_CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
+_K6065, _K607A, _K6080 = (0x6065, 0), (0x607A, 0), (0x6080, 0)
+_B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +121,7 @@ class Drive:
         self._rx_noted = False
         self._live = self.store.live          # perf: the store's values, read directly
         self._rx_codec: tuple = ((), None)    # perf: (active_rx, codec) of the last cycle
+        self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, (struct, [(dict, key)]))
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
         self._hook = self._on_write
@@ -440,7 +446,8 @@ class Drive:
         OP; objects before 6040h), evaluate the held controlword, run the
         mode's cycle, and return the TxPDO image."""
         with self.store.lock:
-            self._step(t_us, rx, None)
+            if rx is None or not self._csp_fast(t_us, rx, None):
+                self._step(t_us, rx, None)
             tx = self.pdo.active_tx
             entries, codec = self._tx_codec
             if entries is not tx:
@@ -462,6 +469,99 @@ class Drive:
         controlword, run the mode's cycle."""
         with self.store.lock:
             self._step(t_us, None, None)
+
+    def _csp_fast(self, t: int, rx: Optional[bytes],
+                  values: Optional[dict[tuple[int, int], int]]) -> bool:
+        """The bus cycle of a drive following CSP set-points, written out:
+        what :meth:`_step` does (advance, received objects, the mode's
+        cycle, publish) when no event can come, no object the drive acts on
+        changes (6040h held; no 6060h, 605Ah, 6084h, 6085h, 6065h, 6066h,
+        6080h, 1C32h), no switch is configured and the following error lies
+        within 6065h.  Returns False, having done nothing, otherwise."""
+        # perf: the steady CSP cycle in one function: no stage calls, no
+        # Result, no Write, only the values that change written
+        sm = self.sm
+        if (sm.state is not _OE or self.mode_number != 8 or self._qs_wait or t < self.now
+                or self.esm.state is not _ESM_OP or self.store.hooked != self._only_hook):
+            return False
+        plant = self.plant
+        if plant.pos_limit is not None or plant.neg_limit is not None:
+            return False
+        ax = self.axis
+        if ax._line is None and ax.legs:
+            return False
+        csp = self.engines[8]
+        if csp.__class__ is not CyclicPosition or csp._last is None:
+            return False
+        live = self._live
+        window, v_max = live.get(_K6065), live.get(_K6080)
+        if window.__class__ is not int or v_max.__class__ is not int:
+            return False
+        mech = ax.mechanical(t)
+        pos = mech + ax.shift
+        fe = csp.demand - pos
+        if fe > window or -fe > window:
+            return False
+        known = rx is not None
+        if known:
+            rx_map = self.pdo.active_rx
+            codec = self._csp_codec
+            if codec[0] is not rx_map:
+                codec = self._csp_codec = (rx_map, self._csp_rx_codec(rx_map))
+            codec = codec[1]
+            if codec is None or len(rx) != codec[0]:
+                return False
+            _, objects, keys, cw_st, at = codec
+            if cw_st is not None and cw_st.unpack_from(rx, at)[0] != self.controlword:
+                return False
+            changed = [kv for kv in zip(keys, objects.unpack(rx)) if live[kv[0]] != kv[1]]
+        else:
+            changed = []
+            for kv in values.items():                       # type: ignore[union-attr]
+                key, v = kv
+                if key == _CW:
+                    if v != self.controlword:
+                        return False
+                    continue
+                cur = live.get(key, _MISSING)
+                if not cur == v:
+                    if cur is _MISSING or key[0] in _HOOK_INDEXES or key in _CSP_READS:
+                        return False
+                    changed.append(kv)
+        # from here on as _step: the time, then the objects (no hook acts on them)
+        self.now = t
+        store = self.store
+        for key, v in changed:
+            if known:
+                store.set_known(key, v)
+            else:
+                store.set(key[0], key[1], v)
+        # CyclicPosition.cycle with no switch and the following error within 6065h
+        csp.following_error = fe
+        csp._fe_since = None
+        period = t - csp._last
+        csp._last = t
+        target = live.get(_K607A)
+        if target.__class__ is not int:
+            target = self.param(0x607A)
+        csp.limit_stop = False
+        ax.linear(t, t + (period if period > 1 else 1), target, v_max, mech)
+        csp.demand = target
+        # publish(): CyclicPosition.bits (no limit stop, no following error
+        # beyond 6065h); the line starts at t, so the count there is still mech
+        sm.set_mode_bits(_B12 if ax.moving(t) else _B12 | _B10)
+        self._publish_values((target, pos, ax.velocity(t), fe),
+                             (sm.statusword, 8, sm.error_code, sm.error_register,
+                              plant.inputs(mech)))
+        return True
+
+    def _csp_rx_codec(self, entries: tuple) -> Optional[tuple]:
+        """:meth:`_rx_fast_codec` for :meth:`_csp_fast`: None when the map
+        holds an object the drive acts on besides 6040h and 607Ah."""
+        codec = self._rx_fast_codec(entries)
+        if codec is None or any(k[0] in _HOOK_INDEXES or k in _CSP_READS for k in codec[2]):
+            return None
+        return codec
 
     def _step(self, t_us: int, rx: Optional[bytes],
               values: Optional[dict[tuple[int, int], int]]) -> None:
@@ -568,7 +668,8 @@ class Drive:
         before 6040h); the caller reads what it transmits from
         :attr:`store`."""
         with self.store.lock:
-            self._step(t_us, None, values)   # the same cycle as cycle()
+            if not self._csp_fast(t_us, None, values):
+                self._step(t_us, None, values)   # the same cycle as cycle()
 
     def _apply_rx(self, t_us: int, rx: bytes) -> None:
         rx_map = self.pdo.active_rx
@@ -635,12 +736,18 @@ class Drive:
             demand = csp.demand if sm.state is _OE else pos
         else:
             fe, demand = 0, pos
+        self._publish_values(
+            (demand, pos, ax.velocity(t), fe),
+            (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
+             self.plant.inputs(mech)))
+
+    def _publish_values(self, motion: tuple[int, int, int, int],
+                        state: tuple[int, int, int, int, int]) -> None:
+        """Write the drive's own objects: *motion* = 6062h, 6064h, 606Ch,
+        60F4h and *state* = 6041h, 6061h, 603Fh, 1001h, 60FDh."""
         # perf: two groups, each written only when one of its values changed
         # (the motion values change every cycle of a move, the state values
         # seldom); a group is written whole, unchanged values as they are
-        vel, inputs = ax.velocity(t), self.plant.inputs(mech)
-        motion = (demand, pos, vel, fe)
-        state = (sm.statusword, self.mode_number, sm.error_code, sm.error_register, inputs)
         last_motion, last_state = self._published
         new_motion, new_state = motion != last_motion, state != last_state
         if not (new_motion or new_state):
@@ -657,7 +764,8 @@ class Drive:
                 out.update(zip(_STATE_KEYS, state))
         else:
             # each changed value in the order of _OUTPUTS, up to one out of range
-            values = (state[0], state[1], demand, pos, vel, state[2], state[3], fe, inputs)
+            values = (state[0], state[1], motion[0], motion[1], motion[2], state[2], state[3],
+                      motion[3], state[4])
             own = self._own
             changed = {key: v for key, v in zip(_OUTPUT_KEYS, values)
                        if out.get(key) != v and key in own}

@@ -39,14 +39,16 @@ from .pdo import ASSIGN, RX_MAPS, TX_MAPS, PdoConfig, pack, unpack
 from .plant import DrivePlant
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
-from .store import Store, Write
+from .store import Store, Write, key
 
 __all__ = ["Drive", "DriveEvent"]
 
 _OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
-_OUTPUT_KEYS = tuple((i, 0) for i in _OUTPUTS)
-_MOTION_KEYS = ((0x6062, 0), (0x6064, 0), (0x606C, 0), (0x60F4, 0))
-_STATE_KEYS = ((0x6041, 0), (0x6061, 0), (0x603F, 0), (0x1001, 0), (0x60FD, 0))
+_OUTPUT_KEYS = tuple(key(i, 0) for i in _OUTPUTS)
+_MOTION_KEYS = _K6062, _K6064, _K606C, _K60F4 = tuple(
+    key(i, 0) for i in (0x6062, 0x6064, 0x606C, 0x60F4))
+_STATE_KEYS = _K6041, _K6061, _K603F, _K1001, _K60FD = tuple(
+    key(i, 0) for i in (0x6041, 0x6061, 0x603F, 0x1001, 0x60FD))
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
 #: (no speed limit then) and no P03.07 (no homing time limit).
 _ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0}
@@ -54,7 +56,7 @@ _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an er
 #: Objects whose write the drive's hook acts on whatever the mode (6040h
 #: controlword, 6060h mode, 605Ah/6084h/6085h read by the state machine).
 _HOOK_INDEXES = frozenset({0x6040, 0x6060, 0x605A, 0x6084, 0x6085})
-_CW = (0x6040, 0)
+_CW = key(0x6040, 0)
 # perf: enum members as module constants (a class attribute of an Enum costs
 # ten times a global on Python 3.11, EnumType.__getattr__)
 _OE = State.OPERATION_ENABLED
@@ -63,7 +65,7 @@ _MISSING = object()
 #: Objects the CSP cycle reads besides 607Ah (HCFA §7.5.1): a received one
 #: that changes takes the general cycle.
 _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
-_K6065, _K607A, _K6080 = (0x6065, 0), (0x607A, 0), (0x6080, 0)
+_K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
 
 
@@ -124,8 +126,11 @@ class Drive:
         self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, (struct, [(dict, key)]))
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
+        self._motion_out = dict.fromkeys(_MOTION_KEYS, 0)   # perf: refilled by publish
+        self._state_out = dict.fromkeys(_STATE_KEYS, 0)
         self._hook = self._on_write
         self._only_hook = ((), (self._hook,))
+        self._hooked_ok: tuple = ()           # perf: store.hooked when last found == _only_hook
         self.store.on_write(self._hook)
         self._mirror()
         self.publish()
@@ -482,8 +487,13 @@ class Drive:
         # Result, no Write, only the values that change written
         sm = self.sm
         if (sm.state is not _OE or self.mode_number != 8 or self._qs_wait or t < self.now
-                or self.esm.state is not _ESM_OP or self.store.hooked != self._only_hook):
+                or self.esm.state is not _ESM_OP):
             return False
+        hooked = self.store.hooked
+        if hooked is not self._hooked_ok:
+            if hooked != self._only_hook:
+                return False
+            self._hooked_ok = hooked        # perf: the same subscriptions, seen before
         plant = self.plant
         if plant.pos_limit is not None or plant.neg_limit is not None:
             return False
@@ -514,7 +524,10 @@ class Drive:
             _, objects, keys, cw_st, at = codec
             if cw_st is not None and cw_st.unpack_from(rx, at)[0] != self.controlword:
                 return False
-            changed = [kv for kv in zip(keys, objects.unpack(rx)) if live[kv[0]] != kv[1]]
+            changed = []
+            for kv in zip(keys, objects.unpack(rx)):
+                if live[kv[0]] != kv[1]:
+                    changed.append(kv)
         else:
             changed = []
             for kv in values.items():                       # type: ignore[union-attr]
@@ -610,7 +623,7 @@ class Drive:
                 continue
             code = {8: "b", 16: "h", 32: "i"}[e.bits]
             fmt += code if (e.index, e.sub) in self._signed else code.upper()
-            keys.append((e.index, e.sub))
+            keys.append(key(e.index, e.sub))
         codec = (struct.Struct(fmt), keys)
         self._codecs[id(entries)] = (entries, codec)
         return codec
@@ -642,21 +655,21 @@ class Drive:
         for e in entries:
             if e.bits not in (8, 16, 32):
                 return None
-            key, size = (e.index, e.sub), e.bits // 8
+            k, size = key(e.index, e.sub), e.bits // 8
             code = {8: "b", 16: "h", 32: "i"}[e.bits]
-            code = code if key in self._signed else code.upper()
+            code = code if k in self._signed else code.upper()
             if e.index == 0:
                 fmt += "x" * size
-            elif key == _CW:
+            elif k == _CW:
                 if cw is not None:
                     return None
                 fmt += "x" * size
                 cw = (struct.Struct("<" + code), offset)
             else:
-                if key in keys:
+                if k in keys:
                     return None
                 fmt += code
-                keys.append(key)
+                keys.append(k)
             offset += size
         return (offset, struct.Struct(fmt), tuple(keys), *(cw or (None, 0)))
 
@@ -756,12 +769,17 @@ class Drive:
         if len(self._own) == len(_OUTPUTS) \
                 and (not new_motion or store.fits_group(_MOTION_KEYS, motion)) \
                 and (not new_state or store.fits_group(_STATE_KEYS, state)):
+            # perf: each group's dict is kept and refilled, then merged whole
             if new_motion:
-                store.set_status_group(_MOTION_KEYS, motion)
-                out.update(zip(_MOTION_KEYS, motion))
+                group = self._motion_out
+                group[_K6062], group[_K6064], group[_K606C], group[_K60F4] = motion
+                store.set_status_group(group)
+                out.update(group)
             if new_state:
-                store.set_status_group(_STATE_KEYS, state)
-                out.update(zip(_STATE_KEYS, state))
+                group = self._state_out
+                group[_K6041], group[_K6061], group[_K603F], group[_K1001], group[_K60FD] = state
+                store.set_status_group(group)
+                out.update(group)
         else:
             # each changed value in the order of _OUTPUTS, up to one out of range
             values = (state[0], state[1], motion[0], motion[1], motion[2], state[2], state[3],

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Optional
 
 from .homing import homing_status
 from .homing_plan import HomingPlan, HomingRequest, HomingStep, Watch
+from .store import key
 
 if TYPE_CHECKING:  # pragma: no cover
     from .drive import Drive
@@ -32,7 +33,7 @@ MODE_NAMES = {0: "no mode", 1: "PP", 3: "PV", 6: "HM", 8: "CSP"}
 
 NEW_SETPOINT, CHANGE_IMMEDIATELY, RELATIVE, HALT = 0x10, 0x20, 0x40, 0x100  # HCFA §7.4.1
 B8, B10, B11, B12, B13, B14, B15 = 0x100, 0x400, 0x800, 0x1000, 0x2000, 0x4000, 0x8000
-_K6065, _K607A, _K6080 = (0x6065, 0), (0x607A, 0), (0x6080, 0)
+_K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 
 
 class Mode:

@@ -25,6 +25,16 @@ from .od import DTYPES, ESM_STATES, Entry, ObjectDictionary, SdoAbort, is_assign
 
 Value = int | str
 
+#: perf: one tuple object per (index, sub), shared by every store and by the
+#: drive's constants: a dict finds a key by identity, without comparing tuples
+_KEYS: dict[tuple[int, int], tuple[int, int]] = {}
+
+
+def key(index: int, sub: int) -> tuple[int, int]:
+    """The shared ``(index, sub)`` tuple the stores' value dicts hold."""
+    k = (index, sub)
+    return _KEYS.setdefault(k, k)
+
 
 @dataclass(frozen=True, slots=True)
 class Write:
@@ -65,19 +75,22 @@ class Store:
             raise PlcConfigError(f"length_abort = {length_abort!r}; expected 'exact' or 'generic'")
         self.od = od
         self.length_abort = length_abort
-        self._active: dict[tuple[int, int], Value] = {(e.index, e.sub): e.default for e in od}
+        self._active: dict[tuple[int, int], Value] = {key(e.index, e.sub): e.default for e in od}
         self._pending: dict[tuple[int, int], Value] = {}
         # perf: the hooks as tuples, rebuilt when one (un)subscribes: a write
         # iterates a snapshot without copying a list
         self._check_hooks: tuple[Hook, ...] = ()
         self._write_hooks: tuple[Hook, ...] = ()
+        #: The check hooks and the write hooks subscribed now (read only).
+        self.hooked: tuple[tuple[Hook, ...], tuple[Hook, ...]] = ((), ())
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
         # perf: (entry, low, high) per key, low None for a string, found once
         self._types: dict[tuple[int, int], tuple[Entry, int | None, int]] = {}
-        # perf: the (low, high) all objects of a status group share, (1, 0) if none
-        self._groups: dict[tuple[tuple[int, int], ...], tuple[int, int]] = {}
+        # perf: the (low, high, bits) all objects of a status group share
+        # (bits: log2 of the range's width when a power of two, else None)
+        self._groups: dict[tuple[tuple[int, int], ...], tuple[int, int, int | None]] = {}
 
     @property
     def live(self) -> dict[tuple[int, int], Value]:
@@ -86,10 +99,6 @@ class Store:
         check of :meth:`get`."""
         return self._active
 
-    @property
-    def hooked(self) -> tuple[tuple[Hook, ...], tuple[Hook, ...]]:
-        """The check hooks and the write hooks subscribed now."""
-        return self._check_hooks, self._write_hooks
 
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:
@@ -180,19 +189,29 @@ class Store:
         common = self._groups.get(keys)
         if common is None:
             bounds = {(e.low, e.high) for e in (self.od.entry(*k) for k in keys)}
-            common = self._groups[keys] = bounds.pop() if len(bounds) == 1 else (1, 0)
-        # perf: one range check by the extremes instead of one per object
-        return common[0] <= min(values) and max(values) <= common[1]
+            low, high = bounds.pop() if len(bounds) == 1 else (1, 0)
+            span = high - low + 1
+            common = self._groups[keys] = (low, high, span.bit_length() - 1
+                                           if span > 0 and span & (span - 1) == 0 else None)
+        low, high, width = common
+        if width is not None:
+            # perf: a CoE integer type spans 2**bits values from its minimum:
+            # all values fit when all offsets from it are below 2**bits (a
+            # negative one keeps its sign bits and fails too)
+            offsets = 0
+            for v in values:
+                offsets |= v - low
+            return offsets >> width == 0
+        return low <= min(values) and max(values) <= high
 
-    def set_status_group(self, keys: tuple[tuple[int, int], ...],
-                         values: tuple[int, ...]) -> None:
-        """Set status objects *keys* to *values* that :meth:`fits_group`
-        found in range (no further check, no hooks)."""
+    def set_status_group(self, values: dict[tuple[int, int], int]) -> None:
+        """Set status objects to *values* that :meth:`fits_group` found in
+        range (no further check, no hooks)."""
         with self.lock:
-            self._active.update(zip(keys, values))
+            self._active.update(values)
             if self._pending:
-                for key in keys:
-                    self._pending.pop(key, None)
+                for k in values:
+                    self._pending.pop(k, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.
@@ -239,6 +258,7 @@ class Store:
         raise :class:`SdoAbort` to refuse it.  Returns an unsubscribe function."""
         with self.lock:
             self._check_hooks = (*self._check_hooks, callback)
+            self.hooked = (self._check_hooks, self._write_hooks)
         return lambda: self._unsubscribe("_check_hooks", callback)
 
     def on_write(self, callback: Hook) -> Callable[[], None]:
@@ -246,6 +266,7 @@ class Store:
         Returns an unsubscribe function."""
         with self.lock:
             self._write_hooks = (*self._write_hooks, callback)
+            self.hooked = (self._check_hooks, self._write_hooks)
         return lambda: self._unsubscribe("_write_hooks", callback)
 
     def _unsubscribe(self, which: str, callback: Hook) -> None:
@@ -253,6 +274,7 @@ class Store:
             hooks = list(getattr(self, which))
             hooks.remove(callback)          # ValueError when not subscribed, as list.remove
             setattr(self, which, tuple(hooks))
+            self.hooked = (self._check_hooks, self._write_hooks)
 
     # -- SDO ---------------------------------------------------------------
     def sdo_read(self, index: int, sub: int) -> bytes:

@@ -74,6 +74,15 @@ _PLAIN_PLANT = {f.name for f in fields(DrivePlant)} == {
     "neg_limit", "pos_limit", "home_switch", "index_period", "index_phase"}
 
 
+def _picker(at: list) -> Callable[[object], tuple]:
+    """itemgetter(*at), giving a tuple also for one or no item."""
+    if len(at) > 1:
+        return itemgetter(*at)
+    if at:
+        return lambda values, one=at[0]: (values[one],)
+    return lambda values: ()
+
+
 @dataclass(frozen=True, slots=True)
 class DriveEvent:
     """One entry of the drive's event log."""
@@ -464,10 +473,14 @@ class Drive:
                 codec = self._tx_fast_codec(tx)     # perf: once per mapping
                 self._tx_codec = (tx, codec)
             if codec is not None:
+                st, pick, get = codec
+                if pick is not None:
+                    motion, state = self._published
+                    return st.pack(*pick(motion + state + (get(self._live) if get else ())))
                 args: list[int] = []
-                for get, src in codec[1]:
+                for get, src in get:
                     args += get(src)
-                return codec[0].pack(*args)
+                return st.pack(*args)
             get, out = self.store.get, self._out
             values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out
                       else int(get(e.index, e.sub)) for e in tx if e.index}
@@ -643,12 +656,26 @@ class Drive:
         return codec
 
     def _tx_fast_codec(self, entries: tuple) -> Optional[tuple]:
-        """For a byte-aligned TxPDO map: its struct, and the objects as runs
-        of (getter, source): the drive's own outputs (:attr:`_out`) or the
-        store's values, each getter giving a tuple."""
+        """For a byte-aligned TxPDO map: (struct, pick, getter).  When the
+        model has all the drive's own objects, *pick* takes the image's
+        values by position from the motion and state groups publish wrote
+        last followed by *getter* (store values) of the other objects;
+        otherwise *pick* is None and *getter* lists runs of (getter, source):
+        the drive's own outputs (:attr:`_out`) or the store's values."""
         found = self._codec(entries)
         if found is None:
             return None
+        st, keys = found
+        if len(self._own) == len(_OUTPUTS):
+            # perf: the own objects from the values publish wrote last (the
+            # motion and state groups, kept equal to _out), the others from
+            # the store: one tuple, picked by position without hashing keys
+            own = _MOTION_KEYS + _STATE_KEYS
+            extra = [k for k in keys if k not in own]
+            at = [own.index(k) if k in own else len(own) + extra.index(k) for k in keys]
+            pick = _picker(at)
+            get_extra = None if not extra else _picker(extra)
+            return st, pick, get_extra
         runs: list[tuple[list[tuple[int, int]], dict]] = []
         for key in found[1]:
             src = self._out if key in self._own else self._live
@@ -656,9 +683,7 @@ class Drive:
                 runs[-1][0].append(key)
             else:
                 runs.append(([key], src))
-        return found[0], [(itemgetter(*keys) if len(keys) > 1 else
-                           (lambda values, key=keys[0]: (values[key],)), src)
-                          for keys, src in runs]
+        return st, None, [(_picker(keys), src) for keys, src in runs]
 
     def _rx_fast_codec(self, entries: tuple) -> Optional[tuple]:
         """For a byte-aligned RxPDO map without repeated objects: (image

@@ -16,6 +16,7 @@ they produce with :meth:`Store.set`.
 
 from __future__ import annotations
 
+import struct
 import threading
 from dataclasses import dataclass
 from typing import Callable
@@ -60,6 +61,10 @@ class StoreEvent:
 
 Hook = Callable[[Write], None]
 
+#: struct codes of the CoE integer types (their ranges are the types' ranges)
+_STRUCT_CODES = {"I8": "b", "U8": "B", "I16": "h", "U16": "H", "I32": "i", "U32": "I",
+                 "I64": "q", "U64": "Q"}
+
 
 class Store:
     """Values of one drive, initialised from the defaults of ``od``.
@@ -88,9 +93,8 @@ class Store:
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
         # perf: (entry, low, high) per key, low None for a string, found once
         self._types: dict[tuple[int, int], tuple[Entry, int | None, int]] = {}
-        # perf: the (low, high, bits) all objects of a status group share
-        # (bits: log2 of the range's width when a power of two, else None)
-        self._groups: dict[tuple[tuple[int, int], ...], tuple[int, int, int | None]] = {}
+        # perf: a struct per status group, whose packing checks the ranges
+        self._groups: dict[tuple[tuple[int, int], ...], struct.Struct | bool] = {}
 
     @property
     def live(self) -> dict[tuple[int, int], Value]:
@@ -184,25 +188,26 @@ class Store:
                     pending.pop(key, None)
 
     def fits_group(self, keys: tuple[tuple[int, int], ...], values: tuple[int, ...]) -> bool:
-        """Whether the status objects *keys* (a constant tuple) all share one
-        integer range and *values* (in the same order) all lie in it."""
-        common = self._groups.get(keys)
-        if common is None:
-            bounds = {(e.low, e.high) for e in (self.od.entry(*k) for k in keys)}
-            low, high = bounds.pop() if len(bounds) == 1 else (1, 0)
-            span = high - low + 1
-            common = self._groups[keys] = (low, high, span.bit_length() - 1
-                                           if span > 0 and span & (span - 1) == 0 else None)
-        low, high, width = common
-        if width is not None:
-            # perf: a CoE integer type spans 2**bits values from its minimum:
-            # all values fit when all offsets from it are below 2**bits (a
-            # negative one keeps its sign bits and fails too)
-            offsets = 0
-            for v in values:
-                offsets |= v - low
-            return offsets >> width == 0
-        return low <= min(values) and max(values) <= high
+        """Whether *values* (in the order of the status objects *keys*, a
+        constant tuple) all lie in their objects' integer ranges; False too
+        when an object is not a plain integer type (then :meth:`set_status`
+        decides)."""
+        packer = self._groups.get(keys)
+        if packer is None:
+            entries = [self.od.entry(*k) for k in keys]
+            # a struct code only for an object whose range is its type's
+            codes = [_STRUCT_CODES.get(e.dtype) if e.dtype in DTYPES
+                     and (e.low, e.high) == DTYPES[e.dtype][1:] else None for e in entries]
+            packer = self._groups[keys] = \
+                struct.Struct("<" + "".join(codes)) if None not in codes else False
+        if packer is False:
+            return False
+        # perf: struct checks every value against its type's range in C
+        try:
+            packer.pack(*values)
+        except struct.error:
+            return False
+        return True
 
     def set_status_group(self, values: dict[tuple[int, int], int]) -> None:
         """Set status objects to *values* that :meth:`fits_group` found in

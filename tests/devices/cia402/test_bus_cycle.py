@@ -269,3 +269,17 @@ def test_a_csp_line_ends_at_an_exact_rest_position():
     d.advance(t + 5000)
     x, v = d.axis.exact(d.now)
     assert isinstance(x, Fraction) and x == 123 and v == 0 and d.position == 123
+
+
+def test_a_value_out_of_its_type_is_refused_after_the_values_before_it_are_written():
+    d = in_op()
+    d.write(0x6080, 0, 0xFFFF_FFFF)
+    t = 0
+    for cw in (0x06, 0x07, 0x0F, 0x0F):
+        t += 1000
+        d.cycle(t, image(cw, 0))
+    with pytest.raises(PlcConfigError, match="606Ch"):
+        d.cycle(t + 1, image(0x0F, -10**9))      # 4294 counts in 1 µs: 606Ch beyond I32
+    # 6062h and 6064h come before 606Ch in the drive's outputs and are written
+    assert d.store.get(0x6062) == -10**9 and d.store.get(0x6064) == d.axis.position(d.now)
+    assert d.store.get(0x606C) == 0

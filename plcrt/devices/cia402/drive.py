@@ -138,7 +138,7 @@ class Drive:
         self._live = self.store.live          # perf: the store's values, read directly
         self._rx_codec: tuple = ((), None)    # perf: (active_rx, codec) of the last cycle
         self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
-        self._tx_codec: tuple = ((), None)    # perf: (active_tx, (struct, [(dict, key)]))
+        self._tx_codec: tuple = ((), None)    # perf: (active_tx, _tx_fast_codec of it)
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
         self._motion_out = dict.fromkeys(_MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(_STATE_KEYS, 0)
@@ -473,13 +473,13 @@ class Drive:
                 codec = self._tx_fast_codec(tx)     # perf: once per mapping
                 self._tx_codec = (tx, codec)
             if codec is not None:
-                st, pick, get = codec
+                st, pick, more = codec
                 if pick is not None:
                     motion, state = self._published
-                    return st.pack(*pick(motion + state + (get(self._live) if get else ())))
+                    return st.pack(*pick(motion + state + (more(self._live) if more else ())))
                 args: list[int] = []
-                for get, src in get:
-                    args += get(src)
+                for run, src in more:
+                    args += run(src)
                 return st.pack(*args)
             get, out = self.store.get, self._out
             values = {(e.index, e.sub): out.get((e.index, e.sub)) if (e.index, e.sub) in out

@@ -103,7 +103,6 @@ class Store:
         check of :meth:`get`."""
         return self._active
 
-
     # -- values ------------------------------------------------------------
     def get(self, index: int, sub: int = 0) -> Value:
         """The active value (the one the drive acts on)."""

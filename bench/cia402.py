@@ -8,16 +8,22 @@ Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
    image), the master sending a sine-like target each cycle, and reports
    simulated drive-seconds per wall second (drives x simulated seconds /
    wall seconds) as "x real time";
-2. runs the same PP move (one set-point, the positive limit switch crossed
+2. runs the same through ``Drive.exchange`` (object-level process data
+   ``{(index, sub): value}``, the path of a PLC's master module), one and
+   eight drives;
+3. runs the same PP move (one set-point, the positive limit switch crossed
    half-way through the window) at 10 kP/s and at 1 MP/s with 1 ms cycles and reports the ratio of their costs: the drive solves
    positions and crossings in closed form (plcrt.devices.motion), so the
    ratio stays near 1 although the speed differs a hundredfold;
-3. measures SDO round trips per second over python-can's ``virtual`` bus:
+4. measures SDO round trips per second over python-can's ``virtual`` bus:
    a canopen master uploads 6064h from a drive put on the bus with
    ``plcrt.cia402.attach`` (manual clock, so only the SDO path is timed).
 
 Each figure is the best of ``--repeat`` runs (fresh drives, set-up not
-timed).  A measuring tool: it asserts nothing.
+timed).  The CSP figures come twice: per wall second, and per CPU second
+of this process (on a shared machine other processes take the CPU for part
+of the wall time; the load average is printed).  A measuring tool: it
+asserts nothing.
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import os
 import platform
 import sys
 import time
@@ -58,7 +65,7 @@ def csp_drives(n: int) -> list[Drive]:
     return drives
 
 
-def time_csp(n: int, seconds: float) -> float:
+def time_csp(n: int, seconds: float) -> tuple[float, float]:
     drives = csp_drives(n)
     cycles = int(seconds * 1e6) // CYCLE_US
     t0 = drives[0].now
@@ -66,14 +73,38 @@ def time_csp(n: int, seconds: float) -> float:
     targets = [rx(0x0F, 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100))
                for k in range(cycles)]
     gc.collect()
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     for k in range(cycles):
         t = t0 + (k + 1) * CYCLE_US
         image = targets[k]
         for d in drives:
             d.cycle(t, image)
-    wall = time.perf_counter() - start
-    return n * cycles * CYCLE_US / 1e6 / wall
+    return ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
+
+
+def ratios(simulated: float, start: float, cpu: float) -> tuple[float, float]:
+    """Simulated seconds per wall second and per CPU second of this process
+    (the second does not count the time other processes took the CPU)."""
+    wall, used = time.perf_counter() - start, time.process_time() - cpu
+    return simulated / wall, simulated / max(used, 1e-9)
+
+
+def time_csp_exchange(n: int, seconds: float) -> tuple[float, float]:
+    """As :func:`time_csp`, the process data given by object (``Drive.exchange``)."""
+    drives = csp_drives(n)
+    cycles = int(seconds * 1e6) // CYCLE_US
+    t0 = drives[0].now
+    targets = [{(0x6040, 0): 0x0F,
+                (0x607A, 0): 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)}
+               for k in range(cycles)]
+    gc.collect()
+    start, cpu = time.perf_counter(), time.process_time()
+    for k in range(cycles):
+        t = t0 + (k + 1) * CYCLE_US
+        values = targets[k]
+        for d in drives:
+            d.exchange(t, values)
+    return ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
 
 
 def time_pp(speed: int, seconds: float) -> float:
@@ -140,8 +171,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="runs per figure (best is kept)")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
-    one = max(time_csp(1, args.seconds) for _ in range(args.repeat))
-    eight = max(time_csp(8, args.seconds / 4) for _ in range(args.repeat))
+    def best(runs: list[tuple[float, float]]) -> tuple[float, float]:
+        return max(r[0] for r in runs), max(r[1] for r in runs)
+
+    one, one_cpu = best([time_csp(1, args.seconds) for _ in range(args.repeat)])
+    eight, eight_cpu = best([time_csp(8, args.seconds / 4) for _ in range(args.repeat)])
+    x_one, x_one_cpu = best([time_csp_exchange(1, args.seconds) for _ in range(args.repeat)])
+    x_eight, x_eight_cpu = best([time_csp_exchange(8, args.seconds / 4)
+                                 for _ in range(args.repeat)])
     slow = min(time_pp(10_000, args.seconds) for _ in range(args.repeat))
     fast = min(time_pp(1_000_000, args.seconds) for _ in range(args.repeat))
     sdo = max(sdo_round_trips() for _ in range(args.repeat))
@@ -151,6 +188,12 @@ def main(argv: list[str] | None = None) -> int:
            "calibration_1e6_adds_s": round(cal, 3),
            "csp_1_drive_x_real_time": round(one, 1),
            "csp_8_drives_x_real_time": round(eight, 1),
+           "csp_exchange_1_drive_x_real_time": round(x_one, 1),
+           "csp_exchange_8_drives_x_real_time": round(x_eight, 1),
+           "per_cpu_second": {"csp_1": round(one_cpu, 1), "csp_8": round(eight_cpu, 1),
+                              "exchange_1": round(x_one_cpu, 1),
+                              "exchange_8": round(x_eight_cpu, 1)},
+           "load_average_1min": round(os.getloadavg()[0], 2),
            "pp_10kHz_wall_s": round(slow, 4), "pp_1MHz_wall_s": round(fast, 4),
            "pp_cost_ratio_fast_over_slow": round(fast / slow, 2),
            "sdo_round_trips_per_s": round(sdo)}
@@ -159,8 +202,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     print(f"plcrt CiA 402 drive benchmark ({out['machine']}), 1 ms bus cycle, best of "
           f"{args.repeat}; 10^6 Python additions take {cal * 1e3:.0f} ms here")
-    print(f"  CSP, 1 drive:  {one:8.1f} x real time")
-    print(f"  CSP, 8 drives: {eight:8.1f} x real time (drive-seconds per wall second)")
+    print(f"  load average {out['load_average_1min']} on {os.cpu_count()} CPUs; in brackets: "
+          "drive-seconds per CPU second of this process")
+    print(f"  CSP, 1 drive:  {one:8.1f} x real time ({one_cpu:.1f})")
+    print(f"  CSP, 8 drives: {eight:8.1f} x real time ({eight_cpu:.1f}; drive-seconds per "
+          "wall second)")
+    print(f"  CSP through Drive.exchange (process data by object), 1 drive: {x_one:8.1f} x "
+          f"({x_one_cpu:.1f}), 8 drives: {x_eight:8.1f} x real time ({x_eight_cpu:.1f})")
     print(f"  PP move at 10 kP/s: {slow * 1e3:.1f} ms wall, at 1 MP/s: {fast * 1e3:.1f} ms wall "
           f"(ratio {fast / slow:.2f}) for {args.seconds:g} s simulated")
     print(f"  SDO round trips over the virtual bus (canopen master, attach): {sdo:8.0f} /s")

@@ -74,10 +74,16 @@ class Axis:
     """One axis: at rest at an exact position, or following a plan."""
 
     def __init__(self, position: int = 0) -> None:
-        self._rest = Fraction(position)
+        # perf: the rest position is an int after a CSP line (exact() makes
+        # it a Fraction when asked); _count is its floor, kept with it
+        self._rest: Fraction | int = Fraction(position)
+        self._count = position
         self.shift = 0              #: count - mechanical position (set by homing)
         self._dir = 1
         self.legs: list[AnyLeg] = []
+        # perf: the plan's only leg when it is a CSP line (else None): the
+        # bus cycle's questions answered without looking through legs
+        self._line: Optional[LinLeg] = None
         self.evaluations = 0        #: polynomial evaluations (for cost tests)
         self.version = 0            #: changes whenever the plan changes
         self._memo: tuple = (None, None, None)
@@ -128,7 +134,10 @@ class Axis:
         """Exact position and signed speed (P/s) of the plan at integer µs *t*."""
         if self._memo[0] == t and self._memo[1] == self.version:
             return self._memo[2]
-        out = self._rest, ZERO
+        rest = self._rest
+        if rest.__class__ is int:
+            rest = self._rest = Fraction(rest)
+        out = rest, ZERO
         for leg in self.legs:
             end = leg.t_end
             if end is None or t < end:
@@ -145,30 +154,27 @@ class Axis:
     def mechanical(self, t: int) -> int:
         """Whole counts in the plant's frame (switch positions), which
         homing does not move."""
+        leg = self._line
+        if leg is not None and self.bounds is None:     # perf: CSP, integers only
+            if t >= leg.t1:
+                return leg.x1
+            tt = leg.t0 if t < leg.t0 else t
+            return leg.x0 + (leg.x1 - leg.x0) * (tt - leg.t0) // (leg.t1 - leg.t0)
         if not self.legs and self.bounds is None:
-            x = self._rest
-        elif not self.legs:
-            x = self.exact(t)[0]          # at rest, perhaps held at a mechanical end
-        else:
-            leg = self.legs[-1]
-            if isinstance(leg, LinLeg) and len(self.legs) == 1 and self.bounds is None:
-                if t >= leg.t1:                                     # perf: CSP, integers only
-                    return leg.x1
-                tt = max(t, leg.t0)
-                return leg.x0 + (leg.x1 - leg.x0) * (tt - leg.t0) // (leg.t1 - leg.t0)
-            x = self.exact(t)[0]
+            return self._count          # perf: floor of the rest position, kept
+        x = self.exact(t)[0]              # perhaps held at a mechanical end
         return x.numerator // x.denominator
 
     def velocity(self, t: int) -> int:
         """606Ch: whole P/s, truncated toward 0."""
-        if not self.legs:
-            return 0
-        leg = self.legs[-1]
-        if isinstance(leg, LinLeg) and len(self.legs) == 1 and self.bounds is None:
-            if t >= leg.t1 or t < leg.t0:                           # perf: CSP, integers only
+        leg = self._line
+        if leg is not None and self.bounds is None:               # perf: CSP, integers only
+            if t >= leg.t1 or t < leg.t0:
                 return 0
             num, den = (leg.x1 - leg.x0) * US, leg.t1 - leg.t0
             return num // den if num >= 0 else -(-num // den)
+        if not self.legs:
+            return 0
         return int(self.exact(t)[1])
 
     def end_time(self) -> Optional[int]:
@@ -178,6 +184,8 @@ class Axis:
         return self.legs[-1].t_end
 
     def moving(self, t: int) -> bool:
+        if self._line is not None:
+            return t < self._line.t1        # perf: a CSP line
         if not self.legs:
             return False
         end = self.legs[-1].t_end
@@ -204,10 +212,13 @@ class Axis:
             self._dir = legs[-1].direction or self._dir
             last = legs[-1]
             if isinstance(last, LinLeg):
-                self._rest = Fraction(last.x1)
+                self._rest = last.x1        # perf: an int, made a Fraction when asked
             elif last.t_end is not None:
                 self._rest = last.origin + last.direction * last.segs[-1].x1
+        rest = self._rest
+        self._count = rest if rest.__class__ is int else rest.numerator // rest.denominator
         self.legs = legs
+        self._line = legs[0] if len(legs) == 1 and legs[0].__class__ is LinLeg else None
         self.version += 1
 
     # ---------------------------------------------------------------- planning
@@ -292,19 +303,29 @@ class Axis:
             legs.append(Leg(direction, x, segs))
         self._set(x, legs)
 
-    def linear(self, t0: int, t1: int, target: int, v_max: int) -> None:
+    def linear(self, t0: int, t1: int, target: int, v_max: int,
+               x0: Optional[int] = None) -> None:
         """CSP: from the count at *t0* to *target* at *t1*, at most *v_max*
-        P/s (then it ends short, at a whole count)."""
-        x0 = self.mechanical(t0)
+        P/s (then it ends short, at a whole count).  *x0*: the plant
+        position at *t0* when the caller has it (``mechanical(t0)``)."""
+        if x0 is None:
+            x0 = self.mechanical(t0)
         x1 = target - self.shift
         cap = v_max * (t1 - t0) // US
-        if abs(x1 - x0) > cap:
-            x1 = x0 + cap if x1 > x0 else x0 - cap
+        if x1 > x0 + cap:
+            x1 = x0 + cap
+        elif x1 < x0 - cap:
+            x1 = x0 - cap
         if x1 == x0:
             if self.legs or self._rest != x0:
                 self._set(Fraction(x0), [])
         else:
-            self._set(Fraction(x0), [LinLeg(t0, t1, x0, x1)])
+            # perf: _set(x0, [line]) written out: the rest is x1, an int
+            self._dir = 1 if x1 > x0 else -1
+            self._rest = self._count = x1
+            self._line = line = LinLeg(t0, t1, x0, x1)
+            self.legs = [line]
+            self.version += 1
 
     # ---------------------------------------------------------------- crossings
     def first_reach(self, t_from: int, level: int, direction: int,

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Optional
 
 from .homing import homing_status
 from .homing_plan import HomingPlan, HomingRequest, HomingStep, Watch
+from .store import key
 
 if TYPE_CHECKING:  # pragma: no cover
     from .drive import Drive
@@ -32,12 +33,22 @@ MODE_NAMES = {0: "no mode", 1: "PP", 3: "PV", 6: "HM", 8: "CSP"}
 
 NEW_SETPOINT, CHANGE_IMMEDIATELY, RELATIVE, HALT = 0x10, 0x20, 0x40, 0x100  # HCFA §7.4.1
 B8, B10, B11, B12, B13, B14, B15 = 0x100, 0x400, 0x800, 0x1000, 0x2000, 0x4000, 0x8000
+_K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 
 
 class Mode:
     """Base engine: no motion of its own, the idle statusword."""
 
     number = 0
+    #: Whether the engine acts on written objects (overrides :meth:`parameter`);
+    #: set for each subclass by ``__init_subclass__``.
+    takes_parameters = False
+
+    def __init_subclass__(cls, **kwargs: object) -> None:
+        super().__init_subclass__(**kwargs)
+        # perf: the drive stores a received object without its write hook
+        # when the engine has no parameter() of its own
+        cls.takes_parameters = cls.parameter is not Mode.parameter
 
     def __init__(self, drive: Drive) -> None:
         self.d = drive
@@ -293,11 +304,18 @@ class CyclicPosition(Mode):
 
     def cycle(self, t: int) -> None:
         d = self.d
-        pos = d.axis.position(t)
+        ax = d.axis
+        mech = ax.mechanical(t)
+        pos = mech + ax.shift                      # axis.position(t)
         fe = self.demand - pos
         self.following_error = fe
-        window = d.param(0x6065)
-        if abs(fe) > window:
+        # perf: the integer objects read from the store's values directly
+        # (what d.param does first), d.param for anything else
+        live = d._live
+        window = live.get(_K6065)
+        if window.__class__ is not int:
+            window = d.param(0x6065)
+        if fe > window or -fe > window:
             if self._fe_since is None:
                 self._fe_since = t
             limit_us = d.param(0x6066) * 1000
@@ -310,19 +328,35 @@ class CyclicPosition(Mode):
             self._fe_since = None
         period = t - self._last if self._last is not None else d.bus_period_us()
         self._last = t
-        target = d.param(0x607A)
-        if target != pos and d.limit_toward(t, 1 if target > pos else -1):
-            self.limit_stop = True
-            self.demand = target
-            return
-        if not d.limit_active(t):
+        target = live.get(_K607A)
+        if target.__class__ is not int:
+            target = d.param(0x607A)
+        v_max = live.get(_K6080)
+        if v_max.__class__ is not int:
+            v_max = d.param(0x6080)
+        plant = d.plant
+        if plant.pos_limit is None and plant.neg_limit is None:
+            # perf: no limit switch, so none is active or lies ahead
+            # (d.limit_toward and d.limit_active say so then)
             self.limit_stop = False
-        d.axis.linear(t, t + max(period, 1), target, d.param(0x6080))
+        else:
+            if target != pos and d.limit_toward(t, 1 if target > pos else -1):
+                self.limit_stop = True
+                self.demand = target
+                return
+            if not d.limit_active(t):
+                self.limit_stop = False
+        ax.linear(t, t + (period if period > 1 else 1), target, v_max, mech)
         self.demand = target
 
     def bits(self, t: int) -> int:
-        b = self._limit_bits(t) | B12
-        b |= 0 if self.d.axis.moving(t) else B10
+        d = self.d
+        plant = d.plant
+        if plant.pos_limit is None and plant.neg_limit is None:
+            b = (B8 if self.limit_stop else 0) | B12   # perf: _limit_bits, no switch to ask
+        else:
+            b = self._limit_bits(t) | B12
+        b |= 0 if d.axis.moving(t) else B10
         b |= B13 if self._fe_since is not None else 0
         return b
 

@@ -40,6 +40,9 @@ __all__ = [
 ]
 
 S = State
+# perf: members read on every bus cycle, as module constants (an Enum class
+# attribute goes through EnumType.__getattr__ on Python 3.11)
+_NOT_READY, _QSA, _FRA = S.NOT_READY_TO_SWITCH_ON, S.QUICK_STOP_ACTIVE, S.FAULT_REACTION_ACTIVE
 
 # --------------------------------------------------------------------------- the drive
 
@@ -180,7 +183,7 @@ class Drive402:
     def statusword(self) -> int:
         """6041h: the state's word (HCFA §7.2), the idle mode bits of §7.3 or
         the mode layer's bits, bit 10 at rest in QSA, Kinco's bit 15."""
-        if self.state is S.NOT_READY_TO_SWITCH_ON:
+        if self.state is _NOT_READY:
             return 0
         base = STATUSWORD[self.state]
         if self._mode_bits is not None:
@@ -189,7 +192,7 @@ class Drive402:
             extra = IDLE_STATUSWORD.get((self.mode, self.state), base) & ~base
         else:
             extra = 0
-        if self.state is S.QUICK_STOP_ACTIVE and self.at_rest_in_quick_stop:
+        if self.state is _QSA and self.at_rest_in_quick_stop:
             extra |= 0x0400
         if self.personality.bit15 == "reference-found":
             extra = (extra & ~0x8000) | (0x8000 if self.homed else 0)
@@ -244,6 +247,21 @@ class Drive402:
         cmd = decode_controlword(self.controlword, self.controlword)
         return self._evaluate(cmd, t, f"6040h = 0x{self.controlword:04X} held",
                               log_refusal=False)
+
+    def cycle_acts(self) -> bool:
+        """Whether :meth:`cycle` would change anything now: a transition the
+        held controlword makes, or the end of a fault reaction (14).  A held
+        level that holds its state or is refused changes nothing (a cycle
+        logs no refusal), so a caller may skip that cycle."""
+        # perf: the bus cycle asks this first; :meth:`cycle` builds the
+        # explanation of a refusal and a Result, which nobody reads then
+        state = self.state
+        if state is _FRA:
+            return True
+        cw = self.controlword
+        cmd = decode_controlword(cw, cw)
+        n = TRANSITIONS.get((state, cmd))
+        return n is not None and self._guard(state, cmd, n) is None
 
     def command(self, cmd: Command, t: float, source: str) -> Result:
         """Apply *cmd* on the drive's own account (e.g. the EtherCAT bus

@@ -17,14 +17,25 @@ they produce with :meth:`Store.set`.
 from __future__ import annotations
 
 import copy
+import struct
 import threading
 from dataclasses import dataclass
 from typing import Callable
 
 from ...errors import PlcConfigError
-from .od import ESM_STATES, Entry, ObjectDictionary, SdoAbort, is_assign, is_map, obj
+from .od import DTYPES, ESM_STATES, Entry, ObjectDictionary, SdoAbort, is_assign, is_map, obj
 
 Value = int | str
+
+#: perf: one tuple object per (index, sub), shared by every store and by the
+#: drive's constants: a dict finds a key by identity, without comparing tuples
+_KEYS: dict[tuple[int, int], tuple[int, int]] = {}
+
+
+def key(index: int, sub: int) -> tuple[int, int]:
+    """The shared ``(index, sub)`` tuple the stores' value dicts hold."""
+    k = (index, sub)
+    return _KEYS.setdefault(k, k)
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,6 +62,10 @@ class StoreEvent:
 
 Hook = Callable[[Write], None]
 
+#: struct codes of the CoE integer types (their ranges are the types' ranges)
+_STRUCT_CODES = {"I8": "b", "U8": "B", "I16": "h", "U16": "H", "I32": "i", "U32": "I",
+                 "I64": "q", "U64": "Q"}
+
 
 class Store:
     """Values of one drive, initialised from the defaults of ``od``.
@@ -66,13 +81,28 @@ class Store:
             raise PlcConfigError(f"length_abort = {length_abort!r}; expected 'exact' or 'generic'")
         self.od = od
         self.length_abort = length_abort
-        self._active: dict[tuple[int, int], Value] = {(e.index, e.sub): e.default for e in od}
+        self._active: dict[tuple[int, int], Value] = {key(e.index, e.sub): e.default for e in od}
         self._pending: dict[tuple[int, int], Value] = {}
-        self._check_hooks: list[Hook] = []
-        self._write_hooks: list[Hook] = []
+        # perf: the hooks as tuples, rebuilt when one (un)subscribes: a write
+        # iterates a snapshot without copying a list
+        self._check_hooks: tuple[Hook, ...] = ()
+        self._write_hooks: tuple[Hook, ...] = ()
+        #: The check hooks and the write hooks subscribed now (read only).
+        self.hooked: tuple[tuple[Hook, ...], tuple[Hook, ...]] = ((), ())
         self.events: list[StoreEvent] = []
         self.lock = threading.RLock()
         self._bounds: dict[tuple[int, int], tuple[int, int]] = {}
+        # perf: (entry, low, high) per key, low None for a string, found once
+        self._types: dict[tuple[int, int], tuple[Entry, int | None, int]] = {}
+        # perf: a struct per status group, whose packing checks the ranges
+        self._groups: dict[tuple[tuple[int, int], ...], struct.Struct | bool] = {}
+
+    @property
+    def live(self) -> dict[tuple[int, int], Value]:
+        """The active values by (index, sub), the store's own dict (read it,
+        never write it): the bus cycle reads many objects without the entry
+        check of :meth:`get`."""
+        return self._active
 
     def __deepcopy__(self, memo: dict) -> "Store":
         # a fork of a PLC copies its drives: a lock is not copied, it is made anew
@@ -80,7 +110,12 @@ class Store:
         memo[id(self)] = new
         memo.setdefault(id(self.od), self.od)        # the dictionary itself is read-only data
         for key, value in self.__dict__.items():
-            new.__dict__[key] = threading.RLock() if key == "lock" else copy.deepcopy(value, memo)
+            if key == "lock":
+                new.__dict__[key] = threading.RLock()
+            elif key == "_groups":
+                new.__dict__[key] = {}          # struct codecs: rebuilt on first use
+            else:
+                new.__dict__[key] = copy.deepcopy(value, memo)
         return new
 
     # -- values ------------------------------------------------------------
@@ -109,18 +144,40 @@ class Store:
             SdoAbort: unknown object or subindex.
             PlcConfigError: the value does not fit the entry's type.
         """
-        entry = self.od.entry(index, sub)
-        self._check_type(entry, value)
+        key = (index, sub)
+        known = self._types.get(key)
+        if known is None:
+            entry = self.od.entry(index, sub)
+            lo, hi = (None, 0) if entry.dtype == "STR" else DTYPES[entry.dtype][1:]
+            known = self._types[key] = (entry, lo, hi)
+        entry, lo, hi = known
+        # perf: a plain int in range is the common case; anything else takes
+        # the full check (bool and str values, out-of-range numbers)
+        if lo is None or value.__class__ is not int or not lo <= value <= hi:
+            self._check_type(entry, value)
         with self.lock:
-            write = Write(entry, value, self.stored(index, sub), False, source)
-            if source != "drive":
-                for hook in list(self._check_hooks):
-                    hook(write)
-            self._active[(index, sub)] = value
-            self._pending.pop((index, sub), None)
-            if source != "drive":
-                for hook in list(self._write_hooks):
-                    hook(write)
+            if source == "drive":
+                # perf: no Write is built when no hook will see it
+                self._active[key] = value
+                if self._pending:
+                    self._pending.pop(key, None)
+                return
+            write = Write(entry, value, self._pending.get(key, self._active[key]), False, source)
+            for hook in self._check_hooks:
+                hook(write)
+            self._active[key] = value
+            self._pending.pop(key, None)
+            for hook in self._write_hooks:
+                hook(write)
+
+    def set_known(self, key: tuple[int, int], value: int) -> None:
+        """Set an object's value from the drive side when its type is known
+        to fit (an RxPDO field unpacked at the mapped object's own width and
+        signedness): no checks, no hooks.  The caller holds :attr:`lock`."""
+        # perf: the bus cycle's path for an RxPDO object no hook needs to see
+        self._active[key] = value
+        if self._pending:
+            self._pending.pop(key, None)
 
     def set_status(self, values: dict[tuple[int, int], int]) -> None:
         """Set the drive's own integer status objects (6041h, 6064h, ...)
@@ -129,19 +186,51 @@ class Store:
         Raises:
             PlcConfigError: a value outside its entry's type range.
         """
-        bounds = self._bounds
+        bounds, active, pending = self._bounds, self._active, self._pending
         with self.lock:
             for key, value in values.items():
-                b = bounds.get(key)
-                if b is None:
+                try:
+                    low, high = bounds[key]
+                except KeyError:
                     entry = self.od.entry(*key)
-                    b = bounds[key] = (entry.low, entry.high)
-                if not b[0] <= value <= b[1]:
+                    low, high = bounds[key] = (entry.low, entry.high)
+                if not low <= value <= high:
                     entry = self.od.entry(*key)
                     raise PlcConfigError(f"{entry.label} := {value} does not fit {entry.dtype}")
-                self._active[key] = value
-                if self._pending:
-                    self._pending.pop(key, None)
+                active[key] = value
+                if pending:
+                    pending.pop(key, None)
+
+    def fits_group(self, keys: tuple[tuple[int, int], ...], values: tuple[int, ...]) -> bool:
+        """Whether *values* (in the order of the status objects *keys*, a
+        constant tuple) all lie in their objects' integer ranges; False too
+        when an object is not a plain integer type (then :meth:`set_status`
+        decides)."""
+        packer = self._groups.get(keys)
+        if packer is None:
+            entries = [self.od.entry(*k) for k in keys]
+            # a struct code only for an object whose range is its type's
+            codes = [_STRUCT_CODES.get(e.dtype) if e.dtype in DTYPES
+                     and (e.low, e.high) == DTYPES[e.dtype][1:] else None for e in entries]
+            packer = self._groups[keys] = \
+                struct.Struct("<" + "".join(codes)) if None not in codes else False
+        if packer is False:
+            return False
+        # perf: struct checks every value against its type's range in C
+        try:
+            packer.pack(*values)
+        except struct.error:
+            return False
+        return True
+
+    def set_status_group(self, values: dict[tuple[int, int], int]) -> None:
+        """Set status objects to *values* that :meth:`fits_group` found in
+        range (no further check, no hooks)."""
+        with self.lock:
+            self._active.update(values)
+            if self._pending:
+                for k in values:
+                    self._pending.pop(k, None)
 
     def power_cycle(self) -> list[StoreEvent]:
         """Make the pending power-up parameters active; returns the events.
@@ -186,14 +275,25 @@ class Store:
     def on_check(self, callback: Hook) -> Callable[[], None]:
         """Call ``callback(write)`` before a master's write is stored; it may
         raise :class:`SdoAbort` to refuse it.  Returns an unsubscribe function."""
-        self._check_hooks.append(callback)
-        return lambda: self._check_hooks.remove(callback)
+        with self.lock:
+            self._check_hooks = (*self._check_hooks, callback)
+            self.hooked = (self._check_hooks, self._write_hooks)
+        return lambda: self._unsubscribe("_check_hooks", callback)
 
     def on_write(self, callback: Hook) -> Callable[[], None]:
         """Call ``callback(write)`` after a master's write is stored.
         Returns an unsubscribe function."""
-        self._write_hooks.append(callback)
-        return lambda: self._write_hooks.remove(callback)
+        with self.lock:
+            self._write_hooks = (*self._write_hooks, callback)
+            self.hooked = (self._check_hooks, self._write_hooks)
+        return lambda: self._unsubscribe("_write_hooks", callback)
+
+    def _unsubscribe(self, which: str, callback: Hook) -> None:
+        with self.lock:
+            hooks = list(getattr(self, which))
+            hooks.remove(callback)          # ValueError when not subscribed, as list.remove
+            setattr(self, which, tuple(hooks))
+            self.hooked = (self._check_hooks, self._write_hooks)
 
     # -- SDO ---------------------------------------------------------------
     def sdo_read(self, index: int, sub: int) -> bytes:
@@ -240,7 +340,7 @@ class Store:
             self._check_mapping(entry, value)
             self._check_range(entry, value)
             write = Write(entry, value, self.stored(index, sub), entry.effect == "power-up", "sdo")
-            for hook in list(self._check_hooks):
+            for hook in self._check_hooks:
                 hook(write)
             key = (index, sub)
             if write.pending and value != self._active[key]:
@@ -252,7 +352,7 @@ class Store:
             else:
                 self._pending.pop(key, None)
                 self._active[key] = value
-            for hook in list(self._write_hooks):
+            for hook in self._write_hooks:
                 hook(write)
 
     # -- rules -------------------------------------------------------------
@@ -301,7 +401,6 @@ class Store:
         if entry.dtype == "STR":
             ok = isinstance(value, str)
         else:
-            from .od import DTYPES
             lo, hi = DTYPES[entry.dtype][1:]
             ok = isinstance(value, int) and not isinstance(value, bool) and lo <= value <= hi
         if not ok:

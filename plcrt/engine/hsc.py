@@ -40,7 +40,7 @@ What it is not: no wizard code; a PWM on a wired clock is not counted.
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 __all__ = ["HighSpeedCounter", "Encoder", "SM_HSC", "INPUTS", "MODES", "make_counters"]
 

@@ -170,8 +170,8 @@ class Drive:
         new = object.__new__(type(self))
         memo[id(self)] = new
         memo.setdefault(id(self.od), self.od)
-        for key, value in self.__dict__.items():
-            new.__dict__[key] = _FRESH[key]() if key in _FRESH else copy.deepcopy(value, memo)
+        for name, value in self.__dict__.items():
+            new.__dict__[name] = _FRESH[name]() if name in _FRESH else copy.deepcopy(value, memo)
         return new
 
     # ---------------------------------------------------------------- helpers

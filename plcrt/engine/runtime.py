@@ -129,6 +129,7 @@ class Plc(AddressAccess):
         self.scheduler = Scheduler(self, [self.interrupts, *self.pulse], self._instant)
         self._irq_t = 0            #: the time the running code executes at (µs)
         self._hsc_any = False      #: an HDEF ran (perf: counters cost nothing before)
+        self._sources_on = False   #: a PLS, HDEF or T32/T96 ATCH ran (perf: see _scan_once)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
         self._acc_sm = (self.mem.areas["AC"], self.mem.areas["SM"])
@@ -223,7 +224,7 @@ class Plc(AddressAccess):
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
         irq = self.interrupts
-        if self._hsc_defined:
+        if self._hsc_any:
             for c in self.hsc:
                 if c.scan_start(pi, now):
                     self.scheduler.touch()
@@ -265,10 +266,9 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            # perf: the time line only when a source can have events (a timed
-            # interrupt, a pulse output running, a counter on a pulse source)
-            if irq.timed_next or self._pulse_busy() or len(self.scheduler.sources) > 3 \
-                    or 21 in irq.attached or 22 in irq.attached:
+            # perf: the time line only once a source may have events (a timed
+            # interrupt attached, or ever a PLS, an HDEF or a CT=PT interrupt)
+            if irq.timed_next or self._sources_on:
                 self.scheduler.run(now, now + self.scan_us)
             elif self.devices:
                 t_to = now + self.scan_us
@@ -321,15 +321,6 @@ class Plc(AddressAccess):
             acc[:] = saved_ac
             sm[1] = saved_sm1
 
-    def _pulse_busy(self) -> bool:
-        p0, p1 = self.pulse
-        return bool(p0.trains or p1.trains) or p0.pwm_next is not None \
-            or p1.pwm_next is not None
-
-    @property
-    def _hsc_defined(self) -> bool:
-        return self._hsc_any
-
     def _instant(self, t: int) -> None:
         """After the events of one instant: 1 ms timers and counters current,
         then the routines."""
@@ -341,7 +332,7 @@ class Plc(AddressAccess):
         self.interrupts.run_at(t)
 
     def _hdef(self, number: int, mode: int) -> None:
-        self._hsc_any = True
+        self._hsc_any = self._sources_on = True
         counter = self.hsc[number]
         counter.hdef(mode, self._irq_t)
         self.scheduler.touch()
@@ -358,6 +349,7 @@ class Plc(AddressAccess):
 
     def _pls(self, number: int) -> None:
         self.pulse[number].pls(self._irq_t)
+        self._sources_on = True
         self.scheduler.touch()
 
     def _irq_time(self, t: int) -> None:
@@ -368,6 +360,8 @@ class Plc(AddressAccess):
 
     def _irq_attach(self, number: int, event: int) -> None:
         self.interrupts.attach(number, event, self._irq_t)
+        if event in (21, 22):
+            self._sources_on = True
         self.scheduler.touch()
 
     def _irq_detach(self, event: int) -> None:
@@ -600,7 +594,7 @@ class Plc(AddressAccess):
         dst.scheduler.sources[:] = [dst.interrupts, *dst.pulse,
                                     *(c for c in dst.hsc if c.pulse is not None)]
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
-                     "_irq_t", "_pi0", "_hsc_any"):
+                     "_irq_t", "_pi0", "_hsc_any", "_sources_on"):
             setattr(dst, name, getattr(self, name))
         dst._warned = set(self._warned)
         dst.diagnostics = list(self.diagnostics)

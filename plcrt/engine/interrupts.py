@@ -108,6 +108,7 @@ class Interrupts:
         self.enabled = False                         #: ENI / DISI
         self.queues: tuple[deque[tuple[int, int]], ...] = (deque(), deque(), deque())
         self.running = False                         #: a routine is executing
+        self.queued = False                          #: an occurrence waits (perf: one test)
         self.timed_next: dict[int, int] = {}         #: timed event -> next time (µs)
         self.timed_period: dict[int, int] = {}       #: timed event -> interval (µs)
         self.timed_fired: set[int] = set()           #: timed events that fired since ATCH
@@ -153,6 +154,7 @@ class Interrupts:
             kept = [x for x in q if x[1] != event]
             q.clear()
             q.extend(kept)
+        self.queued = any(self.queues)
 
     def enable(self, t: int) -> None:
         """ENI: interrupts are processed; what is queued runs now."""
@@ -179,6 +181,7 @@ class Interrupts:
                       f"(SM4.{bit.bit_length() - 1} set)", f"irq-overflow-{event}")
             return
         q.append((t, event))
+        self.queued = True
 
     def dispatch(self, t: int) -> None:
         """Run the queued routines, highest priority first, if enabled."""
@@ -198,7 +201,8 @@ class Interrupts:
                 run(number)
         finally:
             self.running = False
-        if not (q0 or q1 or q2):
+        self.queued = bool(q0 or q1 or q2)
+        if not self.queued:
             # System Manual: the overflow bits are reset when the queues are
             # empty and control returns to the main program
             self.sm[4] &= ~0x07 & 0xFF

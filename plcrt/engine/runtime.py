@@ -229,7 +229,7 @@ class Plc(AddressAccess):
                 if c.scan_start(pi, now):
                     self.scheduler.touch()
         pi0 = pi[0] & 0x0F
-        if pi0 != self._pi0 or irq.queues[0] or irq.queues[1] or irq.queues[2]:
+        if pi0 != self._pi0 or irq.queued:
             # input edges from the outside world: their routines run at the
             # scan's start, before the image is read (System Manual: the
             # routine runs when the edge occurs; the image changes next scan)

@@ -65,10 +65,16 @@ class Train:
     delta: int = 0          #: change of the cycle per pulse, µs
     segment: int = 0        #: multi-segment: its number (0 for single)
 
-    @property
-    def end(self) -> int:
+    end: int = 0            #: µs after the last pulse (set from the others)
+
+    def __post_init__(self) -> None:
+        self.shift(0)
+
+    def shift(self, dt: int) -> None:
+        """Move the train by *dt* µs (perf: its end is kept, not recomputed)."""
+        self.start += dt
         n = self.count
-        return self.start + n * self.c0 + self.delta * n * (n - 1) // 2
+        self.end = self.start + n * self.c0 + self.delta * n * (n - 1) // 2
 
     def pulses_started(self, t: int) -> int:
         """Rising edges in [start, t] (closed form; never pulse by pulse)."""
@@ -202,7 +208,7 @@ class PulseOutput:
     def _start(self, trains: list[Train], t: int) -> None:
         shift = t - trains[0].start
         for tr in trains:
-            tr.start += shift
+            tr.shift(shift)
         self.trains = trains
         self.sm[self.status] &= ~(IDLE | USER_ABORT | OVERFLOW | DELTA_ERROR) & 0xFF
         self.sm[self.segment_byte] = trains[0].segment

@@ -326,9 +326,8 @@ class Plc(AddressAccess):
         then the routines."""
         self.timers.refresh_1ms(t)
         if self._hsc_any:
-            for c in self.hsc:
-                if c.pulse is not None:
-                    c.sync(t)
+            for c in self.scheduler.sources[3:]:     # the counters on a pulse source
+                c.sync(t)
         self.interrupts.run_at(t)
 
     def _hdef(self, number: int, mode: int) -> None:

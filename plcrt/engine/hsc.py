@@ -105,6 +105,16 @@ class Encoder:
     def live(self) -> bool:
         return True
 
+    def level(self, t: int, bit: int) -> int:
+        """The level of input *bit* (A, or B a quarter period behind A, ahead
+        when the direction is down) at *t*: A is high in the first half of
+        each period from start."""
+        if t < self.start or (self.stop is not None and t >= self.stop):
+            return 0
+        phase = 0 if bit == self.a else (1 if self.direction > 0 else 3)
+        q = (t - self.start) * 4 * self.hz // 1_000_000
+        return 1 if (q - phase) % 4 in (0, 1) and q >= phase else 0
+
     @property
     def trains(self) -> list:        # the interface of a pulse output the counter reads
         return [self]

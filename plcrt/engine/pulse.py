@@ -294,6 +294,32 @@ class PulseOutput:
         """Rising edges in (t0, t1] (a counter wired to the output)."""
         return self.pulses_until(t1) - self.pulses_until(t0)
 
+    def edge_after(self, after: int, rising: bool) -> Optional[int]:
+        """The terminal's first rising (or falling) edge after *after*, while
+        a PTO runs (a pulse is high for the first half of its cycle)."""
+        k = self.pulses_until(after)              # pulses risen by *after*
+        for j in ((k + 1,) if rising else (k, k + 1)):
+            at = self._pulse(j)
+            if at is None:
+                continue
+            rise, cycle = at
+            te = rise if rising else rise + cycle // 2
+            if te > after:
+                return te
+        return None
+
+    def _pulse(self, k: int) -> Optional[tuple[int, int]]:
+        """(rise, cycle) of the *k*-th pulse since power-up in a running train."""
+        k -= self.sent
+        for tr in self.trains:
+            if k <= 0:
+                return None
+            if k <= tr.count:
+                j = k - 1
+                return tr.start + j * tr.c0 + tr.delta * j * (j - 1) // 2, tr.c0 + j * tr.delta
+            k -= tr.count
+        return None
+
     def time_of_pulse(self, k: int) -> Optional[int]:
         """The time of the *k*-th rising edge since power-up, if a running
         train makes it (closed form)."""

@@ -37,6 +37,7 @@ from .timers import TimerBank
 from .access import AddressAccess
 from .events import Scheduler
 from .interrupts import Interrupts
+from .edges import SignalEdges
 from .hsc import make_counters
 from .pulse import make_outputs
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
@@ -126,7 +127,16 @@ class Plc(AddressAccess):
         self.hsc = make_counters(self)
         #: one time line for the scan interval: event sources in priority order
         #: (a counter joins when HDEF gives it a pulse output to count)
-        self.scheduler = Scheduler(self, [self.interrupts, *self.pulse], self._instant)
+        self.edges = SignalEdges(self)
+        self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse],
+                                   self._instant)
+        #: I0.0–I0.3 whose edges come from a signal at exact times, not from
+        #: the scan start (a pulse output or an encoder drives them)
+        driven = {b for b, out in self.wiring.items() if out in (0, 1)} | set(self.encoders)
+        for enc in self.encoders.values():
+            if enc.b is not None:
+                driven.add(enc.b)
+        self._edge_mask = 0x0F & ~sum(1 << b for b in driven if b < 4)
         self._irq_t = 0            #: the time the running code executes at (µs)
         self._hsc_any = False      #: an HDEF ran (perf: counters cost nothing before)
         self._sources_on = False   #: a PLS, HDEF or T32/T96 ATCH ran (perf: see _scan_once)
@@ -228,7 +238,7 @@ class Plc(AddressAccess):
             for c in self.hsc:
                 if c.scan_start(pi, now):
                     self.scheduler.touch()
-        pi0 = pi[0] & 0x0F
+        pi0 = pi[0] & self._edge_mask
         if pi0 != self._pi0 or irq.queued:
             # input edges from the outside world: their routines run at the
             # scan's start, before the image is read (System Manual: the
@@ -291,6 +301,14 @@ class Plc(AddressAccess):
                     pq[0] = pq[0] | bit if po.level(t_end) else pq[0] & ~bit & 0xFF
                     po.update_segment(t_end)
 
+        if self.encoders:
+            t_end = now + self.scan_us
+            for enc in self.encoders.values():        # the plant's encoders: their levels
+                for inp in (enc.a, enc.b):
+                    if inp is not None:
+                        bit = 1 << (inp % 8)
+                        pi[inp // 8] = pi[inp // 8] | bit if enc.level(t_end, inp) \
+                            else pi[inp // 8] & ~bit & 0xFF
         if self.wiring:
             for inp, out in self.wiring.items():      # the plant's wires: output -> input
                 bit, level = 1 << (inp % 8), pq[out // 8] >> (out % 8) & 1
@@ -326,7 +344,7 @@ class Plc(AddressAccess):
         then the routines."""
         self.timers.refresh_1ms(t)
         if self._hsc_any:
-            for c in self.scheduler.sources[3:]:     # the counters on a pulse source
+            for c in self.scheduler.sources[4:]:     # the counters on a pulse source
                 c.sync(t)
         self.interrupts.run_at(t)
 
@@ -359,7 +377,7 @@ class Plc(AddressAccess):
 
     def _irq_attach(self, number: int, event: int) -> None:
         self.interrupts.attach(number, event, self._irq_t)
-        if event in (21, 22):
+        if event in (21, 22) or (event < 8 and (self.wiring or self.encoders)):
             self._sources_on = True
         self.scheduler.touch()
 
@@ -560,6 +578,7 @@ class Plc(AddressAccess):
                                         (self.counters, dst.counters),
                                         (self.interrupts, dst.interrupts),
                                         *zip(self.pulse, dst.pulse),
+                                        (self.edges, dst.edges),
                                         *zip(self.hsc, dst.hsc)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
@@ -590,7 +609,7 @@ class Plc(AddressAccess):
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
         dst.scheduler._rows = []
-        dst.scheduler.sources[:] = [dst.interrupts, *dst.pulse,
+        dst.scheduler.sources[:] = [dst.interrupts, dst.edges, *dst.pulse,
                                     *(c for c in dst.hsc if c.pulse is not None)]
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_hsc_any", "_sources_on"):

@@ -267,3 +267,36 @@ def test_a_trace_records_what_the_routines_did_in_each_scan():
     tr = Trace(plc, ["VW0"])
     plc.run("50ms")
     assert list(tr["VW0"]) == [10, 20, 30, 40, 50]
+
+
+def test_a_pto_wired_to_i0_0_interrupts_at_every_exact_edge():
+    """Q0.0 wired to I0.0, events 0 and 1: 200 pulses of 1 ms from t = 0
+    rise at k ms and fall at k ms + 0.5 ms; the routines stamp T32-free
+    times by counting, and the last rising edge's routine runs at 199 ms."""
+    ob1 = ("LD SM0.1\nATCH INT_0, 0\nATCH INT_1, 1\nENI\n"
+           "MOVB 16#85, SMB67\nMOVW +1000, SMW68\nMOVD +200, SMD72\nPLS 0")
+    plc = plcrt.load(program(ob1, COUNT, STAMP), plant='[cpu]\nwire = { "I0.0" = "Q0.0" }\n')
+    times: list[int] = []
+    plc._int_fns[0] = (lambda fn: lambda l: (times.append(plc._irq_t), fn(l)))(plc._int_fns[0])
+    plc.run("0.3s")
+    assert (plc["VW0"], plc["VW2"]) == (200, 200)
+    assert times[:3] == [0, 1000, 2000] and times[-1] == 199_000
+
+
+def test_an_encoder_on_i0_0_interrupts_at_its_edges_and_sets_the_input():
+    """1000 Hz on I0.0 from 0.1 s to 0.5 s: 401 rising edges (the first at
+    0.1 s), 400 falling ones; I0.0 reads the signal's level at scan starts."""
+    enc = '[[cpu.encoder]]\ninputs = ["I0.0"]\nhz = 1000\nstart = 0.1\nstop = 0.5\n'
+    plc = plcrt.load(program("LD SM0.1\nATCH INT_0, 0\nATCH INT_1, 1\nENI", COUNT, STAMP),
+                     plant=enc, scan_ms=1.25)
+    plc.run("1s")
+    assert (plc["VW0"], plc["VW2"]) == (401, 400)
+    plc2 = plcrt.load(program("LD SM0.0\n= M0.0"), plant=enc, scan_ms=0.25)
+    seen = []
+    plc2.observers.append(lambda p: seen.append(p["I0.0"]))
+    plc2.run("0.11s")
+    # scan k starts at k x 250 µs and reads the level then: high in the
+    # first half of each ms from 0.1 s (scan 0 reads the power-up 0)
+    expected = [0] + [1 if 100_000 <= t < 500_000 and (t - 100_000) % 1000 < 500 else 0
+                      for t in range(250, 110_001, 250)]
+    assert seen == expected[:len(seen)] and len(seen) == 440

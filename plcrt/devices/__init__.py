@@ -12,11 +12,42 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
+
+
+class _StateMapping(Mapping[str, Any]):
+    """A frozen dataclass of a device's state read as a mapping of its
+    fields (``KEYS``, set after the class): equal to any mapping with the
+    same keys and values, a plain dict for JSON with :meth:`to_dict`."""
+
+    KEYS: ClassVar[tuple[str, ...]] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """A plain dict of the fields, for JSON."""
+        return asdict(self)  # type: ignore[call-overload]
+
+    def __getitem__(self, key: str) -> Any:
+        if key not in self.KEYS:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.KEYS)
+
+    def __len__(self) -> int:
+        return len(self.KEYS)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Mapping):
+            return dict(self) == dict(other)
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash(tuple(self.values()))
 
 
 @dataclass(frozen=True, eq=False)
-class AxisState(Mapping[str, Any]):
+class AxisState(_StateMapping):
     """One axis of a positioning module at a moment of simulated time.
 
     What :meth:`plcrt.Plc.axis` and the test harness's ``axis()`` return:
@@ -39,35 +70,12 @@ class AxisState(Mapping[str, Any]):
         """Whether the axis is moving (``status == "moving"``)."""
         return self.status == "moving"
 
-    def to_dict(self) -> dict[str, Any]:
-        """A plain dict of the fields, for JSON."""
-        return asdict(self)
 
-    def __getitem__(self, key: str) -> Any:
-        if key not in _AXIS_KEYS:
-            raise KeyError(key)
-        return getattr(self, key)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(_AXIS_KEYS)
-
-    def __len__(self) -> int:
-        return len(_AXIS_KEYS)
-
-    def __eq__(self, other: object) -> bool:
-        if isinstance(other, Mapping):
-            return dict(self) == dict(other)
-        return NotImplemented
-
-    def __hash__(self) -> int:
-        return hash(tuple(self.values()))
-
-
-_AXIS_KEYS = tuple(f.name for f in fields(AxisState))
+AxisState.KEYS = tuple(f.name for f in fields(AxisState))
 
 
 @dataclass(frozen=True, eq=False)
-class DriveState(Mapping[str, Any]):
+class DriveState(_StateMapping):
     """One CiA 402 drive on a fieldbus module at a moment of simulated time.
 
     What :meth:`plcrt.Plc.drive` and the test harness's ``drive()`` return,
@@ -110,31 +118,8 @@ class DriveState(Mapping[str, Any]):
         """6061h as its short name: PP, PV, HM, CSP (or the number)."""
         return _MODE_NAMES.get(self.mode, str(self.mode))
 
-    def to_dict(self) -> dict[str, Any]:
-        """A plain dict of the fields, for JSON."""
-        return asdict(self)
 
-    def __getitem__(self, key: str) -> Any:
-        if key not in _DRIVE_KEYS:
-            raise KeyError(key)
-        return getattr(self, key)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(_DRIVE_KEYS)
-
-    def __len__(self) -> int:
-        return len(_DRIVE_KEYS)
-
-    def __eq__(self, other: object) -> bool:
-        if isinstance(other, Mapping):
-            return dict(self) == dict(other)
-        return NotImplemented
-
-    def __hash__(self) -> int:
-        return hash(tuple(self.values()))
-
-
-_DRIVE_KEYS = tuple(f.name for f in fields(DriveState))
+DriveState.KEYS = tuple(f.name for f in fields(DriveState))
 _MODE_NAMES = {0: "none", 1: "PP", 3: "PV", 6: "HM", 8: "CSP"}
 
 

@@ -73,8 +73,16 @@ class Train:
     def shift(self, dt: int) -> None:
         """Move the train by *dt* µs (perf: its end is kept, not recomputed)."""
         self.start += dt
-        n = self.count
-        self.end = self.start + n * self.c0 + self.delta * n * (n - 1) // 2
+        self.end = self.rise(self.count)
+
+    def rise(self, j: int) -> int:
+        """The rising edge of pulse *j* (0 = the first): start + j·c0 + Δ·j(j−1)/2;
+        ``rise(count)`` is the train's end."""
+        return self.start + j * self.c0 + self.delta * j * (j - 1) // 2
+
+    def cycle(self, j: int) -> int:
+        """The cycle of pulse *j*, µs."""
+        return self.c0 + j * self.delta
 
     def pulses_started(self, t: int) -> int:
         """Rising edges in [start, t] (closed form; never pulse by pulse)."""
@@ -82,14 +90,13 @@ class Train:
             return 0
         if t >= self.end:
             return self.count
-        dt = t - self.start
         if self.delta == 0:
-            return min(self.count, dt // self.c0 + 1)
-        # largest k with start_of(k) = k*c0 + delta*k(k-1)/2 <= dt
+            return min(self.count, (t - self.start) // self.c0 + 1)
+        # the largest k with rise(k) <= t
         lo, hi = 0, self.count - 1
         while lo < hi:
             mid = (lo + hi + 1) // 2
-            if mid * self.c0 + self.delta * mid * (mid - 1) // 2 <= dt:
+            if self.rise(mid) <= t:
                 lo = mid
             else:
                 hi = mid - 1
@@ -100,9 +107,7 @@ class Train:
         if not self.start <= t < self.end:
             return 0
         k = self.pulses_started(t) - 1
-        begin = self.start + k * self.c0 + self.delta * k * (k - 1) // 2
-        cycle = self.c0 + k * self.delta
-        return 1 if t - begin < cycle // 2 else 0
+        return 1 if t - self.rise(k) < self.cycle(k) // 2 else 0
 
 
 class PulseOutput:
@@ -315,23 +320,15 @@ class PulseOutput:
             if k <= 0:
                 return None
             if k <= tr.count:
-                j = k - 1
-                return tr.start + j * tr.c0 + tr.delta * j * (j - 1) // 2, tr.c0 + j * tr.delta
+                return tr.rise(k - 1), tr.cycle(k - 1)
             k -= tr.count
         return None
 
     def time_of_pulse(self, k: int) -> Optional[int]:
         """The time of the *k*-th rising edge since power-up, if a running
         train makes it (closed form)."""
-        k -= self.sent
-        for tr in self.trains:
-            if k <= 0:
-                return None
-            if k <= tr.count:
-                j = k - 1
-                return tr.start + j * tr.c0 + tr.delta * j * (j - 1) // 2
-            k -= tr.count
-        return None
+        at = self._pulse(k)
+        return None if at is None else at[0]
 
     def pulses_until(self, t: int) -> int:
         n = self.sent

@@ -11,11 +11,10 @@ counter has are checked when the program is loaded.
 from __future__ import annotations
 
 from ..compiler.emit import Gen
-from ..compiler.operands import Const
-from ..compiler.resolve import ResolveError
 from ..isa.registry import insn
 from ..engine.hsc import MODES
 from ..safetext import excerpt
+from .args import int_constant, operand_texts
 
 F = "high-speed"
 
@@ -23,42 +22,30 @@ F = "high-speed"
 @insn("PLS", family=F, summary="start, update or stop the PTO/PWM of Q0.0 or Q0.1",
       variadic=True)
 def _pls(g: Gen, insn_ir, resolver, *_ops) -> None:
-    ops = [o.text for o in insn_ir.operands]
-    if len(ops) != 1:
-        g.fail(f"PLS takes the pulse output (0 for Q0.0, 1 for Q0.1), got {len(ops)} operand(s)")
-    text = ops[0].strip()
+    text = operand_texts(g, insn_ir, 1, "the pulse output (0 for Q0.0, 1 for Q0.1)")[0].strip()
     if text.upper() in ("Q0.0", "Q0.1"):
         number = int(text[-1])
     else:
-        try:
-            op = resolver.parse(text)
-        except ResolveError as e:
-            g.fail(f"PLS: {e}")
-        if not isinstance(op, Const) or op.is_real or op.value not in (0, 1):
-            g.fail(f"PLS takes the constant 0 (Q0.0) or 1 (Q0.1), got '{excerpt(text)}'")
-        number = int(op.value)
+        wrong = f"PLS takes the constant 0 (Q0.0) or 1 (Q0.1), got '{excerpt(text)}'"
+        number = int_constant(g, resolver, text, "PLS", wrong)
+        if number not in (0, 1):
+            g.fail(wrong)
     pls = g.bind(g.unit.hooks["plc"]._pls, "pls")
     with g.box():
         g.line(f"{pls}({number})")
 
 
 def _const(g: Gen, resolver, text: str, what: str, allowed) -> int:
-    try:
-        op = resolver.parse(text)
-    except ResolveError as e:
-        g.fail(f"{what}: {e}")
-    if not isinstance(op, Const) or op.is_real or not isinstance(op.value, int):
-        g.fail(f"{what} must be a constant, got '{excerpt(text)}'")
-    if op.value not in allowed:
-        g.fail(f"{what} {op.value} is not one of {', '.join(map(str, allowed))}")
-    return int(op.value)
+    value = int_constant(g, resolver, text, what, f"{what} must be a constant, got "
+                         f"'{excerpt(text)}'")
+    if value not in allowed:
+        g.fail(f"{what} {value} is not one of {', '.join(map(str, allowed))}")
+    return value
 
 
 @insn("HDEF", family=F, summary="define the mode of a high-speed counter", variadic=True)
 def _hdef(g: Gen, insn_ir, resolver, *_ops) -> None:
-    ops = [o.text for o in insn_ir.operands]
-    if len(ops) != 2:
-        g.fail(f"HDEF takes a counter and a mode (HDEF HSC, MODE), got {len(ops)} operand(s)")
+    ops = operand_texts(g, insn_ir, 2, "a counter and a mode (HDEF HSC, MODE)")
     if g.unit.current.pou.kind == "INT":
         g.fail("HDEF is not allowed in an interrupt routine")
     n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
@@ -71,9 +58,7 @@ def _hdef(g: Gen, insn_ir, resolver, *_ops) -> None:
 @insn("HSC", family=F, summary="apply the control byte of a high-speed counter",
       variadic=True)
 def _hsc(g: Gen, insn_ir, resolver, *_ops) -> None:
-    ops = [o.text for o in insn_ir.operands]
-    if len(ops) != 1:
-        g.fail(f"HSC takes the counter number, got {len(ops)} operand(s)")
+    ops = operand_texts(g, insn_ir, 1, "the counter number")
     n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
     hsc = g.bind(g.unit.hooks["plc"]._hsc, "hsc")
     with g.box():

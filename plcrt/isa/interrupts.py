@@ -11,9 +11,8 @@ through the engine.
 from __future__ import annotations
 
 from ..compiler.emit import Gen
-from ..compiler.operands import Const
-from ..compiler.resolve import ResolveError
 from ..isa.registry import insn
+from .args import int_constant, operand_texts
 from ..safetext import excerpt
 
 F = "interrupt"
@@ -28,22 +27,11 @@ def _kind(g: Gen) -> str:
 
 
 def _event(g: Gen, resolver, text: str) -> int:
-    try:
-        op = resolver.parse(text)
-    except ResolveError as e:
-        g.fail(f"EVNT: {e}")
-    if not isinstance(op, Const) or not isinstance(op.value, int) or op.is_real:
-        g.fail(f"EVNT must be a constant event number, got '{excerpt(text)}'")
-    if op.value not in EVENT_NUMBERS:
-        g.fail(f"event {op.value} is not in the S7-200's event table (0..33)")
-    return int(op.value)
-
-
-def _operands(g: Gen, insn_ir, n: int, what: str) -> list[str]:
-    ops = [o.text for o in insn_ir.operands]
-    if len(ops) != n:
-        g.fail(f"{insn_ir.mnemonic} takes {what}, got {len(ops)} operand(s)")
-    return ops
+    event = int_constant(g, resolver, text, "EVNT",
+                         f"EVNT must be a constant event number, got '{excerpt(text)}'")
+    if event not in EVENT_NUMBERS:
+        g.fail(f"event {event} is not in the S7-200's event table (0..33)")
+    return event
 
 
 def _guarded(g: Gen):
@@ -58,7 +46,7 @@ def _guarded(g: Gen):
 @insn("ATCH", family=F, summary="attach an interrupt routine to an event and enable it",
       variadic=True)
 def _atch(g: Gen, insn_ir, resolver, *_ops) -> None:
-    name, evnt = _operands(g, insn_ir, 2, "an interrupt routine and an event (ATCH INT, EVNT)")
+    name, evnt = operand_texts(g, insn_ir, 2, "an interrupt routine and an event (ATCH INT, EVNT)")
     callee = g.unit.callee(name.split(":")[0])
     if callee is None:
         g.fail(f"no interrupt routine named '{excerpt(name)}' in the program")
@@ -72,7 +60,7 @@ def _atch(g: Gen, insn_ir, resolver, *_ops) -> None:
 
 @insn("DTCH", family=F, summary="detach (disable) an interrupt event", variadic=True)
 def _dtch(g: Gen, insn_ir, resolver, *_ops) -> None:
-    evnt, = _operands(g, insn_ir, 1, "an event (DTCH EVNT)")
+    evnt, = operand_texts(g, insn_ir, 1, "an event (DTCH EVNT)")
     event = _event(g, resolver, evnt)
     detach = g.bind(g.unit.hooks["plc"]._irq_detach, "dtch")
     with _guarded(g):
@@ -82,7 +70,7 @@ def _dtch(g: Gen, insn_ir, resolver, *_ops) -> None:
 @insn("CEVNT", family=F, summary="clear the queued occurrences of an event (SMART)",
       variadic=True)
 def _cevnt(g: Gen, insn_ir, resolver, *_ops) -> None:
-    evnt, = _operands(g, insn_ir, 1, "an event (CEVNT EVNT)")
+    evnt, = operand_texts(g, insn_ir, 1, "an event (CEVNT EVNT)")
     event = _event(g, resolver, evnt)
     clear = g.bind(g.unit.hooks["plc"].interrupts.clear, "cevnt")
     with _guarded(g):

@@ -535,11 +535,11 @@ def axis_rows(axes: Sequence[Mapping[str, Any]]) -> list[list[str]]:
 
 
 #: columns of the drives table (:meth:`plcrt.Plc.drives`)
-_DRIVE_COLUMNS = ("slot", "node", "model", "mode", "position", "velocity", "statusword", "state")
+DRIVE_COLUMNS = ("slot", "node", "model", "mode", "position", "velocity", "statusword", "state")
 
 
 def drive_rows(drives: Sequence[Any]) -> list[list[str]]:
-    """Table cells of :meth:`plcrt.Plc.drives` entries (columns ``_DRIVE_COLUMNS``):
+    """Table cells of :meth:`plcrt.Plc.drives` entries (columns ``DRIVE_COLUMNS``):
     the statusword in hex and decoded (power state, the mode's bits, 603Fh)."""
     rows = []
     for d in drives:
@@ -560,7 +560,7 @@ def _print_devices(plc: Any) -> None:
     if axes:
         _print_table(_AXIS_COLUMNS, axis_rows(axes))
     if drives:
-        _print_table(_DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
+        _print_table(DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
     # a plant that only wires the CPU's own inputs has no axes to speak of
     if not axes and not drives and (plc.modules or not (plc.wiring or plc.encoders)):
         print("axes: none configured in the plant")
@@ -573,15 +573,21 @@ def _print_table(columns: Sequence[str], rows: list[list[str]],
     lefts = {len(columns) - 1, *left}
     if sys.stdout.isatty() and _print_rich_grid(columns, rows, lefts):
         return
+    for line in table_lines(columns, rows, lefts):
+        print(line)
+
+
+def table_lines(columns: Sequence[str], rows: Sequence[Sequence[str]],
+                lefts: set[int]) -> list[str]:
+    """Plain text table lines, the header first: columns two spaces apart,
+    those in *lefts* left-aligned, the others (numbers) right-aligned."""
     widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(columns)]
 
     def line(cells: Sequence[str]) -> str:
         return "  ".join(c.ljust(w) if i in lefts else c.rjust(w)
                          for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
 
-    print(line(columns))
-    for row in rows:
-        print(line(row))
+    return [line(columns)] + [line(r) for r in rows]
 
 
 def _print_rich_grid(columns: Sequence[str], rows: list[list[str]], lefts: set[int]) -> bool:

@@ -75,33 +75,17 @@ def key_values(rows: Sequence[tuple[str, str]]) -> list[str]:
 def axes_table(axes: Sequence[dict[str, Any]]) -> list[str]:
     """The EM253 axes (entries of :meth:`plcrt.Plc.axes`, at least one):
     numbers right-aligned, the status left-aligned with its notes."""
-    from ..cli import axis_rows
+    from ..cli import axis_rows, table_lines
     head = ("slot", "axis", "position", "mechanical", "speed Hz", "status")
-    rows = [tuple(r) for r in axis_rows(axes)]
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-
-    def line(cells: tuple[str, ...]) -> str:
-        return "  ".join(c.ljust(w) if i == len(head) - 1 else c.rjust(w)
-                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
-
-    return [line(head)] + [line(r) for r in rows]
+    return table_lines(head, axis_rows(axes), {len(head) - 1})
 
 
 def drives_table(drives: Sequence[Any]) -> list[str]:
     """The bus drives (entries of :meth:`plcrt.Plc.drives`, at least one):
     numbers right-aligned, model and state left-aligned, the statusword in
     hex and decoded."""
-    from ..cli import drive_rows
-    head = ("slot", "node", "model", "mode", "position", "velocity", "statusword", "state")
-    rows = [tuple(r) for r in drive_rows(drives)]
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-    lefts = {2, 3, len(head) - 1}
-
-    def line(cells: tuple[str, ...]) -> str:
-        return "  ".join(c.ljust(w) if i in lefts else c.rjust(w)
-                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
-
-    return [line(head)] + [line(r) for r in rows]
+    from ..cli import DRIVE_COLUMNS, drive_rows, table_lines
+    return table_lines(DRIVE_COLUMNS, drive_rows(drives), {2, 3, len(DRIVE_COLUMNS) - 1})
 
 
 def block_heading(pou: ir.Pou) -> str:

@@ -192,15 +192,12 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
     out: dict[int, int] = {}
     for dst, src in wire.items():
-        m_in, m_out = _BIT_RE.fullmatch(str(dst)), _BIT_RE.fullmatch(str(src))
-        if m_in is None or m_in.group(1).upper() != "I" or int(m_in.group(2)) > 1:
-            raise PlcConfigError(f"{where}.wire: {str(dst)[:20]!r} is not one of the CPU's "
-                                 f"inputs I0.0..I1.7")
+        inp = _input(dst, f"{where}.wire")
+        m_out = _BIT_RE.fullmatch(str(src))
         if m_out is None or m_out.group(1).upper() != "Q" or int(m_out.group(2)) > 1:
             raise PlcConfigError(f"{where}.wire: {str(dst)} takes one of the CPU's outputs "
                                  f"Q0.0..Q1.7, got {str(src)[:20]!r}")
-        out[int(m_in.group(2)) * 8 + int(m_in.group(3))] = \
-            int(m_out.group(2)) * 8 + int(m_out.group(3))
+        out[inp] = int(m_out.group(2)) * 8 + int(m_out.group(3))
     return out, _encoders(cpu.get("encoder", []), where, out)
 
 

@@ -38,7 +38,7 @@ from .access import AddressAccess
 from .events import Scheduler
 from .interrupts import Interrupts
 from .edges import SignalEdges
-from .hsc import make_counters
+from .hsc import Encoder, make_counters
 from .pulse import make_outputs
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
@@ -120,11 +120,13 @@ class Plc(AddressAccess):
         #: input bit number -> the plant's encoder signal on it
         self.encoders: dict[int, Any] = {}
         for spec in getattr(plant, "encoders", None) or ():
-            from .hsc import Encoder
             enc = Encoder(**spec)
             self.encoders[enc.a] = enc
         #: the high-speed counters HSC0..HSC5 (HDEF, HSC)
         self.hsc = make_counters(self)
+        #: the counters that count a pulse output or an encoder (HDEF adds them):
+        #: event sources of the time line, made current at every instant
+        self._counted: list[Any] = []
         #: one time line for the scan interval: event sources in priority order
         #: (a counter joins when HDEF gives it a pulse output to count)
         self.edges = SignalEdges(self)
@@ -344,7 +346,7 @@ class Plc(AddressAccess):
         then the routines."""
         self.timers.refresh_1ms(t)
         if self._hsc_any:
-            for c in self.scheduler.sources[4:]:     # the counters on a pulse source
+            for c in self._counted:
                 c.sync(t)
         self.interrupts.run_at(t)
 
@@ -353,7 +355,8 @@ class Plc(AddressAccess):
         counter = self.hsc[number]
         counter.hdef(mode, self._irq_t)
         self.scheduler.touch()
-        if counter.pulse is not None and counter not in self.scheduler.sources:
+        if counter.pulse is not None and counter not in self._counted:
+            self._counted.append(counter)
             self.scheduler.sources.append(counter)
 
     def _hsc(self, number: int) -> None:
@@ -609,8 +612,8 @@ class Plc(AddressAccess):
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
         dst.scheduler._rows = []
-        dst.scheduler.sources[:] = [dst.interrupts, dst.edges, *dst.pulse,
-                                    *(c for c in dst.hsc if c.pulse is not None)]
+        dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
+        dst.scheduler.sources[:] = [dst.interrupts, dst.edges, *dst.pulse, *dst._counted]
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_hsc_any", "_sources_on"):
             setattr(dst, name, getattr(self, name))

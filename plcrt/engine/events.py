@@ -66,10 +66,6 @@ class Scheduler:
         """A source's next event may have moved: ask them all again."""
         self.gen += 1
 
-    def busy(self, t_from: int, t_to: int) -> bool:
-        """Whether a source has an event in (t_from, t_to]."""
-        return any(src.next_time(t_from, t_to) is not None for src in self.sources)
-
     def run(self, t_from: int, t_to: int) -> None:
         """Run (t_from, t_to]: events in time order, devices advanced to each."""
         plc, devices, on_instant = self.plc, self.plc.devices, self.after

@@ -112,14 +112,7 @@ class Interrupts:
         self.timed_next: dict[int, int] = {}         #: timed event -> next time (µs)
         self.timed_period: dict[int, int] = {}       #: timed event -> interval (µs)
         self.timed_fired: set[int] = set()           #: timed events that fired since ATCH
-        self.counts: dict[int, int] = {}             #: event -> routines run (for tools)
-        self.lost: dict[int, int] = {}               #: event -> occurrences lost
         self.timers: Any = None                      #: the timer bank (events 21, 22)
-
-    @property
-    def active(self) -> bool:
-        """Whether anything can happen (an event attached or queued)."""
-        return bool(self.attached) or any(self.queues)
 
     # ------------------------------------------------------------ instructions
     def attach(self, int_number: int, event: int, t: int) -> None:
@@ -175,7 +168,6 @@ class Interrupts:
         if len(q) >= GROUPS[group][1]:
             name, depth, bit = GROUPS[group]
             self.sm[4] |= bit
-            self.lost[event] = self.lost.get(event, 0) + 1
             self.warn(f"interrupt queue overflow: the {name} queue holds {depth} events; "
                       f"event {event} ({EVENTS[event].name}) at {t / 1e6:.6f} s was lost "
                       f"(SM4.{bit.bit_length() - 1} set)", f"irq-overflow-{event}")
@@ -188,7 +180,7 @@ class Interrupts:
         if not self.enabled or self.running:
             return
         q0, q1, q2 = self.queues
-        attached, counts, run = self.attached, self.counts, self.run_routine
+        attached, run = self.attached, self.run_routine
         self.running = True
         try:
             while q0 or q1 or q2:
@@ -197,7 +189,6 @@ class Interrupts:
                 number = attached.get(event)
                 if number is None:
                     continue            # detached while queued
-                counts[event] = counts.get(event, 0) + 1
                 run(number)
         finally:
             self.running = False
@@ -274,9 +265,3 @@ class Interrupts:
                 if te is not None and after < te <= until and (best is None or te < best):
                     best = te
         return best
-
-    def state(self) -> dict[str, Any]:
-        """What the tools show: attached events, enabled, queued, counts."""
-        return {"enabled": self.enabled, "attached": dict(self.attached),
-                "queued": [list(q) for q in self.queues], "counts": dict(self.counts),
-                "lost": dict(self.lost)}

@@ -34,7 +34,7 @@ user, .6 pipeline overflow, .7 PTO idle.
   first half of each PTO cycle, for the pulse width of each PWM cycle).
 
 What it is not: no counter (a high-speed counter wired to the output counts
-with :meth:`pulses_between`), no wizard code (PTOx_* blocks).
+with :meth:`pulses_until`), no wizard code (PTOx_* blocks).
 """
 
 from __future__ import annotations
@@ -294,10 +294,6 @@ class PulseOutput:
         elif self.pwm_next is not None:
             cycle, width = self.pwm_next
             self.pwm, self.pwm_next = (t, cycle, width), None
-
-    def pulses_between(self, t0: int, t1: int) -> int:
-        """Rising edges in (t0, t1] (a counter wired to the output)."""
-        return self.pulses_until(t1) - self.pulses_until(t0)
 
     def edge_after(self, after: int, rising: bool) -> Optional[int]:
         """The terminal's first rising (or falling) edge after *after*, while

@@ -299,22 +299,17 @@ class Plc(AddressAccess):
             t_end = now + self.scan_us
             for po in self.pulse:
                 if po.running:
-                    bit = 1 << po.number
-                    pq[0] = pq[0] | bit if po.level(t_end) else pq[0] & ~bit & 0xFF
+                    _put_bit(pq, po.number, po.level(t_end))
                     po.update_segment(t_end)
-
         if self.encoders:
             t_end = now + self.scan_us
             for enc in self.encoders.values():        # the plant's encoders: their levels
                 for inp in (enc.a, enc.b):
                     if inp is not None:
-                        bit = 1 << (inp % 8)
-                        pi[inp // 8] = pi[inp // 8] | bit if enc.level(t_end, inp) \
-                            else pi[inp // 8] & ~bit & 0xFF
+                        _put_bit(pi, inp, enc.level(t_end, inp))
         if self.wiring:
             for inp, out in self.wiring.items():      # the plant's wires: output -> input
-                bit, level = 1 << (inp % 8), pq[out // 8] >> (out % 8) & 1
-                pi[inp // 8] = pi[inp // 8] | bit if level else pi[inp // 8] & ~bit & 0xFF
+                _put_bit(pi, inp, pq[out // 8] >> (out % 8) & 1)
         self.scans = scans + 1
         self._t_us = now + self.scan_us
         if self.stop_requested:
@@ -345,9 +340,8 @@ class Plc(AddressAccess):
         """After the events of one instant: 1 ms timers and counters current,
         then the routines."""
         self.timers.refresh_1ms(t)
-        if self._hsc_any:
-            for c in self._counted:
-                c.sync(t)
+        for c in self._counted:
+            c.sync(t)
         self.interrupts.run_at(t)
 
     def _hdef(self, number: int, mode: int) -> None:
@@ -624,6 +618,12 @@ class Plc(AddressAccess):
         dst._force_slots = []
         for key, value in self.forces.items():
             dst.force(key, value)
+
+def _put_bit(buf: bytearray, n: int, level: int) -> None:
+    """Bit *n* of *buf* (byte n // 8, bit n % 8) := *level*."""
+    mask = 1 << (n % 8)
+    buf[n // 8] = buf[n // 8] | mask if level else buf[n // 8] & ~mask & 0xFF
+
 
 def _int_or_none(text: str) -> int | None:
     t = text.strip()

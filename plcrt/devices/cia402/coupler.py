@@ -75,7 +75,7 @@ from ...errors import PlcConfigError, PlcError
 from .. import AxisState, DriveState
 from .drive import Drive
 from .esm import EsmState
-from .od import SdoAbort
+from .od import DTYPES, SdoAbort
 from .plant import DrivePlant
 
 __all__ = ["FieldbusModule", "IMAGE_BYTES", "OUT_LAYOUT", "IN_LAYOUT", "SDO_CYCLES"]
@@ -112,8 +112,8 @@ REQ, WRITE = 0x01, 0x02
 #: SDO abort code of a value the mailbox's DINT cannot carry (CiA 301:
 #: "data type does not match, length of service parameter does not match")
 ABORT_LENGTH = 0x06070010
-_INT_RANGE = {"I8": (-2**7, 2**7 - 1), "I16": (-2**15, 2**15 - 1), "I32": (-2**31, 2**31 - 1),
-              "U8": (0, 2**8 - 1), "U16": (0, 2**16 - 1), "U32": (0, 2**32 - 1)}
+#: the object types the mailbox's DINT carries (their ranges: od.DTYPES)
+_MAILBOX_TYPES = frozenset({"I8", "U8", "I16", "U16", "I32", "U32"})
 
 
 class _Port:
@@ -236,7 +236,7 @@ class FieldbusModule:
         what = f"{'write' if write else 'read'} {index:04X}h:{sub:02X}"
         try:
             entry = drive.od.entry(index, sub)
-            bounds = _INT_RANGE.get(entry.dtype)
+            bounds = DTYPES[entry.dtype][1:] if entry.dtype in _MAILBOX_TYPES else None
             if write:
                 if entry.dtype == "U32" and value < 0:
                     value += 2**32            # a DWORD above 2**31 reads as a negative DINT

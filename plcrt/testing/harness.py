@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..devices import AxisState, DriveState
-from ..trace.recorder import parse_signal
+from ..trace.recorder import is_device_signal, parse_signal
 from ..engine.runtime import Plc, load
 from ..engine.values import Duration, check_address, parse_number, scan_number
 from ..engine.values import duration as parse_duration
@@ -57,12 +57,9 @@ def reader(plc: Plc, spec: str) -> Callable[[], Value]:
     symbol names) or one device quantity (``axis0.0.position``,
     ``drive1.statusword``, the signals of ``plcrt trace``) resolved once,
     for per-scan use (see :meth:`Plc.reader`)."""
-    if isinstance(spec, str) and _DEVICE_RE.match(spec):
+    if isinstance(spec, str) and is_device_signal(spec):
         return parse_signal(plc, spec).read
     return plc.reader(spec)[1]
-
-
-_DEVICE_RE = re.compile(r"\s*(axis|drive)\d*\.", re.IGNORECASE)
 
 
 _COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"

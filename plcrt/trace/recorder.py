@@ -62,6 +62,13 @@ class Signal:
         return np.float64 if self.kind == "real" else np.int64
 
 
+def is_device_signal(text: str) -> bool:
+    """Whether *text* names an axis or drive quantity (``axis0.0.speed``,
+    ``drive1.position``) rather than an address or a symbol."""
+    name = text.strip()
+    return bool(_AXIS_PREFIX_RE.match(name) or _DRIVE_PREFIX_RE.match(name))
+
+
 def parse_signal(plc: Any, text: str) -> Signal:
     """Validate one signal string against ``plc`` and build its reader.
 

@@ -33,17 +33,29 @@ def _ceil_div(a: int, b: int) -> int:
 class SignalEdges:
     """The exactly timed edges of I0.0–I0.3 (events 0–7)."""
 
-    #: its next edge depends on the interrupts attached: asked anew each time
-    cacheable = False
+    #: its next edge moves only by ATCH/DTCH, PLS or a train's end, which all
+    #: touch the scheduler, or by its own events
+    cacheable = True
 
     def __init__(self, plc: Any) -> None:
         self.plc = plc
         self.last: Optional[int] = None           #: the time of the last edge fired
+        self._version = -1                        #: the interrupts' version _inputs is for
+        self._inputs: list[tuple[int, int, int, Any, int]] = []
 
     def _driven(self) -> list[tuple[int, int, int, Any, int]]:
         """(bit, rise event, fall event, source, phase) of attached edge inputs
         driven by a signal: source a pulse output or an encoder; phase the
         encoder quarter period (0 for A, 1 or 3 for B)."""
+        irq = self.plc.interrupts
+        # perf: derived again only when ATCH/DTCH changed what is attached
+        # (the wiring and the encoders are fixed when the PLC is built)
+        if irq.version != self._version:
+            self._inputs = self._derive()
+            self._version = irq.version
+        return self._inputs
+
+    def _derive(self) -> list[tuple[int, int, int, Any, int]]:
         plc, attached = self.plc, self.plc.interrupts.attached
         out = []
         for bit, (rise, fall) in EDGES.items():

@@ -62,6 +62,16 @@ class Scheduler:
         return [[src, -1, None, src.cacheable, getattr(src, "moves_others", False)]
                 for src in self.sources]
 
+    def add(self, source: EventSource) -> None:
+        """A new source (an HDEF'd counter on a pulse output), lowest priority."""
+        self.sources.append(source)
+        self._rows = []
+
+    def reset(self, sources: list[EventSource]) -> None:
+        """Replace the sources (a forked PLC's own)."""
+        self.sources[:] = sources
+        self._rows = []
+
     def touch(self) -> None:
         """A source's next event may have moved: ask them all again."""
         self.gen += 1
@@ -74,44 +84,41 @@ class Scheduler:
         # or something touches the sources: one [source, gen, time, cacheable,
         # moves others] row each, kept between scans
         rows = self._rows
-        if len(rows) != len(self.sources):
+        if not rows:
             rows = self._rows = self._make_rows()
         # events that the program itself caused at the scan's instant (a
         # pulse train started by PLS reaching a counter's PV at once) are
         # asked for from just before it
         after = t_from - 1
         while True:
-            best: Optional[int] = None
-            due: list[Any] = []
+            best = _NEVER
             gen = self.gen
-            for row in rows:           # in priority order: ties fire in this order
-                if row[1] == gen and row[3]:
-                    te = row[2]
-                else:
+            for row in rows:
+                if row[1] != gen or not row[3]:
                     src = row[0]
-                    te = src.next_time(after, _NEVER) if src.live() else None
-                    row[1], row[2] = gen, te
-                if te is None or te > t_to:
-                    continue
-                if best is None or te < best:
-                    best, due = te, [row]
-                elif te == best:
-                    due.append(row)
-            if best is None:
+                    row[2] = src.next_time(after, _NEVER) if src.live() else None
+                    row[1], row[3] = gen, src.cacheable
+                te = row[2]
+                if te is not None and te < best:
+                    best = te
+            if best > t_to:
                 break
             if best > t:
                 for dev in devices:
                     dev.step(plc, t, best)
                 t = best
-            for row in due:
-                row[1] = -1
-                row[0].fire(best)
-                if row[4]:
-                    self.gen += 1      # e.g. a train ended: a counter on it moves too
+            # perf: the rows due are found by their kept times (no list per
+            # instant); firing changes no other row's time
+            for row in rows:           # in priority order: ties fire in this order
+                if row[2] == best:
+                    row[1] = -1
+                    row[0].fire(best)
+                    if row[4]:
+                        self.gen += 1  # e.g. a train ended: a counter on it moves too
             if on_instant is not None:
                 on_instant(best)
             after = best
-            if len(rows) != len(self.sources):   # HDEF in a routine added a counter
+            if rows is not self._rows:   # HDEF in a routine added a counter
                 rows = self._rows = self._make_rows()
         if t < t_to:
             for dev in devices:

@@ -40,6 +40,7 @@ What it is not: no wizard code; a PWM on a wired clock is not counted.
 
 from __future__ import annotations
 
+import struct
 from typing import Any, Optional
 
 __all__ = ["HighSpeedCounter", "Encoder", "SM_HSC", "INPUTS", "MODES", "make_counters"]
@@ -64,6 +65,9 @@ INTERNAL_PTO = {0: 0, 3: 1}
 
 UP, EQUAL, GREATER = 0x20, 0x40, 0x80
 _I32 = 2**31
+
+
+_UD = struct.Struct(">I")
 
 
 def _wrap(v: int) -> int:
@@ -138,17 +142,17 @@ class HighSpeedCounter:
         self.inputs = 0                  #: the input bits as last sampled (4 bits)
         self.reset_held = False
         self.fired_at: Optional[int] = None   #: the time of the last CV=PV event
+        self._hc_at = 4 * number              #: HCn's offset in the HC area
+        #: (input byte, bit, position in the 4-bit sample) of each input it has
+        self._taps = tuple((bit // 8, bit % 8, k) for k, bit in enumerate(INPUTS[number])
+                           if bit is not None)
 
     # ------------------------------------------------------------ helpers
     def _dword(self, offset: int) -> int:
         return int.from_bytes(self.sm[offset:offset + 4], "big", signed=True)
 
-    def _bit(self, pi: bytearray, k: int) -> int:
-        bit = INPUTS[self.number][k]
-        return 0 if bit is None else pi[bit // 8] >> (bit % 8) & 1
-
     def _publish(self) -> None:
-        self.hc[4 * self.number:4 * self.number + 4] = (self.cv & 0xFFFFFFFF).to_bytes(4, "big")
+        _UD.pack_into(self.hc, self._hc_at, self.cv & 0xFFFFFFFF)
         st = UP if self.direction > 0 else 0
         if self.cv == self.pv:
             st |= EQUAL
@@ -230,11 +234,14 @@ class HighSpeedCounter:
 
     def sync(self, t: int) -> None:
         """Count the wired pulse output's pulses up to *t*."""
-        if self.pulse is None or not self.enabled:
+        pulse = self.pulse
+        if pulse is None or not self.enabled:
             return
-        now = self.pulse.pulses_until(t)
+        now = pulse.pulses_until(t)
         if now != self.base:
-            if self.counting() and not self.reset_held:
+            # perf: the start input is read only in the modes that have one
+            if not self.reset_held and (self.mode == 12 or self.mode % 3 != 2
+                                        or self.counting()):
                 self.cv = _wrap(self.cv + self.direction * (now - self.base))
             self.base = now
             self._publish()
@@ -260,7 +267,10 @@ class HighSpeedCounter:
             self._post(0, t)
 
     def _sample(self, pi: bytearray) -> int:
-        return sum(self._bit(pi, k) << k for k in range(4))
+        v = 0
+        for byte, bit, k in self._taps:       # perf: no generator per scan
+            v |= (pi[byte] >> bit & 1) << k
+        return v
 
     def scan_start(self, pi: bytearray, t: int) -> bool:
         """Edges of the counter's inputs since the last scan (the outside

@@ -98,10 +98,8 @@ class Interrupts:
     generated code); *warn(message, key)* reports a diagnostic once."""
 
     def __init__(self, sm: bytearray, run_routine: Callable[[int], None],
-                 warn: Callable[[str, str], None],
-                 set_time: Callable[[int], None] = lambda t: None) -> None:
+                 warn: Callable[[str, str], None]) -> None:
         self.sm = sm
-        self.set_time = set_time                     #: tells the engine the routines' time
         self.run_routine = run_routine
         self.warn = warn
         self.attached: dict[int, int] = {}          #: event -> INT number
@@ -113,11 +111,19 @@ class Interrupts:
         self.timed_period: dict[int, int] = {}       #: timed event -> interval (µs)
         self.timed_fired: set[int] = set()           #: timed events that fired since ATCH
         self.timers: Any = None                      #: the timer bank (events 21, 22)
+        #: bumped by ATCH/DTCH (perf: sources that depend on what is attached
+        #: keep what they derived from it until it changes)
+        self.version = 0
+        #: the scheduler may keep this source's next event until it fires or
+        #: something touches the sources; not while T32/T96 CT=PT is attached
+        #: (a routine's TON moves that time without touching anything)
+        self.cacheable = True
 
     # ------------------------------------------------------------ instructions
     def attach(self, int_number: int, event: int, t: int) -> None:
         """ATCH: *event* runs INT *int_number* from now on."""
         self.attached[event] = int_number
+        self._attached_changed()
         sm_byte = TIMED.get(event)
         if sm_byte is None:
             return
@@ -140,6 +146,11 @@ class Interrupts:
         """DTCH: *event* is disabled; its occurrences are ignored."""
         self.attached.pop(event, None)
         self.timed_next.pop(event, None)
+        self._attached_changed()
+
+    def _attached_changed(self) -> None:
+        self.version += 1
+        self.cacheable = 21 not in self.attached and 22 not in self.attached
 
     def clear(self, event: int) -> None:
         """CEVNT (SMART): drop the queued occurrences of *event*."""
@@ -208,9 +219,6 @@ class Interrupts:
                 self.post(rise if new >> bit & 1 else fall, t)
 
     # ------------------------------------------------------------ timed
-    #: its next event is asked anew each time (a routine's TON moves T32's CT=PT)
-    cacheable = False
-
     def live(self) -> bool:
         """Whether a timed interrupt runs, or T32/T96 CT=PT is attached (the
         scheduler asks only live sources)."""
@@ -223,35 +231,29 @@ class Interrupts:
             te = min(self.timed_next.values())   # perf: always after the last one fired
             if after < te <= until:
                 best = te
-        if 21 in self.attached or 22 in self.attached:
+        if not self.cacheable:                   # T32/T96 CT=PT attached
             te = self._timer_next(after, until)
             if te is not None and (best is None or te < best):
                 best = te
         return best
 
-    def fire_timed(self, t: int) -> None:
-        """Post the timed occurrences due at *t* and schedule their next ones."""
+    def fire(self, t: int) -> None:
+        """The scheduler's call (:class:`plcrt.engine.events.EventSource`):
+        post the timed occurrences due at *t* and schedule their next ones
+        (the engine runs the routines once every source of the instant has
+        fired)."""
         timed = self.timed_next
-        for event in (10, 11):          # event order: 10 before 11 at one instant
-            if timed.get(event) == t:
+        # event order: 10 before 11 at one instant (perf: no sort for one)
+        for event in (sorted(timed) if len(timed) > 1 else tuple(timed)):
+            if timed[event] == t:
                 timed[event] = t + self.timed_period[event]
                 self.timed_fired.add(event)
                 self.post(event, t)
-        for event, n in ((21, 32), (22, 96)):
-            if event in self.attached and self.timers.ct_pt_time(n) == t:
-                self.timers.refresh_1ms(t)       # CV = PT now: no second event
-                self.post(event, t)
-
-    def fire(self, t: int) -> None:
-        """The scheduler's call (:class:`plcrt.engine.events.EventSource`):
-        post the timed occurrences due at *t* (the routines run in
-        :meth:`run_at`, once every source of the instant has fired)."""
-        self.fire_timed(t)
-
-    def run_at(self, t: int) -> None:
-        """Run what is queued, at time *t*."""
-        self.set_time(t)
-        self.dispatch(t)
+        if not self.cacheable:
+            for event, n in ((21, 32), (22, 96)):
+                if event in self.attached and self.timers.ct_pt_time(n) == t:
+                    self.timers.refresh_1ms(t)       # CV = PT now: no second event
+                    self.post(event, t)
 
     def attach_timer_events(self, timers: Any) -> None:
         """Events 21 / 22: T32 / T96 CT=PT, from the timer bank."""

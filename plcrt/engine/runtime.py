@@ -110,8 +110,7 @@ class Plc(AddressAccess):
         self.wd = [0, int(watchdog_ms * 1000 / WATCHDOG_US_PER_INSN), 0, 0]
         self.devices: list[Any] = []
         #: the interrupt system; routines run through _run_interrupt
-        self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn,
-                                     self._irq_time)
+        self.interrupts = Interrupts(self.mem.areas["SM"], self._run_interrupt, self._irq_warn)
         self.interrupts.attach_timer_events(self.timers)
         #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
         self.pulse = make_outputs(self)
@@ -140,7 +139,8 @@ class Plc(AddressAccess):
                 driven.add(enc.b)
         self._edge_mask = 0x0F & ~sum(1 << b for b in driven if b < 4)
         self._irq_t = 0            #: the time the running code executes at (µs)
-        self._hsc_any = False      #: an HDEF ran (perf: counters cost nothing before)
+        #: the counters an HDEF defined, in HDEF order (perf: the others cost nothing)
+        self._defined: list[Any] = []
         self._sources_on = False   #: a PLS, HDEF or T32/T96 ATCH ran (perf: see _scan_once)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
@@ -236,8 +236,8 @@ class Plc(AddressAccess):
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
         irq = self.interrupts
-        if self._hsc_any:
-            for c in self.hsc:
+        if self._defined:
+            for c in self._defined:
                 if c.scan_start(pi, now):
                     self.scheduler.touch()
         pi0 = pi[0] & self._edge_mask
@@ -342,16 +342,21 @@ class Plc(AddressAccess):
         self.timers.refresh_1ms(t)
         for c in self._counted:
             c.sync(t)
-        self.interrupts.run_at(t)
+        irq = self.interrupts
+        if irq.queued:                  # perf: nothing to run for an unattached event
+            self._irq_t = t
+            irq.dispatch(t)
 
     def _hdef(self, number: int, mode: int) -> None:
-        self._hsc_any = self._sources_on = True
+        self._sources_on = True
         counter = self.hsc[number]
         counter.hdef(mode, self._irq_t)
+        if counter.mode is not None and counter not in self._defined:
+            self._defined.append(counter)
         self.scheduler.touch()
         if counter.pulse is not None and counter not in self._counted:
             self._counted.append(counter)
-            self.scheduler.sources.append(counter)
+            self.scheduler.add(counter)
 
     def _hsc(self, number: int) -> None:
         self.hsc[number].hsc(self._irq_t)
@@ -365,9 +370,6 @@ class Plc(AddressAccess):
         self.pulse[number].pls(self._irq_t)
         self._sources_on = True
         self.scheduler.touch()
-
-    def _irq_time(self, t: int) -> None:
-        self._irq_t = t
 
     def _irq_warn(self, message: str, key: str) -> None:
         self.warn(message, None, key)
@@ -605,11 +607,11 @@ class Plc(AddressAccess):
             b.__dict__.update(state)
         dst.modules = {d.slot: d for d in dst.devices}
         dst._int_l[:] = self._int_l
-        dst.scheduler._rows = []
         dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
-        dst.scheduler.sources[:] = [dst.interrupts, dst.edges, *dst.pulse, *dst._counted]
+        dst._defined[:] = [dst.hsc[c.number] for c in self._defined]
+        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse, *dst._counted])
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
-                     "_irq_t", "_pi0", "_hsc_any", "_sources_on"):
+                     "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))
         dst._warned = set(self._warned)
         dst.diagnostics = list(self.diagnostics)

@@ -143,6 +143,7 @@ class HighSpeedCounter:
         self.reset_held = False
         self.fired_at: Optional[int] = None   #: the time of the last CV=PV event
         self._hc_at = 4 * number              #: HCn's offset in the HC area
+        self._signal_bits = 0                 #: input bits a counted signal drives
         #: (input byte, bit, position in the 4-bit sample) of each input it has
         self._taps = tuple((bit // 8, bit % 8, k) for k, bit in enumerate(INPUTS[number])
                            if bit is not None)
@@ -182,6 +183,9 @@ class HighSpeedCounter:
             self.pulse = self.plc.pulse[source]
         elif encoder is not None and mode not in (6, 7, 8):
             self.pulse = encoder
+        if self.pulse is not None:
+            # the inputs the signal drives: the clock (A), and B in quadrature
+            self._signal_bits = 0x0F if mode == 12 else 0x03 if mode >= 9 else 0x01
         self.inputs = self._sample(self.plc.mem.areas["PI"])
 
     def hsc(self, t: int) -> None:
@@ -283,7 +287,9 @@ class HighSpeedCounter:
         if not self.enabled:
             return old != new
         self._scan_start(old, new, t)
-        return old != new
+        # perf: a clock that a pulse output or an encoder drives was counted
+        # in closed form; its level changing moves no event
+        return bool((old ^ new) & ~self._signal_bits)
 
     def _scan_start(self, old: int, new: int, t: int) -> None:
         self.sync(t)

@@ -118,12 +118,19 @@ class Interrupts:
         #: something touches the sources; not while T32/T96 CT=PT is attached
         #: (a routine's TON moves that time without touching anything)
         self.cacheable = True
+        #: whether the CPU's communication ports are simulated (their events 8,
+        #: 9 and 23–26 can occur); until then ATCH to them is diagnosed
+        self.ports = False
 
     # ------------------------------------------------------------ instructions
     def attach(self, int_number: int, event: int, t: int) -> None:
         """ATCH: *event* runs INT *int_number* from now on."""
         self.attached[event] = int_number
         self._attached_changed()
+        if EVENTS[event].group == 0 and not self.ports:
+            self.warn(f"event {event} ({EVENTS[event].name}) comes from a freeport "
+                      f"communication port, which this run does not simulate: INT "
+                      f"{int_number} is attached but never runs", f"irq-port-{event}")
         sm_byte = TIMED.get(event)
         if sm_byte is None:
             return

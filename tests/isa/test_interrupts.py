@@ -88,6 +88,17 @@ def test_interval_zero_never_fires_and_is_diagnosed():
     assert any("SMB34 = 0" in d.message for d in plc.diagnostics)
 
 
+@pytest.mark.parametrize("event", [8, 9, 23, 24, 25, 26])
+def test_attaching_a_communication_event_without_simulated_ports_is_diagnosed(event):
+    """The freeport ports are not simulated yet: their routines never run,
+    and ATCH says so instead of leaving the learner to wonder."""
+    plc = plcrt.load(program(f"LD SM0.1\nATCH INT_0, {event}\nENI", COUNT))
+    plc.run(0.1)
+    assert plc["VW0"] == 0
+    assert any(f"event {event} (port" in d.message and "never runs" in d.message
+               for d in plc.diagnostics)
+
+
 def test_interrupts_start_disabled_and_queue_until_eni_with_overflow_bits():
     """RUN starts with interrupts disabled: occurrences queue (8 in the timed
     group), the ninth is lost and sets SM4.2; ENI runs the queue at once and

@@ -13,7 +13,7 @@ This module is not a logger and does no I/O.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Iterable, Literal, Sequence
+from typing import Any, Iterable, Literal, Sequence
 
 from .safetext import excerpt, printable
 
@@ -133,7 +133,12 @@ class PlcError(Exception):
 
 
 class PlcSyntaxError(PlcError):
-    """The program, symbol or data file text cannot be parsed."""
+    """The program, symbol or data file text cannot be parsed.
+
+    ``partial``: for a program, the blocks that parsed without an error
+    (a :class:`plcrt.lang.ir.Program`), so that a viewer can draw them."""
+
+    partial: Any = None
 
 
 class PlcCompileError(PlcError):

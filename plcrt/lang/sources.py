@@ -16,7 +16,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from ..errors import PlcConfigError, PlcError, SourceLoc
+from ..errors import PlcConfigError, PlcError, PlcSyntaxError, SourceLoc
 from . import ir
 from .datablock import parse_datablock
 from .encoding import Decoded, decode_files, encoding_note, resolve_encoding
@@ -60,19 +60,39 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
         if isinstance(x, str) and not is_file_arg(x):
             check_text_size(x, "<string>", limit)
     decoded = {id(x): d for x, d in zip(files, decode_files(files, codec, limit))}
-    programs = [_parse(parse_program, x, decoded.get(id(x))) for x in items]
+    programs: list[ir.Program] = []
+    failed: list[PlcSyntaxError] = []
+    for x in items:               # every file's syntax errors in one report
+        try:
+            programs.append(_parse(parse_program, x, decoded.get(id(x))))
+        except PlcSyntaxError as e:
+            failed.append(e)
+            if e.partial is not None:
+                programs.append(e.partial)
     used = {decoded[id(x)].encoding for x in items if id(x) in decoded}
-    pous = tuple(p for prog in programs for p in prog.pous)
-    if len(programs) > 1:
-        pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
-    program = ir.Program(pous, programs[0].file, programs[0].source,
-                         used.pop() if len(used) == 1 else "")
+    program = _merge(programs, used.pop() if len(used) == 1 else "") if programs else None
+    if failed:
+        if len(failed) == 1:
+            raise failed[0]
+        err = PlcSyntaxError(failed[0].message, failed[0].loc,
+                             [d for e in failed for d in e.diagnostics])
+        err.partial = program
+        raise err
+    assert program is not None
     if tables[0] is not None:
         symbols = _parse(parse_symbols, tables[0], decoded.get(id(tables[0])))
     if tables[1] is not None:
         data = _parse(partial(parse_datablock, v_bytes=v_bytes) if v_bytes else parse_datablock,
                       tables[1], decoded.get(id(tables[1])))
     return program, symbols, data
+
+
+def _merge(programs: list[ir.Program], encoding: str) -> ir.Program:
+    """One program of the blocks of several files, OB1 first."""
+    pous = tuple(p for prog in programs for p in prog.pous)
+    if len(programs) > 1:
+        pous = tuple(sorted(pous, key=lambda p: p.kind != "OB"))
+    return ir.Program(pous, programs[0].file, programs[0].source, encoding)
 
 
 def _parse(fn: Callable[[str, str], Any], x: Any, decoded: Decoded | None) -> Any:

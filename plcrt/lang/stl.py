@@ -106,17 +106,23 @@ def parse_program(text: str, file: str = "<string>") -> Program:
     """Parse the text of an STL export and return its :class:`Program`.
 
     ``file`` is used only for source locations.  Raises
-    :class:`PlcSyntaxError` with every syntax problem found (one per block at
-    most, since a block with an error cannot be read reliably past it).
+    :class:`PlcSyntaxError` with every syntax problem found (see
+    :func:`_parse_collecting`); its ``partial`` is the program of the blocks
+    that parsed without an error, for tools that show what they can.
     """
     prepared = _prepare(text)
     sink = DiagnosticSink()
-    tree = _parse_collecting(prepared, file, sink)
-    if tree is None:
-        raise_collected(sink)
-        raise AssertionError("unreachable: failed parse without diagnostics")
-    pous = _Builder(file, sink).program(tree)
-    raise_collected(sink)
+    tree, broken = _parse_collecting(prepared, file, sink)
+    pous: list[Pou] = []
+    if tree is not None:
+        pous = _Builder(file, sink).program(tree)
+    if sink.errors:
+        good = tuple(p for p in pous if p.loc.line not in broken)
+        try:
+            raise_collected(sink)
+        except PlcSyntaxError as e:
+            e.partial = Program(pous=good, file=file, source=text)
+            raise
     return Program(pous=tuple(pous), file=file, source=text)
 
 
@@ -158,48 +164,67 @@ _BLOCK_START = re.compile(
     r"[ \t]*(?:ORGANIZATION_BLOCK|SUBROUTINE_BLOCK|INTERRUPT_BLOCK)(?!\w)", re.I)
 
 
-def _parse_collecting(text: str, file: str, sink: DiagnosticSink) -> Tree | None:
-    """Parse ``text``; on errors, record them and resume at the next block.
+_BEGIN_LINE = re.compile(r"[ \t]*BEGIN(?!\w)", re.I)
+_HEADER_LINE = re.compile(
+    r"[ \t]*(?:(?:END_)?(?:ORGANIZATION|SUBROUTINE|INTERRUPT)_BLOCK|NETWORK(?![A-Za-z_])"
+    r"|BEGIN(?!\w)|(?:END_)?VAR)", re.I)
+
+
+def _parse_collecting(text: str, file: str,
+                      sink: DiagnosticSink) -> tuple[Tree | None, set[int]]:
+    """Parse ``text``, recording every syntax error; returns the tree of
+    what remains readable and the header lines of the blocks with errors.
 
     Lark's LALR error recovery cannot tell where a broken line ends, and
-    resuming mid-block produces a cascade of follow-on errors.  Restarting
-    at the next block header instead gives at most one precise error per
-    block at the cost of re-lexing the rest of the file once per error.  The
-    text before the restart point is replaced by bare newlines so that lark's
-    line numbers stay those of the file.
+    resuming mid-line produces a cascade of follow-on errors.  Instead a
+    broken instruction line inside a block's networks is blanked and the
+    parse goes on, so a user fixing a large export sees every broken line of
+    a block in one run; an error anywhere else (a block header, a VAR
+    section, a missing END_...) blanks the rest of that block.  Blanked
+    lines stay as empty lines, so locations are those of the file.  A block
+    that had an error is in the returned set (its tree lacks lines); the
+    others are whole.
     """
     parser = _parser()
     lines = text.split("\n")
+    work = list(lines)
     starts = [i + 1 for i, line in enumerate(lines) if _BLOCK_START.match(line)]
-    start_line = 1
-    tree: Tree | None = None
+    broken: set[int] = set()
     while True:
-        chunk = text if start_line == 1 else (
-            "\n" * (start_line - 1) + "\n".join(lines[start_line - 1:]))
         try:
-            parsed = parser.parse(chunk)
+            return parser.parse("\n".join(work)), broken
         except UnexpectedInput as exc:
-            loc, message = _describe(exc, chunk, file, lines)
+            loc, message = _describe(exc, "\n".join(work), file, lines)
             sink.error(message, loc, code="syntax")
             if len(sink.errors) >= _MAX_SYNTAX_ERRORS:
-                return None
-            # Resume at the header the error stopped on (a missing END_...),
-            # otherwise at the first header after the error line.
+                return None, broken
+            line = loc.line
             at_header = (isinstance(exc, UnexpectedToken)
                          and exc.token.type in ("OB_KW", "SBR_KW", "INT_KW"))
-            nxt = [s for s in starts
-                   if (s >= loc.line if at_header else s > loc.line) and s > start_line]
-            if not nxt:
-                return None
-            start_line = nxt[0]
-            continue
+            at_end = not isinstance(exc, (UnexpectedToken, UnexpectedCharacters)) or (
+                isinstance(exc, UnexpectedToken) and exc.token.type == "$END")
+            # the block the error is in: a header the parse stopped on ends
+            # the block before it (whose END_... is missing)
+            owner = [s for s in starts if (s < line if at_header else s <= line)]
+            head = owner[-1] if owner else 1
+            if owner:
+                broken.add(head)
+            if (owner and not at_header and not at_end and work[line - 1].strip()
+                    and not _HEADER_LINE.match(work[line - 1])
+                    and any(_BEGIN_LINE.match(x) for x in work[head:line - 1])):
+                work[line - 1] = ""           # an instruction line: skip it
+                continue
+            # otherwise the block (or the text before the first block) goes
+            nxt = [s for s in starts if s > head]
+            end = (line - 1 if at_header else nxt[0] - 1) if nxt else len(work)
+            if all(not x.strip() for x in work[head - 1:end]):
+                return None, broken           # nothing left to blank: give up
+            for i in range(head - 1, end):
+                work[i] = ""
         except Exception as exc:  # noqa: BLE001 - a lark bug must not escape raw
             sink.error(f"internal parser error: {exc}", SourceLoc(file, 1, 1),
                        code="syntax")
-            return None
-        if start_line == 1:
-            tree = parsed
-        return tree
+            return None, broken
 
 
 # --------------------------------------------------------------------------

@@ -50,9 +50,10 @@ def cmd_show(args: argparse.Namespace) -> int:
     from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
                        load_for_run, parse_sets, print_diagnostics)
     from ..engine.runtime import parse_sources
-    from ..errors import PlcConfigError, PlcError, PlcRuntimeError
+    from ..errors import PlcConfigError, PlcError, PlcRuntimeError, PlcSyntaxError
 
     fault: PlcError | None = None
+    broken: PlcError | None = None
     try:
         _check_options(args, PlcConfigError)
         check_run_length(args)
@@ -61,7 +62,15 @@ def cmd_show(args: argparse.Namespace) -> int:
             plc = load_for_run(args, writes)
             program = plc.program
         else:
-            program = parse_sources([Path(p) for p in args.programs], encoding=args.encoding)
+            try:
+                program = parse_sources([Path(p) for p in args.programs],
+                                        encoding=args.encoding)
+            except PlcSyntaxError as e:
+                # draw every block that parsed; the errors are listed first
+                if e.partial is None or not e.partial.pous or args.network:
+                    raise
+                program, broken = e.partial, e
+                print_diagnostics(e.diagnostics)
         if not program.pous:
             raise PlcConfigError(f"nothing to show: {', '.join(args.programs)} holds no block "
                                  f"(an empty file, or only comments)")
@@ -109,6 +118,8 @@ def cmd_show(args: argparse.Namespace) -> int:
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
+    if broken is not None:
+        return EXIT_ERROR
     if stopped is not None:
         print_diagnostics(stopped.diagnostics)
         return EXIT_WALL

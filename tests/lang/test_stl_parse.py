@@ -432,6 +432,35 @@ def test_several_errors_one_per_block() -> None:
     assert str(err).startswith("bad.awl:4:9: error: ")
 
 
+def test_every_broken_line_of_a_block_is_reported_in_one_run() -> None:
+    """A user fixing a large export sees all broken instruction lines of a
+    block at once, not one per run; the lines after them still parse."""
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0 I0.1\n=      Q0.0\n"
+            "Network 2\nLD     I0.2 ,\n=      Q0.1\nNetwork 3\nMOVB   'x\n"
+            "END_ORGANIZATION_BLOCK\n")
+    err = syntax_error(text)
+    assert [(d.loc.line, d.loc.network) for d in err.diagnostics] == [(4, 1), (7, 2), (10, 3)]
+
+
+def test_the_blocks_without_errors_are_kept_as_a_partial_program() -> None:
+    """PlcSyntaxError.partial holds exactly the blocks that parsed whole (a
+    viewer draws them); a block with a broken line or a missing END_... is
+    left out."""
+    text = (wrap("LD I0.0 I0.1") + wrap("LD I0.0\n= Q0.0", "SUBROUTINE_BLOCK S:SBR1")
+            + "SUBROUTINE_BLOCK T:SBR2\nBEGIN\nNetwork 1\nLD I0.0\n"
+            + wrap("LD I0.1\n= Q0.1", "SUBROUTINE_BLOCK U:SBR3"))
+    err = syntax_error(text)
+    assert [d.loc.block for d in err.diagnostics] == ["OB1", "SBR2"]
+    assert err.partial is not None
+    assert [p.ident for p in err.partial.pous] == ["SBR1", "SBR3"]
+    assert [i.mnemonic for i in err.partial.pous[1].networks[0].insns] == ["LD", "="]
+
+
+def test_a_missing_end_at_the_end_of_the_file_is_one_error() -> None:
+    err = syntax_error("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0\n")
+    assert len(err.diagnostics) == 1 and "missing END_ORGANIZATION_BLOCK" in err.message
+
+
 def test_network_without_number() -> None:
     """``Network`` without a number is an error at the line end."""
     err = syntax_error(wrap("LD I0.0").replace("Network 1", "Network"))

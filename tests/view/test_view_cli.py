@@ -92,3 +92,23 @@ def test_show_status_needs_ob1(tmp_path: Path, capsys: pytest.CaptureFixture[str
     capsys.readouterr()
     assert main(["show", str(sbr), "--status"]) == 1
     assert "OB1" in capsys.readouterr().err
+
+
+def test_show_draws_the_blocks_that_parsed_when_others_have_syntax_errors(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A large export with a few broken lines still shows every block that
+    parsed; the errors come first and the exit code says the input is bad."""
+    main_file = tmp_path / "main.awl"
+    main_file.write_text("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0 I0.1\n"
+                         "= Q0.0\nEND_ORGANIZATION_BLOCK\n"
+                         "SUBROUTINE_BLOCK S:SBR0\nBEGIN\nNetwork 1 // kept\nLD I0.2\n"
+                         "= Q0.2\nEND_SUBROUTINE_BLOCK\n", encoding="utf-8")
+    other = tmp_path / "other.awl"
+    other.write_text("SUBROUTINE_BLOCK T:SBR1\nBEGIN\nNetwork 1\nLD ,\n"
+                     "END_SUBROUTINE_BLOCK\n", encoding="utf-8")
+    assert main(["show", str(main_file), str(other)]) == 1
+    out, err = capsys.readouterr()
+    assert f"{main_file}:4:" in err and f"{other}:4:" in err   # both files' errors
+    assert out.startswith("SBR0 (S)")
+    assert "Network 1  kept" in out and "I0.2" in out
+    assert "OB1" not in out and "SBR1" not in out

@@ -43,6 +43,9 @@ def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
     Consecutive BOOLs pack into one byte; other types start on the next byte
     boundary (S7-200 System Manual, "Subroutine parameters").
 
+    Names are case-sensitive, as in Micro/WIN: a Siemens library block
+    declares ``tmp_b`` (BOOL) and ``tmp_B`` (BYTE) side by side.
+
     Raises:
         ResolveError: unknown type, duplicate name, or L memory exhausted.
     """
@@ -50,7 +53,7 @@ def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
     byte, bit = 0, 0
     for section in SECTION_ORDER:
         for d in (v for v in pou.variables if v.section == section):
-            key = d.name.upper()
+            key = d.name
             if key in out:
                 raise ResolveError(f"variable '#{excerpt(d.name)}' declared twice")
             width = TYPE_WIDTH.get(d.type.upper())
@@ -108,10 +111,19 @@ class Resolver:
         return op
 
     def _local(self, t: str) -> LocalVar:
-        var = self.locals.get(t[1:].upper())
-        if var is None:
-            raise ResolveError(f"unknown local variable '{excerpt(t)}'")
-        return var
+        var = self.locals.get(t[1:])
+        if var is not None:
+            return var
+        # spelt in another case: the one variable of that name, if only one
+        # (hand-written programs); tmp_b / tmp_B need the declared spelling
+        same = [v for k, v in self.locals.items() if k.upper() == t[1:].upper()]
+        if len(same) == 1:
+            return same[0]
+        if same:
+            names = " and ".join(f"#{excerpt(v.decl.name)}" for v in same)
+            raise ResolveError(f"'{excerpt(t)}' could be {names} (local names differ by case): "
+                               f"write it as declared")
+        raise ResolveError(f"unknown local variable '{excerpt(t)}'")
 
     def _symbol(self, op: Name, text: str) -> Resolved:
         target = None

@@ -275,7 +275,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
     copy_in: list[tuple] = []
     copy_out: list[tuple] = []
     for decl, op_ir in zip(params, actual):
-        lv = callee.local_vars[decl.name.upper()]
+        lv = callee.local_vars[decl.name]
         width = lv.addr.width or 0
         sections = ("IN",) if decl.section == "IN" else ("OUT",) if decl.section == "OUT" \
             else ("IN", "OUT")

@@ -127,6 +127,10 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
         p.add_argument("--plant", metavar="F",
                        help="plant file (TOML): EM253 modules and the machine around "
                             "their axes")
+    p.add_argument("--auto-symbols", action="store_true",
+                   help="give each symbol that no symbol table defines a free M (bits) or V "
+                        "address, reported as warnings (for exports published without "
+                        "their symbol table)")
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="refuse program, symbol and data files larger than this "
                         "(default 16 MB, far above any S7-200 program)")
@@ -207,7 +211,8 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 scan_ms=scan_ms, cpu=getattr(args, "cpu", None), pace=pace,
                 plant=Path(plant) if plant else None, instrument=instrument, library=library,
                 encoding=getattr(args, "encoding", None),
-                max_file_mb=getattr(args, "max_file_mb", None))
+                max_file_mb=getattr(args, "max_file_mb", None),
+                auto_symbols=getattr(args, "auto_symbols", False))
 
 
 def cmd_check(args: argparse.Namespace) -> int:

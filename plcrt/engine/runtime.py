@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
 from ..compiler.rt import CODECS, make_indirect
-from ..errors import (PlcAddressError, PlcConfigError, PlcError,
+from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
@@ -63,7 +63,8 @@ class Plc(AddressAccess):
                  scan_ms: float = 10.0, cpu: str | None = None,
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
-                 plant: Any = None, instrument: bool = False, library: bool = False) -> None:
+                 plant: Any = None, instrument: bool = False, library: bool = False,
+                 auto_symbols: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
@@ -81,6 +82,15 @@ class Plc(AddressAccess):
             raise PlcConfigError(f"system_symbols must be a dict of name -> address, got "
                                  f"{type(system_symbols).__name__}")
         self.program = program
+        self.model = cpu_model(cpu)
+        auto_diags: list[Diagnostic] = []
+        if auto_symbols:
+            # unknown symbols get free M/V addresses, each reported (docs/decisions.md)
+            from ..compiler.autosym import auto_symbols as assign_symbols
+            from ..lang.symbols import SYSTEM_SYMBOLS
+            symbols, auto_diags = assign_symbols(
+                program, self.model, symbols,
+                system_symbols if system_symbols is not None else SYSTEM_SYMBOLS, data)
         self.symbols = symbols
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
@@ -93,7 +103,6 @@ class Plc(AddressAccess):
         #: forced addresses -> value (see :meth:`force`)
         self.forces: dict[str, int | float] = {}
         self._force_slots: list[tuple[bytearray, int, int, int, int | float]] = []
-        self.model = cpu_model(cpu)
         self.mem = MemoryImage(self.model)
         self.scan_us = int(round(scan_ms * 1000))
         self.pace = pace
@@ -164,10 +173,14 @@ class Plc(AddressAccess):
             unit.hooks["timers"] = self.timers
             unit.hooks["counters"] = self.counters
 
-        self.unit, self.source, self.line_locs = compile_program(
-            program, self.model, symbols=symbols, system_symbols=system_symbols, setup=setup,
-            probes=self.coverage, library=library)
-        self.diagnostics = list(self.unit.diag.items) + self.diagnostics
+        try:
+            self.unit, self.source, self.line_locs = compile_program(
+                program, self.model, symbols=symbols, system_symbols=system_symbols,
+                setup=setup, probes=self.coverage, library=library)
+        except PlcCompileError as e:
+            e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
+            raise
+        self.diagnostics = auto_diags + list(self.unit.diag.items) + self.diagnostics
         self._filename = f"<plcrt {program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)

@@ -1,0 +1,111 @@
+"""--auto-symbols: an address for each symbol no table defines, of the kind
+its uses need, always reported (plcrt.compiler.autosym; docs/decisions.md,
+"Symbols")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import plcrt
+from plcrt.cli import main
+from plcrt.errors import PlcCompileError
+
+CORPUS = Path(__file__).resolve().parents[3] / "shared" / "corpus"
+
+
+def ob1(*networks: str, extra: str = "") -> str:
+    body = "".join(f"Network {i}\n{n}\n" for i, n in enumerate(networks, 1))
+    return f"ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\n{body}END_ORGANIZATION_BLOCK\n{extra}"
+
+
+def assigned(plc: plcrt.Plc) -> dict[str, str]:
+    return {name: sym.address for name, sym in plc.symbols.entries.items()
+            if sym.comment == "assigned by auto-symbols"}
+
+
+def test_bits_get_free_m_bits_from_the_top_and_values_free_v_from_the_top() -> None:
+    """M31 is used by the program, so bits start at M30.7; a word and a
+    double word come from the top of V (CPU 226: 10240 bytes), aligned."""
+    plc = plcrt.load(ob1("LD Start\n= Motor\n= M31.0", "LD SM0.0\nMOVW Speed, Target\n"
+                         "MOVD Total, VD0"), auto_symbols=True)
+    assert assigned(plc) == {"Start": "M30.7", "Motor": "M30.6", "Speed": "VW10238",
+                             "Target": "VW10236", "Total": "VD10232"}
+    messages = [d.message for d in plc.diagnostics if d.code == "auto-symbol"]
+    assert len(messages) == 5
+    assert "'Start' is not in a symbol table; it is M30.7 (a bit" in messages[0]
+
+
+def test_the_assigned_addresses_run() -> None:
+    plc = plcrt.load(ob1("LD Start\n= Motor", "LD SM0.0\nMOVW Speed, Target"),
+                     auto_symbols=True)
+    plc.write("Start", 1)
+    plc.write("Speed", 1234)
+    plc.scan()
+    assert plc.read("Motor") == 1 and plc.read("Target") == 1234
+
+
+def test_immediate_instructions_get_input_and_output_bits() -> None:
+    """LDI reads a real input, =I writes a real output: I15.7 and Q15.7; a
+    plain contact on the same name is served by that input."""
+    plc = plcrt.load(ob1("LD EStop\nLDI EStop\nOLD\n=I Horn"), auto_symbols=True)
+    assert assigned(plc) == {"EStop": "I15.7", "Horn": "Q15.7"}
+
+
+def test_call_arguments_take_the_parameters_types() -> None:
+    sbr = ("SUBROUTINE_BLOCK S:SBR0\nVAR_INPUT\nOn:BOOL;\nSet:INT;\nEND_VAR\n"
+           "VAR_OUTPUT\nOut:DWORD;\nEND_VAR\nBEGIN\nNetwork 1\nLD #On\n"
+           "ITD #Set, #Out\nEND_SUBROUTINE_BLOCK\n")
+    plc = plcrt.load(ob1("LD SM0.0\nCALL S, Run, Setpoint, Result", extra=sbr),
+                     auto_symbols=True)
+    assert assigned(plc) == {"Run": "M31.7", "Setpoint": "VW10238", "Result": "VD10232"}
+
+
+def test_the_data_block_and_the_programs_own_addresses_are_not_taken() -> None:
+    plc = plcrt.load(ob1("LD SM0.0\nMOVW Speed, VW10238"), data="VD10234 16#01020304\n",
+                     auto_symbols=True)
+    assert assigned(plc) == {"Speed": "VW10232"}
+
+
+def test_a_name_used_with_two_widths_gets_no_address_and_each_use_is_an_error() -> None:
+    with pytest.raises(PlcCompileError) as info:
+        plcrt.load(ob1("LD Flag\n= Q0.0", "LD SM0.0\nMOVW Flag, VW0"), auto_symbols=True)
+    diags = info.value.diagnostics
+    assert any(d.code == "auto-symbol" and "'Flag' is used as a bit and, at line 8" in d.message
+               for d in diags)
+    assert sum("unknown symbol 'Flag'" in d.message for d in diags) == 2
+
+
+def test_a_table_symbol_wins_and_nothing_is_reported_without_unknown_names() -> None:
+    plc = plcrt.load(ob1("LD Start\n= Q0.0"), symbols="Start\tI0.0\n", auto_symbols=True)
+    assert assigned(plc) == {} and not [d for d in plc.diagnostics if d.code == "auto-symbol"]
+
+
+def test_without_the_option_an_unknown_symbol_is_still_an_error() -> None:
+    with pytest.raises(PlcCompileError, match="unknown symbol 'Start'"):
+        plcrt.load(ob1("LD Start\n= Q0.0"))
+
+
+def test_check_prints_every_assignment(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    prog = tmp_path / "p.awl"
+    prog.write_text(ob1("LD 启动\n= 电机"), encoding="utf-8")
+    assert main(["check", "--auto-symbols", str(prog)]) == 0
+    err = capsys.readouterr().err
+    assert "'启动' is not in a symbol table; it is M31.7" in err
+    assert "'电机' is not in a symbol table; it is M31.6" in err
+    assert err.splitlines()[-1].startswith(f"{prog}: 0 errors, 2 warnings")
+
+
+@pytest.mark.skipif(not (CORPUS / "bulaofen0036-coder__Smart200-MicroWIN-MCP__roundtrip.awl")
+                    .exists(), reason="the public corpus is not beside the project")
+def test_the_corpus_export_without_its_symbol_table_has_no_unknown_symbol_left() -> None:
+    """The largest SMART export was published without its table: with
+    --auto-symbols none of its symbols stays unknown."""
+    path = CORPUS / "bulaofen0036-coder__Smart200-MicroWIN-MCP__roundtrip.awl"
+    try:
+        plcrt.load(path, auto_symbols=True)
+    except PlcCompileError as e:
+        assert not [d for d in e.diagnostics if "unknown symbol" in d.message]
+        assert not [d for d in e.diagnostics if d.code == "auto-symbol"
+                    and "gets no address" in d.message]

@@ -648,4 +648,30 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
                         info.calls[callee.pou.ident] = insn.loc.within(
                             info.pou.ident, net.number)
     check_calls(unit)
+    _empty_library_blocks(unit)
     return unit
+
+
+def _empty_library_blocks(unit: Unit) -> None:
+    """Warn about called subroutines that have an interface and no code.
+
+    Micro/WIN exports a protected block (a Siemens instruction library such
+    as MBUS_CTRL or USS_INIT, wizard code, a password-protected block) with
+    its interface and an empty body: its calls run nothing here.  Blocks
+    plcrt emulates by name (a library interface in ``library/``) are left
+    to that emulation."""
+    from ..blocks.interface import interfaces
+    emulated = interfaces()
+    called = {callee for info in unit.pous.values() for callee in info.calls}
+    for ident in called:
+        info = unit.pous[ident]
+        pou = info.pou
+        if not pou.variables or any(net.insns for net in pou.networks):
+            continue
+        if pou.name.upper() in emulated:
+            continue
+        unit.diag.warning(
+            f"{ident} ({excerpt(pou.name)}) has an interface and no code: a protected "
+            f"library, wizard or password block exported without its body; its calls do "
+            f"nothing here (what it would do is not simulated)",
+            pou.loc.within(ident, None), "empty-block")

@@ -410,9 +410,12 @@ def wizard_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
     once = g.unit.hooks.setdefault("ptowizard-once", set())
     if callee.pou.ident not in once:
         once.add(callee.pou.ident)
-        why = "has instructions" if not empty else (
-            "has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
-            + ", not the wizard's " + ", ".join(f"{d} {t}" for d, t in wanted))
+        why = [w for w, bad in (
+            ("has instructions", not empty),
+            ("has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
+             + ", not the wizard's " + ", ".join(f"{d} {t}" for d, t in wanted),
+             own != wanted)) if bad]
+        why = " and ".join(why)
         g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the wizard "
                f"block {itf.name} but {why}: the program's own subroutine runs, not the "
                f"wizard emulation", f"ptowizard-own-{callee.pou.ident}")

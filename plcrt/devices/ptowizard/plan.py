@@ -137,7 +137,7 @@ def change_trains(start: int, c_now: int, speed: int, cfg: Any, segment: int) ->
     """From the cycle *c_now* (the pulse in progress ends at *start*) to
     *speed*, then at that speed without end (manual mode)."""
     out = ramp(speed_of(c_now), speed, cfg, segment)
-    out.append(Train(0, FOREVER, c, 0, segment))
+    out.append(Train(0, FOREVER, cycle_us(speed), 0, segment))
     return _chain(out, start)
 
 

@@ -122,11 +122,10 @@ def test_a_ramped_profile_sends_exactly_its_steps_pulses():
     plc = load("RUN", accel=500, decel=500)
     plc.scan()
     t0 = pulse(plc, "M0.2")
-    trains = plc.pulse[0].trains
-    up = trains[:next(i for i, tr in enumerate(trains) if tr.c0 == 200 and tr.delta == 0)]
-    assert sum(tr.count for tr in up) == ramp_pulses(200, 5000, load_plant(plant(500, 500))
-                                                     .pto[0], decel=False) == 315
-    assert up[-1].end - t0 == pytest.approx(121_212, rel=0.02)
+    assert ramp_pulses(200, 5000, load_plant(plant(500, 500)).pto[0], decel=False) == 315
+    # the 316th pulse is the first at 5000/s: the ramp's end (123.586 ms)
+    assert plc.pulse[0].time_of_pulse(316) - t0 == pytest.approx(121_212, rel=0.02)
+    assert plc.pulse[0].pulse_in_progress(plc.pulse[0].time_of_pulse(316)).c0 == 200
     plc.run("3s")
     assert (plc["M2.1"], plc["VD10"], sent(plc), plc["VW60"]) == (1, 1500, 1500, 1)
 

@@ -15,8 +15,10 @@ docs/pto-wizard.md):
   inside a piece the cycle changes linearly per pulse, in whole µs, from
   the piece's first to its last speed: ``Δ = round((c_b − c_a) / n)``
   (the manual's formula for a segment's delta), first cycle
-  ``c_a + round(Δ / 2)``, cycles ``c = round(10⁶ / v)`` µs.  Pieces of
-  20 % keep the ramp's time within about 1 % of the linear ramp's (a
+  ``c_a + round(Δ / 2)``, cycles ``c = round(10⁶ / v)`` µs; a piece that
+  changes by less than a µs per pulse is a constant train per whole µs
+  instead (pulse i: ``round(c_a + (i + ½)·(c_b − c_a)/n)``).  Pieces of
+  20 % keep the ramp's time within about 2 % of the linear ramp's (a
   single piece from 200 to 5000 pulses/s would take seven times as long);
 * a start from rest begins at SS_SPEED; a change while running begins after
   the pulse in progress; a stop ends at SS_SPEED.
@@ -83,10 +85,29 @@ def ramp(v_from: int, v_to: int, cfg: Any, segment: int) -> list[Train]:
         n = upto - done
         if n <= 0:
             continue            # no pulse yet: the piece goes on to the next speed
-        ca, cb = cycle_us(va), cycle_us(vb)
-        delta = _round_div(cb - ca, n)
-        out.append(Train(0, n, ca + _round_div(delta, 2), delta, segment))
+        out += _piece(cycle_us(va), cycle_us(vb), n, segment)
         done, va = upto, vb
+    return out
+
+
+def _piece(ca: int, cb: int, n: int, segment: int) -> list[Train]:
+    """*n* pulses whose cycle goes linearly from *ca* to *cb* µs.  A change
+    of at least a µs per pulse is one train, ``Δ = round((cb − ca) / n)``;
+    a slower one (a whole µs would overshoot) is one constant train per
+    whole µs, pulse i taking the cycle round(ca + (i + ½)·(cb − ca)/n)."""
+    d = cb - ca
+    if abs(d) >= n:
+        delta = _round_div(d, n)
+        return [Train(0, n, ca + _round_div(delta, 2), delta, segment)]
+    k = abs(d)
+    step = 1 if d > 0 else -1
+    out, below = [], 0
+    for j in range(k + 1):
+        # pulses i with (i + ½)/n < (j + ½)/k: cycles rounded to ca + step·j or less far
+        upto = n if j == k else min(n, max(0, -(-(n * (2 * j + 1) - k) // (2 * k))))
+        if upto > below:
+            out.append(Train(0, upto - below, ca + step * j, 0, segment))
+            below = upto
     return out
 
 

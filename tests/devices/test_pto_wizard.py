@@ -486,3 +486,18 @@ def test_plant_keys_read_into_the_configuration():
     assert [(s.speed, s.pulses) for s in pto.profiles[0].steps] == [(5000, 1000), (1000, 500)]
     assert (pto.profiles[1].speed, pto.profiles[1].stop_pulses) == (1000, 300)
     assert cfg.pwm[1].unit == 1000
+
+
+def test_d_stop_holds_a_manual_motion_that_run_keeps_asking_for():
+    """MAN's RUN stays on while D_STOP stops the motion: the stop completes
+    and MAN reports Error 7 instead of ramping up again."""
+    plc = load("MAN")
+    plc.scan()
+    plc["VD20"] = 1000
+    plc["M0.4"] = 1
+    plc.run("0.1s")
+    ts = plc.now_us
+    plc["M0.1"] = 1
+    plc.run("0.1s")
+    assert plc["VB14"] == wz.STOP_INPUT and not plc.pulse[0].trains
+    assert sent(plc) == plc.pulse[0].pulses_until(ts) == 101

@@ -261,7 +261,8 @@ class PtoRun(_Block):
             ax.decel_stop(t)
         elif start and not mine:
             self._start(t, profile)
-        cur = ax.pulse.pulse_in_progress(t) if self.motion == ax.motion else None
+        cur = ax.pulse.pulse_in_progress(t) if self.motion and self.motion == ax.motion \
+            else None
         if cur is not None:
             self.step = cur.segment
         return int(self.finished()), self.error, self.profile, self.step, ax.c_pos(t)
@@ -292,7 +293,9 @@ class PtoMan(_Block):
         mine = ax.kind == "MAN" and ax.busy()
         if run:
             cfg = ax.cfg
-            code = ax.refusal(manual_ok=True) if not mine else OK
+            # a stop input holds even the manual motion's own stop
+            code = ax.refusal(manual_ok=True) if not mine else \
+                STOP_INPUT if ax.stop_inputs else OK
             if code == OK and not cfg.ss_speed <= speed <= cfg.max_speed:
                 code = BAD_SPEED
             if code:
@@ -375,6 +378,7 @@ class PwmRun(_Block):
             if run:
                 self.refuse(NO_CONFIG)
             return (self.error,)
+        before = (po.mode, po.pwm, po.pwm_next)
         if run:
             unit = self.cfg.unit
             if cycle * unit < po.min_cycle:
@@ -384,8 +388,10 @@ class PwmRun(_Block):
             self.error = OK
         elif po.mode == "PWM":
             po.stop_now(t)
-        self.plc._sources_on = True
-        self.plc.scheduler.touch()
+        if (po.mode, po.pwm, po.pwm_next) != before:
+            # perf: the time line is asked again only when the PWM changed
+            self.plc._sources_on = True
+            self.plc.scheduler.touch()
         return (self.error,)
 
 

@@ -501,3 +501,18 @@ def test_d_stop_holds_a_manual_motion_that_run_keeps_asking_for():
     plc.run("0.1s")
     assert plc["VB14"] == wz.STOP_INPUT and not plc.pulse[0].trains
     assert sent(plc) == plc.pulse[0].pulses_until(ts) == 101
+
+
+def test_the_ladder_view_draws_wizard_calls_with_their_pins(tmp_path, capsys):
+    """A library call (PTO0_RUN, no subroutine) and a NAME:SBRn call of a
+    protected subroutine: boxes with the interface's pin names."""
+    from plcrt.cli import main
+    text = program("RUN", sbrs=protected("PTO0_CTRL", 1)).replace(
+        "END_ORGANIZATION_BLOCK", "Network 9\nLD SM0.0\n"
+        "CALL PTO0_CTRL:SBR1, M0.0, M0.1, M2.0, VB0, VD4\nEND_ORGANIZATION_BLOCK")
+    path = tmp_path / "wizard.awl"
+    path.write_text(text, encoding="utf-8")
+    assert main(["show", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "│     PTO0_RUN     │" in out and "─┤START         Done├─M2.1" in out
+    assert "PTO0_CTRL:SBR1" in out and "─┤p0            p2├─M2.0" in out

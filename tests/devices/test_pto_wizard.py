@@ -516,3 +516,21 @@ def test_the_ladder_view_draws_wizard_calls_with_their_pins(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "│     PTO0_RUN     │" in out and "─┤START         Done├─M2.1" in out
     assert "PTO0_CTRL:SBR1" in out and "─┤p0            p2├─M2.0" in out
+
+
+def test_abort_in_the_last_pulses_of_a_relative_profile_ends_as_planned():
+    """5000 pulses at 1000/s whose last 75 are the stop ramp: an Abort when
+    fewer pulses are left than a new stop would take changes nothing (the
+    move never goes beyond its own end)."""
+    text = ("[pto.0]\nmax_speed = 1000\nss_speed = 500\ndecel_ms = 100\nhsc = true\n"
+            "[[pto.0.profile]]\nmode = \"relative\"\nsteps = [ { speed = 1000, pulses = 5000 } ]\n")
+    plc = load("RUN", plant_text=text)
+    plc.scan()
+    pulse(plc, "M0.2")
+    end = plc.pulse[0].trains[-1].end
+    plc.run("4.94s")
+    assert 4925 < sent(plc) < 5000
+    pulse(plc, "M0.3")
+    assert plc.pulse[0].trains[-1].end == end
+    plc.run("0.2s")
+    assert (sent(plc), plc["M2.1"], plc["VW60"]) == (5000, 1, 1)

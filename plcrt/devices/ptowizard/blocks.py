@@ -93,10 +93,12 @@ class WizardAxis:
     def too_fast(self) -> bool:
         return self.cfg is not None and self.cfg.max_speed * self.pulse.min_cycle > 1_000_000
 
-    def refusal(self, manual_ok: bool = False) -> int:
-        """Why a new motion cannot start now (0: it can)."""
+    def refusal(self, manual_ok: bool = False, motion: bool = True) -> int:
+        """Why a new motion (or, *motion* False, a position load) cannot
+        start now (0: it can)."""
         for code, bad in ((NO_CONFIG, self.cfg is None), (NOT_INIT, not self.initialised),
-                          (STOP_INPUT, self.stop_inputs), (TOO_FAST, self.too_fast()),
+                          (STOP_INPUT, motion and self.stop_inputs),
+                          (TOO_FAST, motion and self.too_fast()),
                           (MANUAL, not manual_ok and self.manual()), (BUSY, self.busy())):
             if bad:
                 return code
@@ -124,10 +126,20 @@ class WizardAxis:
         return True
 
     def decel_stop(self, t: int, total: Optional[int] = None) -> None:
-        if self.cfg is None or self.stopping:
+        """A decelerated stop from the pulse in progress at *t* (with *total*:
+        after exactly that many more pulses); never beyond the end the
+        running motion already has (a relative profile in its last pulses
+        ends as planned)."""
+        po, cfg = self.pulse, self.cfg
+        cur = po.pulse_in_progress(t)
+        if cfg is None or self.stopping or cur is None:
             return
-        cfg = self.cfg
-        self.replan(t, lambda s, c, seg: stop_trains(s, c, cfg, seg, total), True)
+        down = stop_trains(cur.end, cur.c0, cfg, cur.segment, total)
+        left = po.sent + sum(tr.count for tr in po.trains) - po.pulses_until(cur.start)
+        self.stopping = True
+        if sum(tr.count for tr in down) < left:
+            po.run_trains([cur, *down])
+            self._touch()
 
     def init(self, t: int, warn: Any) -> None:
         """The first PTOx_CTRL: with the HSC option, HSC0 (HSC3) in mode 12,
@@ -322,7 +334,7 @@ class PtoLdpos(_Block):
         ax = self.ax
         t = ax.now()
         if start:
-            code = ax.refusal()
+            code = ax.refusal(motion=False)
             if code == OK and ax.counter is None:
                 code = NO_HSC if ax.cfg is not None and not ax.cfg.hsc else COUNTER
             if code:

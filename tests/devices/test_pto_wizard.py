@@ -534,3 +534,18 @@ def test_abort_in_the_last_pulses_of_a_relative_profile_ends_as_planned():
     assert plc.pulse[0].trains[-1].end == end
     plc.run("0.2s")
     assert (sent(plc), plc["M2.1"], plc["VW60"]) == (5000, 1, 1)
+
+
+def test_the_sample_program_runs_its_profile_to_the_end():
+    """programs/events/pto_wizard.awl with its plant: 34000 pulses counted
+    on HSC0, the last step 1, Done and one PTO-complete routine; the ramps
+    (200 ms per 19800/s) lie inside the steps."""
+    from pathlib import Path
+    events = Path(__file__).resolve().parents[2] / "programs" / "events"
+    plc = plcrt.load(events / "pto_wizard.awl", plant=events / "pto_wizard_plant.toml")
+    plc["M0.0"] = 1
+    plc.run("1s")
+    assert (plc["VB113"], plc["M10.1"]) == (0, 0) and 0 < plc["VD104"] < 30000
+    plc.run("5s")
+    assert (plc["VD104"], plc["VB113"], plc["M10.1"], plc["VW120"], plc["VB111"]) == \
+        (34000, 1, 1, 1, 0)

@@ -549,3 +549,35 @@ def test_the_sample_program_runs_its_profile_to_the_end():
     plc.run("5s")
     assert (plc["VD104"], plc["VB113"], plc["M10.1"], plc["VW120"], plc["VB111"]) == \
         (34000, 1, 1, 1, 0)
+
+
+def test_pto1_counts_on_hsc3_and_a_routine_starts_a_motion_at_its_own_time():
+    """PTO1_RUN called in a timed interrupt routine (every 5 ms): the motion
+    starts at the routine's time, not at a scan start; C_Pos is HSC3's CV."""
+    text = """ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1
+LD SM0.1
+MOVB 5, SMB34
+ATCH INT_1, 10
+ENI
+Network 2
+LD SM0.0
+CALL PTO1_CTRL, M0.0, M0.1, M2.0, VB0, VD4
+END_ORGANIZATION_BLOCK
+INTERRUPT_BLOCK INT_1:INT1
+BEGIN
+Network 1
+LD SM0.0
+CALL PTO1_RUN, M0.2, VB1, M0.3, M2.1, VB2, VB3, VB8, VD10
+END_INTERRUPT_BLOCK
+"""
+    plc = plcrt.load(text, plant=load_plant(plant().replace("pto.0", "pto.1")))
+    plc.scan()                                       # t = 0; routines at 5 and 10 ms
+    plc["M0.2"] = 1
+    plc.scan()                                       # the routine at 15 ms starts it
+    plc["M0.2"] = 0
+    po = plc.pulse[1]
+    assert po.trains[0].start == 15_000 and po.trains[-1].end == 15_000 + 700_000
+    plc.run("1s")
+    assert (plc["VD4"], plc["HC3"], plc["M2.1"]) == (1500, 1500, 1)

@@ -115,15 +115,16 @@ class WizardAxis:
         self._touch()
         return self.motion
 
-    def replan(self, t: int, plan: Any, stopping: bool) -> bool:
-        """Keep the pulse in progress at *t*, then *plan(end, cycle, step)*."""
+    def change_speed(self, t: int, speed: int) -> None:
+        """Manual mode: keep the pulse in progress at *t*, then ramp from its
+        speed to *speed* and run on (also out of a stop under way)."""
         cur = self.pulse.pulse_in_progress(t)
-        if cur is None:
-            return False
-        self.pulse.run_trains([cur, *plan(cur.end, cur.c0, cur.segment)])
-        self.stopping = stopping
+        if cur is None or self.cfg is None:
+            return
+        self.pulse.run_trains([cur, *change_trains(cur.end, cur.c0, speed, self.cfg,
+                                                   cur.segment)])
+        self.stopping = False
         self._touch()
-        return True
 
     def decel_stop(self, t: int, total: Optional[int] = None) -> None:
         """A decelerated stop from the pulse in progress at *t* (with *total*:
@@ -318,7 +319,7 @@ class PtoMan(_Block):
             elif speed != ax.speed or ax.stopping:
                 # a new Speed (or RUN again while stopping): ramp from the
                 # speed of the pulse in progress
-                ax.replan(t, lambda s, c, seg: change_trains(s, c, speed, cfg, seg), False)
+                ax.change_speed(t, speed)
                 ax.speed, self.error = speed, OK
         elif mine:
             ax.decel_stop(t)

@@ -326,7 +326,8 @@ def test_refusals_busy_bad_profile_and_not_initialised():
 def test_without_a_plant_the_blocks_load_warn_and_report_error_1():
     plc = plcrt.load(program("CTRL", "RUN", "MAN", "PWM"))
     warns = [d.message for d in plc.diagnostics if d.severity == "warning"]
-    assert any("must come from the plant file ([pto.0])" in w for w in warns)
+    # once per output, however many of its blocks the program calls
+    assert sum("must come from the plant file ([pto.0])" in w for w in warns) == 1
     assert any("must come from the plant file ([pwm.1])" in w for w in warns)
     plc["M0.4"] = 1
     plc["M1.0"] = 1
@@ -406,6 +407,7 @@ def test_an_export_with_protected_wizard_blocks_runs_the_emulation():
         "CALL PTO0_RUN,", "CALL SBR2,")
     plc = plcrt.load(text, plant=load_plant(plant() + "[pwm.1]\ntime_base = \"us\"\n"))
     assert not any("own subroutine runs" in d.message for d in plc.diagnostics)
+    assert sum("emulated from the plant's [pto.0]" in d.message for d in plc.diagnostics) == 1
     plc.scan()
     t0 = pulse(plc, "M0.2")
     assert plc.pulse[0].trains[-1].end == t0 + 700_000
@@ -467,6 +469,10 @@ def test_a_fork_mid_motion_continues_the_same_motion():
     ("[pto.0]\nmax_speed = 1000\nss_speed = 100\ndecel_ms = 1000\n[[pto.0.profile]]\n"
      "mode = \"continuous\"\nspeed = 1000\nstop_pulses = 5\n", "profile[0].stop_pulses"),
     ("[pwm.0]\ntime_base = \"s\"\n", "pwm.0.time_base"),
+    ("[pwm.0]\ntime_base = [1]\n", "pwm.0.time_base"),
+    ("[pto.0]\nmax_speed = 1000\nss_speed = 100\n[[pto.0.profile]]\nmode = [1]\n",
+     "pto.0.profile[0].mode"),
+    ("pto = [1]\n", "[pto] must be a table of outputs"),
     ("[pwm.1]\ntime_base = \"us\"\n[pto.1]\nmax_speed = 1000\nss_speed = 100\n",
      "configured as a PTO and as a PWM"),
     ("[ptos.0]\n", "unknown key(s) ptos"),

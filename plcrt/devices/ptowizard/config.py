@@ -155,7 +155,7 @@ def _profile(raw: Any, where: str, cfg: PtoConfig) -> Profile:
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{where} must be a table")
     mode = raw.get("mode")
-    if mode not in _PROFILE_KEYS:
+    if not isinstance(mode, str) or mode not in _PROFILE_KEYS:
         raise PlcConfigError(f"{where}.mode must be \"relative\" or \"continuous\", got "
                              f"{str(mode)[:20]!r}")
     _table(raw, where, _PROFILE_KEYS[mode])
@@ -201,7 +201,7 @@ def parse_pwm(raw: Any, file: str) -> dict[int, PwmConfig]:
     for n, table, where in _outputs(raw, file, "pwm"):
         t = _table(table, where, _PWM_KEYS)
         base = t.get("time_base")
-        if base not in TIME_BASES:
+        if not isinstance(base, str) or base not in TIME_BASES:
             raise PlcConfigError(f"{where}.time_base must be \"us\" or \"ms\", got "
                                  f"{str(base)[:20]!r}")
         result[n] = PwmConfig(n, TIME_BASES[base], where)

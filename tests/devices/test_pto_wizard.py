@@ -587,3 +587,47 @@ END_INTERRUPT_BLOCK
     assert po.trains[0].start == 15_000 and po.trains[-1].end == 15_000 + 700_000
     plc.run("1s")
     assert (plc["VD4"], plc["HC3"], plc["M2.1"]) == (1500, 1500, 1)
+
+
+def test_a_held_start_runs_the_profile_again_after_each_end():
+    """START is a level (the manual asks for an edge for that reason): held
+    on, the 700 ms profile runs at 0, then again from the first call after
+    its end; while it runs START changes nothing."""
+    plc = load("RUN")
+    plc.scan()
+    plc["M0.2"] = 1
+    t0 = plc.now_us
+    plc.scan()
+    first = plc.pulse[0].trains[-1].end
+    assert first == t0 + 700_000
+    plc.run("0.7s")                                  # the scan at t0 + 700 ms starts it again
+    assert plc.pulse[0].trains[0].start == t0 + 700_000 and plc["VW60"] == 1
+    assert sent(plc) == 1500 + 51                    # 200 µs pulses up to t0 + 710 ms
+
+
+def test_a_counter_the_program_defined_otherwise_gives_error_11():
+    """HSC0 in mode 0 from the program before PTO0_CTRL runs: CTRL reports
+    Error 11, C_Pos stays 0, LDPOS is refused with 11; the motion runs."""
+    text = program("CTRL", "RUN", "LDPOS").replace(
+        "ATCH INT_0, 19", "ATCH INT_0, 19\nHDEF 0, 0")
+    plc = plcrt.load(text, plant=load_plant(plant()))
+    plc.scan()
+    pulse(plc, "M0.2")
+    plc.run("1s")
+    pulse(plc, "M0.5")
+    assert (plc["VB0"], plc["VD4"], plc["VB15"], sent(plc)) == (wz.COUNTER, 0, wz.COUNTER,
+                                                                 1500)
+    assert any("HSC0 has mode 0" in d.message for d in plc.diagnostics)
+
+
+@pytest.mark.parametrize("n_profiles, n_steps, ok", [(32, 16, True), (33, 1, False),
+                                                       (1, 17, False)])
+def test_the_plant_takes_32_profiles_of_16_steps(n_profiles, n_steps, ok):
+    steps = ", ".join("{ speed = 500, pulses = 10 }" for _ in range(n_steps))
+    text = "[pto.0]\nmax_speed = 1000\nss_speed = 100\n" + \
+        f"[[pto.0.profile]]\nmode = \"relative\"\nsteps = [ {steps} ]\n" * n_profiles
+    if ok:
+        assert len(load_plant(text).pto[0].profiles) == n_profiles
+    else:
+        with pytest.raises(plcrt.PlcConfigError):
+            load_plant(text)

@@ -30,9 +30,11 @@ _WRITE = {"BOOL": Role.BIT_W, "BYTE": Role.B_W, "WORD": Role.W_W, "INT": Role.W_
 _KIND = {"BYTE": "B", "WORD": "WU", "INT": "W", "DINT": "D", "DWORD": "DU"}
 
 
-def library_call(g: Any, insn: Any, resolver: Any) -> bool:
-    """Emit a built-in block call; False if ``insn`` does not name one."""
-    name = insn.operands[0].text.split(":")[0].strip().upper()
+def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> bool:
+    """Emit a built-in block call; False if ``insn`` does not name one.
+    *name*: the block, when the call names it otherwise (a program
+    subroutine standing for it, called as ``SBR3``)."""
+    name = (name or insn.operands[0].text.split(":")[0]).strip().upper()
     itf = interfaces().get(name)
     if itf is None:
         return False
@@ -71,6 +73,9 @@ def library_call(g: Any, insn: Any, resolver: Any) -> bool:
             target = op if isinstance(op, (Addr, Indirect)) else None
             writes.append((target, p.type))
     plc = g.unit.hooks["plc"]
+    at_load = getattr(factory, "at_load", None)
+    if at_load is not None:
+        at_load(g, itf, plc)          # load-time warnings of the block's family
     fn = g.bind(factory(plc, g.loc, itf), "blk")
     with g.box():
         r = g.tmp("r")
@@ -112,3 +117,4 @@ _WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4}
 
 def _load_implementations() -> None:
     from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)
+    from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)

@@ -31,6 +31,18 @@
     pos_stop = 60000
     params = { "6099:01" = 20000, "6099:02" = 2000 }   # written by SDO at start-up
 
+    [pto.0]                     # the Position Control wizard of Q0.0 (docs/pto-wizard.md)
+    max_speed = 20000
+    ss_speed = 200
+    accel_ms = 500
+    decel_ms = 500
+    hsc = true
+    [[pto.0.profile]]
+    mode = "relative"
+    steps = [ { speed = 5000, pulses = 20000 } ]
+    [pwm.1]                     # the PWM wizard of Q0.1
+    time_base = "us"
+
 Only this module reads the format; it returns plain dataclasses that the
 device implementations consume.  Every problem is a PlcConfigError naming
 the file and the key.
@@ -49,6 +61,7 @@ from ..errors import PlcConfigError, PlcError
 from ..lang.limits import file_limit, read_capped
 from .cia402.coupler import IMAGE_BYTES
 from .em253.axis import AxisPlant
+from .ptowizard.config import PtoConfig, PwmConfig, check_outputs, parse_pto, parse_pwm
 
 KINDS = ("EM253", "FIELDBUS")
 EVENT_INPUTS = ("STF",)
@@ -91,6 +104,10 @@ class Plant:
     wiring: dict[int, int] = field(default_factory=dict)
     #: encoder signals: dicts of plcrt.engine.hsc.Encoder's arguments
     encoders: list[dict[str, Any]] = field(default_factory=list)
+    #: the Position Control wizard's configuration of Q0.0 / Q0.1 ([pto.N])
+    pto: dict[int, PtoConfig] = field(default_factory=dict)
+    #: the PWM wizard's time base of Q0.0 / Q0.1 ([pwm.N])
+    pwm: dict[int, PwmConfig] = field(default_factory=dict)
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -128,11 +145,15 @@ def _build(data: dict, file: str) -> Plant:
     modules: dict[int, ModuleConfig] = {}
     # A misspelt table ([modules.0]) would otherwise give a plant without
     # modules and only run-time warnings: reject unknown keys at every level.
-    unknown = set(data) - {"module", "cpu"}
+    unknown = set(data) - {"module", "cpu", "pto", "pwm"}
     if unknown:
         raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(a plant file has [module.N] tables and a [cpu] table)")
+                             f"(a plant file has [module.N] tables, a [cpu] table and "
+                             f"[pto.N] / [pwm.N] tables)")
     wiring, encoders = _cpu(data.get("cpu", {}), file)
+    pto = parse_pto(data.get("pto", {}), file)
+    pwm = parse_pwm(data.get("pwm", {}), file)
+    check_outputs(pto, pwm, file)
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -170,7 +191,7 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders)
+    return Plant(modules, file, wiring, encoders, pto, pwm)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)

@@ -347,12 +347,72 @@ class PulseOutput:
             return 1 if (t - start) % cycle < width else 0
         return 0
 
+    def retire(self, t: int) -> None:
+        """Count the trains that ended by *t* as sent and drop them (the
+        running train and what follows stay).  Nothing asks about a time
+        before *t* afterwards (the engine calls it at a scan's end for the
+        next scan's start)."""
+        trains = self.trains
+        # perf: a wizard ramp is many short trains; counters walk this list
+        while len(trains) > 1 and trains[0].end <= t:
+            self.sent += trains.pop(0).count
+
     def update_segment(self, t: int) -> None:
         """SMB166/176: the number of the segment running at *t*."""
         for tr in self.trains:
             if tr.start <= t < tr.end:
                 self.sm[self.segment_byte] = tr.segment
                 return
+
+    # ------------------------------------------------------------ wizard blocks
+    # The Position Control and PWM wizards' subroutines (PTOx_*, PWMx_RUN;
+    # plcrt.devices.ptowizard) drive the generator with whole trains.
+
+    def pulse_in_progress(self, t: int) -> Optional[Train]:
+        """The pulse running at *t* (its rise <= t < the end of its cycle) as
+        a one-pulse train, or None when no PTO runs then."""
+        for tr in self.trains:
+            if tr.start <= t < tr.end:
+                k = tr.pulses_started(t) - 1
+                return Train(tr.rise(k), 1, tr.cycle(k), 0, tr.segment)
+        return None
+
+    def run_trains(self, trains: list[Train]) -> None:
+        """Run *trains* (end to end, from the first one's start) in place of
+        the running PTO; the old trains' pulses that rose before that start
+        count as sent, a PWM stops.  Everything else is as for a PTO that
+        PLS started: SM66.7, the segment byte, the counters on the output,
+        the PTO-complete event at the end."""
+        first = trains[0].start
+        if self.trains:
+            self.sent += sum(tr.pulses_started(first - 1) for tr in self.trains)
+        self.pending = None
+        self.pwm_next = None
+        self.mode = "PTO"
+        self._start(trains, first)
+
+    def stop_now(self, t: int) -> None:
+        """Stop the pulses at *t* as PLS with the enable bit 0 does (a PTO:
+        SM66.5 and idle, no PTO-complete event; a PWM: the output off)."""
+        self._disable(t)
+
+    def pwm_run(self, t: int, cycle: int, width: int) -> None:
+        """Start a PWM of *cycle* and *width* µs, or change the running one
+        with a synchronous update (at the end of the running cycle).  The
+        caller checks the cycle against ``min_cycle``."""
+        if self.trains:
+            self.warn(f"Q0.{self.number}: PWM started while a PTO runs: the PTO is "
+                      f"aborted", f"pls-mode-{self.number}")
+            self._disable(t)
+        if self.mode == "PWM":
+            target = self.pwm_next if self.pwm_next is not None else self.pwm[1:]
+            if (cycle, width) != tuple(target):
+                self.pwm_next = (cycle, width)
+                self.pwm_asked = t
+            return
+        self.mode = "PWM"
+        self.pwm = (t, cycle, width)
+        self.pwm_next = None
 
 
 def make_outputs(plc: Any) -> list[PulseOutput]:

@@ -166,10 +166,12 @@ class Plc(AddressAccess):
             self.devices = build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices}
         from ..blocks.call import library_call
+        from ..devices.ptowizard.blocks import wizard_call
 
         def setup(unit: Any) -> None:
             unit.hooks["plc"] = self
             unit.hooks["library_call"] = library_call
+            unit.hooks["wizard_call"] = wizard_call
             unit.hooks["timers"] = self.timers
             unit.hooks["counters"] = self.counters
 
@@ -314,6 +316,7 @@ class Plc(AddressAccess):
                 if po.running:
                     _put_bit(pq, po.number, po.level(t_end))
                     po.update_segment(t_end)
+                    po.retire(t_end - 1)
         if self.encoders:
             t_end = now + self.scan_us
             for enc in self.encoders.values():        # the plant's encoders: their levels

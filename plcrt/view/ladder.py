@@ -398,14 +398,15 @@ def _call(insn: ir.Insn, ops: list[str], program: ir.Program | None) -> Box:
         raise NotLad("CALL without a block name")
     name, args = ops[0], ops[1:]
     params: list[tuple[str, bool, str | None]] = []
-    pou = _callee(program, name)
+    base = name.split(":")[0].strip()      # CALL NAME:SBRn names the block twice
+    pou = _callee(program, base)
     if pou is not None:
         params = [(v.name, v.section == "OUT", _kind_of(v.type))
                   for v in pou.variables if v.section != "TEMP"]
     else:
         try:
             from ..blocks.interface import interfaces
-            itf = interfaces().get(name.upper())
+            itf = interfaces().get(base.upper())
         except PlcError:
             itf = None
         if itf is not None:

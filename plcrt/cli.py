@@ -472,6 +472,15 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         drives = plc.drives()
         if drives:
             obj["drives"] = [d.to_dict() | {"flags": d.flags} for d in drives]
+    if plc is not None:
+        pulses, counters = pulse_rows(plc), hsc_rows(plc)
+        if pulses:
+            obj["pulse_outputs"] = [dict(zip(PULSE_COLUMNS, r)) | {"pulses": int(r[2])}
+                                    for r in pulses]
+        if counters:
+            obj["counters"] = [dict(zip(HSC_COLUMNS, r)) | {"mode": int(r[1]), "CV": int(r[2]),
+                                                             "PV": int(r[3])}
+                               for r in counters]
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
@@ -559,15 +568,53 @@ def drive_rows(drives: Sequence[Any]) -> list[list[str]]:
     return rows
 
 
+#: columns of the CPU's pulse output and high-speed counter tables
+PULSE_COLUMNS = ("output", "mode", "pulses", "state")
+HSC_COLUMNS = ("counter", "mode", "CV", "PV", "state")
+
+
+def pulse_rows(plc: Any) -> list[list[str]]:
+    """The pulse outputs Q0.0/Q0.1 that PLS or a wizard block used: mode,
+    pulses sent so far, idle or running."""
+    rows = []
+    now = plc.now_us
+    for po in plc.pulse:
+        sent = po.pulses_until(now)
+        if not po.mode and not sent:
+            continue
+        state = "running" if po.running else "idle"
+        rows.append([f"Q0.{po.number}", po.mode or "-", str(sent), state])
+    return rows
+
+
+def hsc_rows(plc: Any) -> list[list[str]]:
+    """The high-speed counters an HDEF defined: mode, CV, PV, enabled."""
+    rows = []
+    for c in plc.hsc:
+        if c.mode is None:
+            continue
+        c.sync(plc.now_us)
+        state = ("counting" if c.enabled else "disabled") + ("" if c.direction > 0 else ", down")
+        rows.append([f"HSC{c.number}", str(c.mode), str(c.cv), str(c.pv), state])
+    return rows
+
+
 def _print_devices(plc: Any) -> None:
-    """The plant's EM253 axes and bus drives after the watch values."""
+    """The plant's EM253 axes and bus drives, then the CPU's pulse outputs
+    and high-speed counters in use, after the watch values."""
     axes, drives = plc.axes(), plc.drives()
     if axes:
         _print_table(_AXIS_COLUMNS, axis_rows(axes))
     if drives:
         _print_table(DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
+    pulses, counters = pulse_rows(plc), hsc_rows(plc)
+    if pulses:
+        _print_table(PULSE_COLUMNS, pulses, left=(0, 1))
+    if counters:
+        _print_table(HSC_COLUMNS, counters, left=(0,))
     # a plant that only wires the CPU's own inputs has no axes to speak of
-    if not axes and not drives and (plc.modules or not (plc.wiring or plc.encoders)):
+    if not axes and not drives and not pulses and not counters and (
+            plc.modules or not (plc.wiring or plc.encoders)):
         print("axes: none configured in the plant")
 
 

@@ -51,3 +51,25 @@ def test_pto_counted_by_hsc0_exactly():
 def test_the_event_samples_check_clean(name):
     from plcrt.cli import main
     assert main(["check", str(EVENTS / name)]) == 0
+
+
+def test_run_reports_the_pulse_outputs_and_counters_in_use(capsys) -> None:
+    """`plcrt run` lists the pulse outputs PLS used (pulses sent, idle or
+    running) and the counters HDEF defined (mode, CV, PV), as text and JSON."""
+    import json
+
+    from plcrt.cli import main
+
+    args = ["run", str(EVENTS / "pto_count.awl"), "--plant",
+            str(EVENTS / "pto_count_plant.toml"), "--seconds", "1.2",
+            "--set", "M0.0=1"]
+    assert main(args) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[-4:] == ["output  mode  pulses  state", "Q0.0    -       5000  idle",
+                        "counter  mode    CV    PV  state", "HSC0        0  5000  2500  counting"]
+    assert main(args + ["--json"]) == 0
+    obj = json.loads(capsys.readouterr().out)
+    assert obj["pulse_outputs"] == [{"output": "Q0.0", "mode": "-", "pulses": 5000,
+                                     "state": "idle"}]
+    assert obj["counters"] == [{"counter": "HSC0", "mode": 0, "CV": 5000, "PV": 2500,
+                                "state": "counting"}]

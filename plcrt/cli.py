@@ -614,7 +614,7 @@ def _print_devices(plc: Any) -> None:
         _print_table(HSC_COLUMNS, counters, left=(0,))
     # a plant that only wires the CPU's own inputs has no axes to speak of
     if not axes and not drives and not pulses and not counters and (
-            plc.modules or not (plc.wiring or plc.encoders)):
+            plc.modules or not (plc.wiring or plc.encoders or plc.devices)):
         print("axes: none configured in the plant")
 
 

@@ -139,5 +139,7 @@ def build_devices(plc: Any, plant: Any) -> list[Any]:
     """Create the devices a plant describes (table of module kinds)."""
     from .cia402.coupler import FieldbusModule
     from .em253.module import EM253Module
+    from .process import FirstOrderProcess
     kinds = {"EM253": EM253Module, "FIELDBUS": FieldbusModule}
-    return [kinds[m.kind](plc, m) for _, m in sorted(plant.modules.items())]
+    devices = [kinds[m.kind](plc, m) for _, m in sorted(plant.modules.items())]
+    return devices + [FirstOrderProcess(plc, p) for p in plant.processes]

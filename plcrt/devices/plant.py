@@ -108,6 +108,8 @@ class Plant:
     pto: dict[int, PtoConfig] = field(default_factory=dict)
     #: the PWM wizard's time base of Q0.0 / Q0.1 ([pwm.N])
     pwm: dict[int, PwmConfig] = field(default_factory=dict)
+    #: first-order processes between an AQW and an AIW ([[cpu.process]])
+    processes: list[dict[str, Any]] = field(default_factory=list)
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -151,6 +153,7 @@ def _build(data: dict, file: str) -> Plant:
                              f"(a plant file has [module.N] tables, a [cpu] table and "
                              f"[pto.N] / [pwm.N] tables)")
     wiring, encoders = _cpu(data.get("cpu", {}), file)
+    processes = _processes(data.get("cpu", {}).get("process", []), f"{file}: cpu")
     pto = parse_pto(data.get("pto", {}), file)
     pwm = parse_pwm(data.get("pwm", {}), file)
     check_outputs(pto, pwm, file)
@@ -191,7 +194,7 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders, pto, pwm)
+    return Plant(modules, file, wiring, encoders, pto, pwm, processes)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
@@ -204,10 +207,10 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
-    unknown = set(cpu) - {"wire", "encoder"}
+    unknown = set(cpu) - {"wire", "encoder", "process"}
     if unknown:
         raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(known: wire, encoder)")
+                             f"(known: wire, encoder, process)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
@@ -223,6 +226,64 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
 
 
 _ENCODER_KEYS = {"inputs", "hz", "start", "stop", "direction"}
+_PROCESS_KEYS = {"output", "input", "gain", "offset", "tau", "dead_time", "start", "range"}
+_ANALOG_RE = re.compile(r"\s*(AIW|AQW)(\d{1,2})\s*", re.I)
+
+
+def _analog(text: Any, kind: str, where: str) -> int:
+    """The byte offset of an analog word ``AIW0`` / ``AQW2`` (even, 0..62)."""
+    m = _ANALOG_RE.fullmatch(str(text))
+    if m is None or m.group(1).upper() != kind or int(m.group(2)) % 2 or int(m.group(2)) > 62:
+        raise PlcConfigError(f"{where} must be an analog word {kind}0, {kind}2 .. {kind}62, "
+                             f"got {str(text)[:20]!r}")
+    return int(m.group(2))
+
+
+def _number(v: Any, where: str, lo: float, hi: float) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+            or not lo <= v <= hi:
+        raise PlcConfigError(f"{where} must be a number in {lo:g}..{hi:g}, got {v!r}")
+    return float(v)
+
+
+def _processes(raw: Any, where: str) -> list[dict[str, Any]]:
+    """``[[cpu.process]]``: a first-order process from an AQW to an AIW
+    (:mod:`plcrt.devices.process`)."""
+    if not isinstance(raw, list):
+        raise PlcConfigError(f"{where}.process must be an array of tables ([[cpu.process]])")
+    out: list[dict[str, Any]] = []
+    inputs: set[int] = set()
+    for i, p in enumerate(raw):
+        pw = f"{where}.process[{i}]"
+        if not isinstance(p, dict):
+            raise PlcConfigError(f"{pw} must be a table")
+        unknown = set(p) - _PROCESS_KEYS
+        if unknown:
+            raise PlcConfigError(f"{pw}: unknown key(s) {', '.join(sorted(unknown))} "
+                                 f"(known: {', '.join(sorted(_PROCESS_KEYS))})")
+        for key in ("output", "input", "tau"):
+            if key not in p:
+                raise PlcConfigError(f"{pw}: {key} is missing")
+        cfg = {"output": _analog(p["output"], "AQW", f"{pw}.output"),
+               "input": _analog(p["input"], "AIW", f"{pw}.input"),
+               "gain": _number(p.get("gain", 1.0), f"{pw}.gain", -1e6, 1e6),
+               "offset": _number(p.get("offset", 0), f"{pw}.offset", -32768, 32767),
+               "tau": _number(p["tau"], f"{pw}.tau", 1e-6, 1e6),
+               "dead_time": _number(p.get("dead_time", 0.0), f"{pw}.dead_time", 0, 3600)}
+        rng = p.get("range", [0, 32000])
+        if (not isinstance(rng, list) or len(rng) != 2
+                or any(isinstance(x, bool) or not isinstance(x, int) for x in rng)
+                or not -32768 <= rng[0] < rng[1] <= 32767):
+            raise PlcConfigError(f"{pw}.range must be [low, high], whole counts in "
+                                 f"-32768..32767, got {rng!r}")
+        cfg["range"] = (rng[0], rng[1])
+        cfg["start"] = _number(p.get("start", cfg["offset"]), f"{pw}.start", -32768, 32767)
+        if cfg["input"] in inputs:
+            raise PlcConfigError(f"{pw}.input: AIW{cfg['input']} is already driven by "
+                                 f"another process")
+        inputs.add(cfg["input"])
+        out.append(cfg)
+    return out
 
 
 def _input(text: Any, where: str) -> int:

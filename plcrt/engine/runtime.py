@@ -39,6 +39,7 @@ from .events import Scheduler
 from .interrupts import Interrupts
 from .edges import SignalEdges
 from .hsc import Encoder, make_counters
+from .pid import make_loops
 from .pulse import make_outputs
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
@@ -123,6 +124,8 @@ class Plc(AddressAccess):
         self.interrupts.attach_timer_events(self.timers)
         #: the CPU's pulse outputs Q0.0 and Q0.1 (PLS)
         self.pulse = make_outputs(self)
+        #: the PID loops 0..7 (PID)
+        self.pid = make_loops(self)
         #: input bit number (I0.0 = 0) -> the output bit (Q0.0 = 0) wired to it in the plant
         self.wiring: dict[int, int] = dict(getattr(plant, "wiring", None) or {})
         #: input bit number -> the plant's encoder signal on it
@@ -164,7 +167,7 @@ class Plc(AddressAccess):
         if plant is not None:
             from ..devices import build_devices
             self.devices = build_devices(self, plant)
-            self.modules = {d.slot: d for d in self.devices}
+            self.modules = {d.slot: d for d in self.devices if d.slot is not None}
         from ..blocks.call import library_call
         from ..devices.ptowizard.blocks import wizard_call
 
@@ -593,6 +596,7 @@ class Plc(AddressAccess):
                                         (self.counters, dst.counters),
                                         (self.interrupts, dst.interrupts),
                                         *zip(self.pulse, dst.pulse),
+                                        (self.pid, dst.pid),
                                         (self.edges, dst.edges),
                                         *zip(self.hsc, dst.hsc)]
         pairs += list(zip(self.devices, dst.devices))
@@ -621,7 +625,7 @@ class Plc(AddressAccess):
         for (_, b), state in zip(pairs, states):
             b.__dict__.clear()
             b.__dict__.update(state)
-        dst.modules = {d.slot: d for d in dst.devices}
+        dst.modules = {d.slot: d for d in dst.devices if d.slot is not None}
         dst._int_l[:] = self._int_l
         dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
         dst._defined[:] = [dst.hsc[c.number] for c in self._defined]

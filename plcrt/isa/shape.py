@@ -115,6 +115,8 @@ _LAD: dict[str, tuple[str, str]] = {
     # high-speed outputs (System Manual, PLS: the box's Q0.X input)
     "PLS": ("PLS", "Q0_X=0"),
     "HDEF": ("HDEF", "HSC=0 MODE=1"), "HSC": ("HSC", "N=0"),
+    # the PID loop (System Manual, PID: the table and the loop number)
+    "PID": ("PID", "TBL=0 LOOP=1"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),
     # rail elements: coils, or boxes (a name without parentheses)

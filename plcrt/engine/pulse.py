@@ -331,7 +331,13 @@ class PulseOutput:
         for tr in self.trains:          # perf: no generator on the event path
             if t < tr.start:
                 break
-            n += tr.pulses_started(t)
+            if t >= tr.end:
+                n += tr.count
+            elif tr.delta == 0:
+                # perf: the constant-cycle train inline (t < end: never past count)
+                n += (t - tr.start) // tr.c0 + 1
+            else:
+                n += tr.pulses_started(t)
         return n
 
     def level(self, t: int) -> int:

@@ -24,6 +24,7 @@ from ..lang import ir
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .emit import CodegenError, Gen
+from .operands import string_codepage
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
 #: S7-200: subroutines nest at most eight levels (System Manual, CALL).
@@ -367,7 +368,8 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
     for info in unit.pous.values():
         p = info.pou
         unit.current = info
-        resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars)
+        resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars,
+                            string_codepage(unit.program.encoding))
         fnames: list[str] = []
         for piece in info.pieces:
             unit.current_piece = piece

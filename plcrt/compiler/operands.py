@@ -70,7 +70,10 @@ class Addr:
 
 @dataclass(frozen=True, slots=True)
 class Const:
-    """A literal: ``int``, ``float`` (REAL) or ``bytes`` (ASCII/string)."""
+    """A literal: ``int``, ``float`` (REAL) or ``bytes`` (ASCII/string).
+
+    A string constant (``is_string``) holds its length byte followed by the
+    characters, exactly as the string is laid out in memory."""
 
     value: int | float | bytes
     text: str = ""
@@ -126,7 +129,9 @@ def parse_constant(text: str) -> Const | None:
     if too_many_digits(t) and t[0] not in "'\"":
         raise OperandError(f"{excerpt(t)}: a number with more than {MAX_DIGITS} digits is "
                            f"out of range")
-    if t[0] == "'" or t[0] == '"':
+    if t[0] == '"':
+        return string_constant(t, DEFAULT_CODEPAGE)
+    if t[0] == "'":
         if len(t) < 2 or t[-1] != t[0]:
             raise OperandError(f"unterminated literal {excerpt(text)!r}")
         body = t[1:-1]
@@ -135,7 +140,7 @@ def parse_constant(text: str) -> Const | None:
         except UnicodeEncodeError:
             raise OperandError(f"literal {excerpt(text)!r} holds characters outside "
                                f"one byte") from None
-        return Const(data, text, is_string=t[0] == '"')
+        return Const(data, text)
     m = _HEX_RE.fullmatch(t)
     if m:
         return Const(int(m.group(1).replace("_", ""), 16), text)
@@ -155,6 +160,73 @@ def parse_constant(text: str) -> Const | None:
     if up in ("FALSE", "OFF"):
         return Const(0, text)
     return None
+
+
+#: The code page of string constants when the program text does not name one
+#: (a program read as ASCII, UTF-8 or UTF-16, or given as text): the Western
+#: Windows code page Micro/WIN uses on an English or German PC.
+DEFAULT_CODEPAGE = "cp1252"
+
+#: Longest S7-200 string: a length byte of 0..254 (System Manual, "Data
+#: types": a string is a length byte followed by up to 254 characters).
+MAX_STRING = 254
+
+
+def string_codepage(encoding: str) -> str:
+    """The code page string constants are stored in, for a program decoded
+    with ``encoding``: that code page itself when it is one (``cp1252``,
+    ``gbk``, ...), else :data:`DEFAULT_CODEPAGE`."""
+    e = (encoding or "").lower().replace("_", "-")
+    if not e or e.startswith(("utf", "ascii", "us-ascii")):
+        return DEFAULT_CODEPAGE
+    return encoding
+
+
+def string_bytes(body: str, codepage: str) -> bytes:
+    """The characters of a string constant in ``codepage``.
+
+    Raises:
+        OperandError: a character that code page cannot hold (the message
+            names it and its position), or more than 254 bytes.
+    """
+    try:
+        data = body.encode(codepage)
+    except UnicodeEncodeError as e:
+        ch = body[e.start]
+        raise OperandError(f"character {excerpt(ch)!r} (U+{ord(ch):04X}, position "
+                           f"{e.start + 1}) is not in code page {codepage.upper()}") from None
+    except LookupError:
+        raise OperandError(f"unknown code page {excerpt(codepage)!r}") from None
+    if len(data) > MAX_STRING:
+        raise OperandError(f"a string holds at most {MAX_STRING} characters, this one "
+                           f"has {len(data)} bytes")
+    return data
+
+
+def string_constant(text: str, codepage: str) -> Const:
+    """A double-quoted string constant (``"ABC"``) as a :class:`Const`
+    holding the length byte and the characters in ``codepage``.
+
+    Inside the quotes a doubled quote (``""``) stands for one, as in the
+    STL grammar and the data block; every other character, ``$`` included,
+    stands for itself (docs/decisions.md, "Strings").
+
+    Raises:
+        OperandError: unterminated or malformed literal, a character outside
+            the code page, or more than 254 characters.
+    """
+    t = text.strip()
+    if len(t) < 2 or t[0] != '"' or t[-1] != '"':
+        raise OperandError(f"unterminated string constant {excerpt(text)!r}")
+    raw = t[1:-1]
+    if raw.replace('""', "").count('"'):
+        raise OperandError(f"string constant {excerpt(text)!r}: a quote inside the "
+                           f"string is written twice (\"\")")
+    try:
+        data = string_bytes(raw.replace('""', '"'), codepage)
+    except OperandError as e:
+        raise OperandError(f"string constant {excerpt(text)!r}: {e}") from None
+    return Const(bytes((len(data),)) + data, text, is_string=True)
 
 
 def _check_range(model: CpuModel, area: str, offset: int, width: int, text: str) -> None:

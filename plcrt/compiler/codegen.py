@@ -21,10 +21,10 @@ from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
+from ..lang.codepage import string_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .emit import CodegenError, Gen
-from .operands import string_codepage
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
 #: S7-200: subroutines nest at most eight levels (System Manual, CALL).

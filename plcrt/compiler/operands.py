@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Union
 
 from ..memory.cpu import CpuModel
+from ..lang.codepage import DEFAULT_CODEPAGE, string_bytes
 from ..lang.limits import MAX_DIGITS, too_many_digits
 from ..safetext import excerpt
 
@@ -162,47 +163,6 @@ def parse_constant(text: str) -> Const | None:
     return None
 
 
-#: The code page of string constants when the program text does not name one
-#: (a program read as ASCII, UTF-8 or UTF-16, or given as text): the Western
-#: Windows code page Micro/WIN uses on an English or German PC.
-DEFAULT_CODEPAGE = "cp1252"
-
-#: Longest S7-200 string: a length byte of 0..254 (System Manual, "Data
-#: types": a string is a length byte followed by up to 254 characters).
-MAX_STRING = 254
-
-
-def string_codepage(encoding: str) -> str:
-    """The code page string constants are stored in, for a program decoded
-    with ``encoding``: that code page itself when it is one (``cp1252``,
-    ``gbk``, ...), else :data:`DEFAULT_CODEPAGE`."""
-    e = (encoding or "").lower().replace("_", "-")
-    if not e or e.startswith(("utf", "ascii", "us-ascii")):
-        return DEFAULT_CODEPAGE
-    return encoding
-
-
-def string_bytes(body: str, codepage: str) -> bytes:
-    """The characters of a string constant in ``codepage``.
-
-    Raises:
-        OperandError: a character that code page cannot hold (the message
-            names it and its position), or more than 254 bytes.
-    """
-    try:
-        data = body.encode(codepage)
-    except UnicodeEncodeError as e:
-        ch = body[e.start]
-        raise OperandError(f"character {excerpt(ch)!r} (U+{ord(ch):04X}, position "
-                           f"{e.start + 1}) is not in code page {codepage.upper()}") from None
-    except LookupError:
-        raise OperandError(f"unknown code page {excerpt(codepage)!r}") from None
-    if len(data) > MAX_STRING:
-        raise OperandError(f"a string holds at most {MAX_STRING} characters, this one "
-                           f"has {len(data)} bytes")
-    return data
-
-
 def string_constant(text: str, codepage: str) -> Const:
     """A double-quoted string constant (``"ABC"``) as a :class:`Const`
     holding the length byte and the characters in ``codepage``.
@@ -224,7 +184,7 @@ def string_constant(text: str, codepage: str) -> Const:
                            f"string is written twice (\"\")")
     try:
         data = string_bytes(raw.replace('""', '"'), codepage)
-    except OperandError as e:
+    except ValueError as e:
         raise OperandError(f"string constant {excerpt(text)!r}: {e}") from None
     return Const(bytes((len(data),)) + data, text, is_string=True)
 

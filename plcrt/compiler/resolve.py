@@ -14,10 +14,11 @@ from typing import Any, Mapping
 
 from ..isa.registry import Role
 from ..lang import ir
+from ..lang.codepage import DEFAULT_CODEPAGE
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
-from .operands import (DEFAULT_CODEPAGE, Addr, Const, Indirect, Name, OperandError,
-                       Pointer, Resolved, parse_operand, string_constant)
+from .operands import (Addr, Const, Indirect, Name, OperandError, Pointer, Resolved,
+                       parse_operand, string_constant)
 
 TYPE_WIDTH = {"BOOL": 0, "BYTE": 1, "CHAR": 1, "WORD": 2, "INT": 2,
               "DWORD": 4, "DINT": 4, "REAL": 4}

@@ -41,9 +41,10 @@ from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
 from ..compiler.emit import Gen
-from ..compiler.operands import MAX_STRING, Addr, Const, Indirect
+from ..compiler.operands import Addr, Const, Indirect
 from ..compiler.rt import to_f32
 from ..errors import PlcRuntimeError, SourceLoc
+from ..lang.codepage import MAX_STRING
 from .registry import Role, insn
 
 F = "string"

@@ -172,7 +172,9 @@ def rts(value: float, fmt: int, dst: Ref) -> int:
     size, nnn = fmt >> 4, fmt & 7
     if size < 3:
         return 0
-    if nnn > 5 or size < nnn + 3 or value != value or value in (float("inf"), float("-inf")):
+    if nnn > 5 or size < nnn + 3 or not abs(value) < 10.0 ** size:
+        # (NaN and the infinities fail the last test; a value that has more
+        # whole digits than the string has characters cannot fit either)
         return _blank(dst, size)
     q = Decimal(value).quantize(Decimal(1).scaleb(-nnn), rounding=ROUND_HALF_UP)
     if q == 0:

@@ -36,7 +36,7 @@ outputs are fixed-size buffers without a length byte) live elsewhere.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
@@ -287,7 +287,7 @@ def _slen(g: Gen, src, out) -> None:
             g.eno("1")
 
 
-def _helper_box(g: Gen, fn, hint: str, *args: str) -> None:
+def _helper_box(g: Gen, fn: Callable[..., int], hint: str, *args: str) -> None:
     """A box whose helper does all the work and returns ENO."""
     helper = g.bind(fn, hint)
     with g.box():
@@ -312,7 +312,7 @@ def _sscpy(g: Gen, src, indx, n, dst) -> None:
     _helper_box(g, sscpy, "sscpy", _ref(g, src), g.rd(indx, "B"), g.rd(n, "B"), _ref(g, dst))
 
 
-def _make_find(mn: str, fn, summary: str) -> None:
+def _make_find(mn: str, fn: Callable[[Ref, Ref, int], int | None], summary: str) -> None:
     def emit(g: Gen, hay, needle, out) -> None:
         helper = g.bind(fn, mn.lower())
         with g.box():

@@ -18,12 +18,13 @@ Errors and flags (docs/decisions.md, "Strings", has every choice):
   written; SLEN, SCPY, SCAT, SSCPY, SFND and CFND change no SM bit.
 * SCAT never makes a string longer than 254: it appends what fits and sets
   ENO 0 when it had to cut.
-* SSCPY, SFND and CFND with an index of 0 (009B) or one past what the
-  string holds: ENO 0, OUT unchanged.  SFND/CFND write 0 when nothing is
-  found (ENO 1).
-* ITS/DTS/RTS: an illegal format writes spaces (nnn > 5, a number that does
-  not fit RTS's ssss) and sets ENO 0; format bits the instruction does not
-  have set (ITS/DTS high nibble, RTS ssss < 3) leave OUT unchanged, ENO 0.
+* SSCPY, SFND and CFND with an index of 0 (009B), or an index or range
+  past the end of the string: ENO 0, OUT unchanged.  SFND/CFND write 0 when
+  nothing is found (ENO 1).
+* ITS/DTS/RTS: nnn > 5, or a number that does not fit RTS's ssss
+  characters, writes a string of spaces and sets ENO 0; a FMT the
+  instruction cannot use at all (ITS/DTS high nibble set, RTS ssss < 3)
+  leaves OUT unchanged, ENO 0.
 * STI/STD/STR: no number at INDX or a value too large for OUT sets SM1.1,
   leaves OUT unchanged, ENO 0; a conversion clears SM1.1.  INDX is an input
   only (the manual lists constants for it), it is not written back.
@@ -41,7 +42,7 @@ from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
 from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const, Indirect
+from ..compiler.operands import Addr, Const, Indirect, area_size
 from ..compiler.rt import to_f32
 from ..errors import PlcRuntimeError, SourceLoc
 from ..lang.codepage import MAX_STRING
@@ -273,11 +274,34 @@ def _ref(g: Gen, op: Any) -> str:
     return f"({buf}, {off})"
 
 
+def _room(g: Gen, op: Any) -> int | None:
+    """For a direct V address: how many characters fit between it and the end
+    of V memory (at most 254), known at compile time; else None."""
+    if isinstance(op, Addr) and op.area == "V":
+        return min(MAX_STRING, area_size(g.unit.model, "V") - op.offset - 1)
+    return None
+
+
 @insn("SLEN", Role.STR_R, Role.B_W, family=F, may_fail=True,
       summary="OUT := length of the string IN")
 def _slen(g: Gen, src, out) -> None:
     read = g.bind(read_string, "sread")
+    room = _room(g, src)
     with g.box():
+        if isinstance(src, Const):
+            g.wr(out, "B", str(src.value[0]))
+            g.eno("1")
+            return
+        if room is not None:
+            # perf: the length byte itself, checked against a constant bound
+            n = g.tmp("n")
+            g.line(f"{n} = {g.use('V')}[{src.offset}]")
+            with g.block(f"if {n} <= {room}:"):
+                g.wr(out, "B", n, exact=True)
+                g.eno("1")
+            with g.block("else:"):
+                g.line("eno = 0")
+            return
         s = g.tmp("s")
         g.line(f"{s} = {read}({_ref(g, src)})")
         with g.block(f"if {s} is None:"):
@@ -392,13 +416,28 @@ COMBINE = {"LD": "push", "A": "&=", "O": "|="}
 RELATIONS = {"=": "", "<>": "1 - "}
 
 
+def _constant_compare(g: Gen, mem: Any, const: Any) -> tuple[str, str] | None:
+    """(``V[a:b]``, bound bytes) for a V string compared with a constant, when
+    no string at that address can run past the end of V memory (so the fatal
+    error cannot happen); else None."""
+    if not isinstance(const, Const) or _room(g, mem) != MAX_STRING:
+        return None
+    # perf: one slice compare of the length byte and characters, no call
+    data = g.bind(bytes(const.value), "str")
+    return f"{g.use('V')}[{mem.offset}:{mem.offset + len(const.value)}]", data
+
+
 def _make_compare(prefix: str, rel: str) -> None:
     how, negate = COMBINE[prefix], RELATIONS[rel]
 
     def emit(g: Gen, a, b) -> None:
-        helper = g.bind(string_equal, "streq")
-        expr = (f"{negate}{helper}({_ref(g, a)}, {_ref(g, b)}, {g.insn_id}, "
-                f"{g.use('_LOCS')})")
+        fast = _constant_compare(g, a, b) or _constant_compare(g, b, a)
+        if fast is not None:
+            expr = f"(1 if {fast[0]} {'!=' if negate else '=='} {fast[1]} else 0)"
+        else:
+            helper = g.bind(string_equal, "streq")
+            expr = (f"{negate}{helper}({_ref(g, a)}, {_ref(g, b)}, {g.insn_id}, "
+                    f"{g.use('_LOCS')})")
         if how == "push":
             g.push(expr)
         else:

@@ -21,10 +21,12 @@ import plcrt
 from plcrt.engine.runtime import parse_sources
 from plcrt.isa.registry import KNOWN_UNIMPLEMENTED, lookup
 from plcrt.isa.shape import shape
+from plcrt.memory import cpu_model
 from plcrt.view.ladder import Box, Contact, to_ladder
 from stl_helpers import ob1_text
 
 SPACE8 = b" " * 8
+V_SIZE = cpu_model(None).v_bytes  #: V memory of the default CPU
 
 
 def _program(lines: list[str]) -> str:
@@ -313,6 +315,32 @@ def test_string_compare_past_memory_is_fatal():
     with pytest.raises(plcrt.PlcRuntimeError, match="past the end of memory") as e:
         p.scan()
     assert e.value.loc.line == 4
+
+
+def test_string_compare_near_the_end_of_v_is_checked():
+    """A direct string near the end of V memory is still checked against its end."""
+    size = V_SIZE
+    p = plcrt.load(ob1_text(f'LDS= VB{size - 2}, "A"\n= Q0.0'))
+    p.mem.areas["V"][size - 2] = 9
+    with pytest.raises(plcrt.PlcRuntimeError, match="past the end of memory"):
+        p.scan()
+    p2 = plcrt.load(ob1_text(f'LDS= VB{size - 2}, "A"\n= Q0.0'))
+    p2.mem.areas["V"][size - 2:] = b"\x01A"
+    p2.scan()
+    assert p2["Q0.0"] == 1
+
+
+def test_slen_near_the_end_of_v():
+    """SLEN of a direct string whose length runs past the end of V is ENO 0."""
+    size = V_SIZE
+    p = plcrt.load(_program([f"SLEN VB{size - 3}, VB0", "AENO", "= Q0.0"]))
+    p.mem.areas["V"][size - 3] = 3
+    p["VB0"] = 7
+    p.scan()
+    assert (p["VB0"], p["Q0.0"]) == (7, 0)
+    p.mem.areas["V"][size - 3] = 2
+    p.scan()
+    assert (p["VB0"], p["Q0.0"]) == (2, 1)
 
 
 def test_string_past_memory_is_out_of_range():

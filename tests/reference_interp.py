@@ -467,13 +467,13 @@ class ReferencePlc:
             raise Unsupported(f"string operand {text}")
         return self.mem["V"], a.offset
 
-    def read_string(self, text: str, limit: int = MAX_STRING) -> bytes | None:
+    def read_string(self, text: str) -> bytes | None:
         """The characters of a string operand, or None if it is out of range."""
         if text.startswith('"'):
             return text[1:-1].replace('""', '"').encode("cp1252")
         buf, offset = self._string_place(text)
         length = buf[offset]
-        if length > limit or offset + 1 + length > len(buf):
+        if length > MAX_STRING or offset + 1 + length > len(buf):
             return None
         return bytes(buf[offset + 1:offset + 1 + length])
 
@@ -486,9 +486,9 @@ class ReferencePlc:
         match = STRING_COMPARE_RE.fullmatch(mnemonic)
         assert match is not None
         how, relation = match.groups()
-        a, b = self.read_string(ops[0], 255), self.read_string(ops[1], 255)
+        a, b = self.read_string(ops[0]), self.read_string(ops[1])
         if a is None or b is None:
-            raise Unsupported("string compare past the end of memory (fatal)")
+            raise Unsupported("compare of an invalid string (a fatal error)")
         result = int((a == b) == (relation == "="))
         if how == "LD":
             self.push(result)

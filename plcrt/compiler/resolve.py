@@ -185,7 +185,7 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
         raise _bad(text, role)
     if role in (Role.BIT_R, Role.BIT_W, Role.BIT_TC, Role.IBIT, Role.QBIT, Role.SBIT):
         return _check_bit(op, role, text, model)
-    if role in (Role.STR_R, Role.STR_W):
+    if role in (Role.STR_R, Role.STR_M, Role.STR_W):
         return _check_string(op, role, text)
     width = _VALUE_WIDTH[role]
     writing = role in _WRITE_ROLES
@@ -257,6 +257,8 @@ def _check_string(op: Resolved, role: Role, text: str) -> Resolved:
     if isinstance(op, Const):
         if role is Role.STR_W:
             raise _bad(text, role, "a constant cannot be written")
+        if role is Role.STR_M:
+            raise _bad(text, role, "a string constant can only be the first operand")
         if not op.is_string:
             raise _bad(text, role, 'a string constant is written in double quotes: "ABC"')
         return op

@@ -46,7 +46,8 @@ class Role(enum.Enum):
     LABEL = "label number (0..255)"
     SBIT = "SCR bit (S)"
     STR_R = 'string (VB, LB, *VD, *LD, *AC or a constant "...")'  #: string input
-    STR_W = "string (VB, LB, *VD, *LD, *AC)"   #: string output
+    STR_M = "string in memory (VB, LB, *VD, *LD, *AC)"  #: string input, no constant
+    STR_W = "writable string (VB, LB, *VD, *LD, *AC)"  #: string output
     NONE = "-"
 
 

@@ -28,8 +28,9 @@ Errors and flags (docs/decisions.md, "Strings", has every choice):
 * STI/STD/STR: no number at INDX or a value too large for OUT sets SM1.1,
   leaves OUT unchanged, ENO 0; a conversion clears SM1.1.  INDX is an input
   only (the manual lists constants for it), it is not written back.
-* The compares have no ENO: a string that runs past the end of memory stops
-  the CPU (a fatal error, as an illegal indirect address in any compare).
+* The compares have no ENO: a string longer than 254 characters, or one
+  that runs past the end of its memory area, stops the CPU (System Manual,
+  "Compare string": fatal errors).  Only IN1 may be a constant.
 
 What this module is not: the ASCII conversions ITA/DTA/RTA/ATH/HTA (their
 outputs are fixed-size buffers without a length byte) live elsewhere.
@@ -247,15 +248,23 @@ def sto(src: Ref, indx: int, kind: str) -> tuple[int, int | float]:
 def string_equal(a: Ref, b: Ref, insn_id: int, locs: Sequence[SourceLoc]) -> int:
     """1 when the two strings hold the same characters (compare string).
 
-    The length bytes are taken as they are (255 included); a string that
-    runs past the end of its area stops the CPU, like an illegal address in
-    any compare (System Manual, "Compare instructions": fatal errors)."""
+    A string longer than 254 characters, or one that runs past the end of
+    its area, stops the CPU (System Manual, "Compare string": both are
+    fatal errors)."""
     (abuf, aoff), (bbuf, boff) = a, b
     na, nb = abuf[aoff], bbuf[boff]
+    if na > MAX_STRING or nb > MAX_STRING:
+        string_too_long(insn_id, locs)
     if aoff + 1 + na > len(abuf) or boff + 1 + nb > len(bbuf):
         raise PlcRuntimeError("string compare reads past the end of memory; the CPU "
                               "goes to STOP", locs[insn_id])
     return int(na == nb and abuf[aoff + 1:aoff + 1 + na] == bbuf[boff + 1:boff + 1 + nb])
+
+
+def string_too_long(insn_id: int, locs: Sequence[SourceLoc]) -> None:
+    """Raise the fatal error of a compare that meets a length byte over 254."""
+    raise PlcRuntimeError("string compare of a string longer than 254 characters; the "
+                          "CPU goes to STOP", locs[insn_id])
 
 
 # -- emitters ------------------------------------------------------------------------
@@ -422,16 +431,20 @@ def _constant_compare(g: Gen, mem: Any, const: Any) -> tuple[str, str] | None:
     error cannot happen); else None."""
     if not isinstance(const, Const) or _room(g, mem) != MAX_STRING:
         return None
-    # perf: one slice compare of the length byte and characters, no call
+    # perf: one slice compare of the length byte and characters, no call;
+    # only a length byte over 254 needs the fatal error first
+    v = g.use("V")
+    with g.block(f"if {v}[{mem.offset}] > {MAX_STRING}:"):
+        g.line(f"{g.bind(string_too_long, 'strlong')}({g.insn_id}, {g.use('_LOCS')})")
     data = g.bind(bytes(const.value), "str")
-    return f"{g.use('V')}[{mem.offset}:{mem.offset + len(const.value)}]", data
+    return f"{v}[{mem.offset}:{mem.offset + len(const.value)}]", data
 
 
 def _make_compare(prefix: str, rel: str) -> None:
     how, negate = COMBINE[prefix], RELATIONS[rel]
 
     def emit(g: Gen, a, b) -> None:
-        fast = _constant_compare(g, a, b) or _constant_compare(g, b, a)
+        fast = _constant_compare(g, b, a)
         if fast is not None:
             expr = f"(1 if {fast[0]} {'!=' if negate else '=='} {fast[1]} else 0)"
         else:
@@ -444,7 +457,7 @@ def _make_compare(prefix: str, rel: str) -> None:
             g.line(f"{g.top} {how} {expr}" if not negate else f"{g.top} {how} ({expr})")
 
     verb = {"push": "push", "&=": "AND", "|=": "OR"}[how]
-    insn(f"{prefix}S{rel}", Role.STR_R, Role.STR_R, family=F,
+    insn(f"{prefix}S{rel}", Role.STR_R, Role.STR_M, family=F,
          summary=f"{verb} IN1 {rel} IN2 (strings)")(emit)
 
 

@@ -72,8 +72,14 @@ DWORD_CONST = ("0", "1", "-1", "+2", "32767", "32768", "-32768", "65536", "+1000
 #: Strings start in the seeded bytes, so their length bytes are random (255,
 #: out of range, included); constants cover quoting and the number forms.
 STRING_AT = ("VB0", "VB3", "VB6", "VB9")
-STRING_READ = STRING_AT + ('"AB"', '""', '"  -12,5x"', '"A""1b2"', '"+7.25"')
-STRING_WRITE = STRING_AT + ("VB20", "VB40")
+#: Compared strings: their length bytes are written only by string
+#: instructions, which write valid strings, and no other string reaches them
+#: (a string at VB20 ends by VB275); a compare of an invalid string would stop
+#: the CPU.  IN1 of a compare may be a constant.
+STRING_COMPARED = ("VB300", "VB600")
+STRING_READ = STRING_AT + ("VB300", '"AB"', '""', '"  -12,5x"', '"A""1b2"', '"+7.25"')
+STRING_WRITE = STRING_AT + ("VB20",) + STRING_COMPARED
+STRING_COMPARE_IN1 = STRING_COMPARED + ('"AB"', '""', '"A""1b2"')
 STRING_INDEX = ("0", "1", "2", "3", "9", "VB1", "VB4", "VB7")
 STRING_FORMATS = ("0", "3", "5", "6", "16#0B", "16#13", "16#30", "16#61", "16#A6", "16#F5",
                   "VB2", "VB5")
@@ -102,7 +108,7 @@ SCAN_MS = (10, 20, 50, 100, 130, 1000, 7000, 60000)
 
 #: Width letter -> operands an input may be (addresses and constants).
 VALUE_INPUTS = {w: reads + consts for w, (reads, _writes, consts) in POOLS.items()}
-VALUE_INPUTS["S"] = STRING_READ
+VALUE_INPUTS["S"] = STRING_COMPARE_IN1
 
 BIT_LOADS = tuple(f"{m} {b}" for m in ("LD", "LDN") for b in BIT_READ)
 BIT_COMBINES = tuple(f"{m} {b}" for m in ("A", "AN", "O", "ON") for b in BIT_READ)
@@ -143,7 +149,8 @@ _CHOICES: dict[tuple, st.SearchStrategy] = {}
 def _compare_insn(draw: st.DrawFn, prefix: str) -> str:
     mnemonic, width = draw(_choice(COMPARES[prefix]))
     inputs = _choice(VALUE_INPUTS[width])
-    return f"{mnemonic} {draw(inputs)}, {draw(inputs)}"
+    second = _choice(STRING_COMPARED) if width == "S" else inputs
+    return f"{mnemonic} {draw(inputs)}, {draw(second)}"
 
 
 COMPARE_INSN = {prefix: _compare_insn(prefix) for prefix in COMPARES}

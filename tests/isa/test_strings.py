@@ -265,20 +265,20 @@ def test_str_values(text, indx, value):
 # -- compares --------------------------------------------------------------------
 
 @pytest.mark.parametrize("lines,strings,expect", [
-    (['LDS= VB0, "ABC"'], {0: b"ABC"}, 1),
-    (['LDS= VB0, "ABC"'], {0: b"ABD"}, 0),
-    (['LDS= VB0, "ABC"'], {0: b"AB"}, 0),
-    (['LDS= VB0, "AB"'], {0: b"ABC"}, 0),
-    (['LDS= VB0, ""'], {0: b""}, 1),
-    (['LDS<> VB0, "ABC"'], {0: b"ABC"}, 0),
-    (['LDS<> VB0, "ABC"'], {0: b"abc"}, 1),
+    (['LDS= "ABC", VB0'], {0: b"ABC"}, 1),
+    (['LDS= "ABC", VB0'], {0: b"ABD"}, 0),
+    (['LDS= "ABC", VB0'], {0: b"AB"}, 0),
+    (['LDS= "AB", VB0'], {0: b"ABC"}, 0),
+    (['LDS= "", VB0'], {0: b""}, 1),
+    (['LDS<> "ABC", VB0'], {0: b"ABC"}, 0),
+    (['LDS<> "ABC", VB0'], {0: b"abc"}, 1),
     (["LDS= VB0, VB100"], {0: b"XY", 100: b"XY"}, 1),
     (['LDS= "XY", VB100'], {100: b"XY"}, 1),
-    (['LD SM0.0', 'AS= VB0, "A"'], {0: b"A"}, 1),
-    (['LD SM0.0', 'AS<> VB0, "A"'], {0: b"A"}, 0),
-    (['LDN SM0.0', 'OS= VB0, "A"'], {0: b"A"}, 1),
-    (['LDN SM0.0', 'OS<> VB0, "A"'], {0: b"A"}, 0),
-    (['LDN SM0.0', 'AS= VB0, "A"'], {0: b"A"}, 0),
+    (['LD SM0.0', 'AS= "A", VB0'], {0: b"A"}, 1),
+    (['LD SM0.0', 'AS<> "A", VB0'], {0: b"A"}, 0),
+    (['LDN SM0.0', 'OS= "A", VB0'], {0: b"A"}, 1),
+    (['LDN SM0.0', 'OS<> "A", VB0'], {0: b"A"}, 0),
+    (['LDN SM0.0', 'AS= "A", VB0'], {0: b"A"}, 0),
 ])
 def test_string_compares(lines, strings, expect):
     """LDS=/AS=/OS= push, AND or OR 'same characters'; <> is its negation."""
@@ -291,7 +291,7 @@ def test_string_compares(lines, strings, expect):
 
 def test_string_compare_runs_without_power_flow():
     """Compares run regardless of power flow: OS= after a 0 still ORs in its result."""
-    p = plcrt.load(ob1_text('LDN SM0.0\nLPS\nOS= VB0, "Q"\n= Q0.0\nLPP\n= Q0.1'))
+    p = plcrt.load(ob1_text('LDN SM0.0\nLPS\nOS= "Q", VB0\n= Q0.0\nLPP\n= Q0.1'))
     put(p, 0, b"Q")
     p.scan()
     assert (p["Q0.0"], p["Q0.1"]) == (1, 0)
@@ -300,7 +300,7 @@ def test_string_compare_runs_without_power_flow():
 def test_lds_logic_stack_instruction_is_undisturbed():
     """`LDS n` (copy a stack level) and `LDS=` (string compare) live side by side."""
     p = plcrt.load(ob1_text('LD SM0.0\nLDN SM0.0\nLDS 1\n= Q0.0\nLPP\n= Q0.1\n'
-                            'LDS= VB0, "A"\n= Q0.2'))
+                            'LDS= "A", VB0\n= Q0.2'))
     put(p, 0, b"A")
     p.scan()
     assert (p["Q0.0"], p["Q0.1"], p["Q0.2"]) == (1, 0, 1)
@@ -308,7 +308,7 @@ def test_lds_logic_stack_instruction_is_undisturbed():
 
 def test_string_compare_past_memory_is_fatal():
     """A compare string that runs past the end of V memory stops the CPU at the compare."""
-    p = plcrt.load(ob1_text('LDS= *VD4, "A"\n= Q0.0'))
+    p = plcrt.load(ob1_text('LDS= "A", *VD4\n= Q0.0'))
     size = len(p.mem.areas["V"])
     p["VD4"] = 0x08000000 | (size - 2)
     p.mem.areas["V"][size - 2] = 9
@@ -317,14 +317,25 @@ def test_string_compare_past_memory_is_fatal():
     assert e.value.loc.line == 4
 
 
+@pytest.mark.parametrize("line", ['LDS= "A", VB0', "LDS= VB0, VB100", "LDS<> VB100, VB0",
+                                  'LDS= "A", *VD200'])
+def test_string_compare_of_a_too_long_string_is_fatal(line):
+    """A length byte over 254 in a compare string stops the CPU (manual: fatal error)."""
+    p = plcrt.load(ob1_text(f"{line}\n= Q0.0"))
+    p["VB0"] = 255
+    p["VD200"] = 0x08000000
+    with pytest.raises(plcrt.PlcRuntimeError, match="longer than 254"):
+        p.scan()
+
+
 def test_string_compare_near_the_end_of_v_is_checked():
     """A direct string near the end of V memory is still checked against its end."""
     size = V_SIZE
-    p = plcrt.load(ob1_text(f'LDS= VB{size - 2}, "A"\n= Q0.0'))
+    p = plcrt.load(ob1_text(f'LDS= "A", VB{size - 2}\n= Q0.0'))
     p.mem.areas["V"][size - 2] = 9
     with pytest.raises(plcrt.PlcRuntimeError, match="past the end of memory"):
         p.scan()
-    p2 = plcrt.load(ob1_text(f'LDS= VB{size - 2}, "A"\n= Q0.0'))
+    p2 = plcrt.load(ob1_text(f'LDS= "A", VB{size - 2}\n= Q0.0'))
     p2.mem.areas["V"][size - 2:] = b"\x01A"
     p2.scan()
     assert p2["Q0.0"] == 1
@@ -384,6 +395,8 @@ def test_string_constant_in_the_file_code_page(tmp_path: Path):
     ('MOVB "A", VB0', "only valid where a string is"),
     ("SCPY 'ABC', VB0", "double quotes"),
     ('SCPY VB0, "ABC"', "cannot be written"),
+    ('LDS= VB0, "ABC"', "only be the first operand"),
+    ('AS<> VB0, "ABC"', "only be the first operand"),
     ("SCPY VW0, VB2", "length byte"),
     ("SCPY MB0, VB2", "length byte"),
     ("SLEN VB0, VW2", "byte"),
@@ -400,7 +413,7 @@ def test_bad_string_operands_are_located_errors(line, fragment):
 def test_constant_text_never_reaches_generated_code():
     """A string constant reaches the generated module as bound bytes, not as source."""
     p = plcrt.load(ob1_text('LD SM0.0\nSCPY "__import__(\'os\')", VB100',
-                            'LDS= VB100, "pwn\\n"\n= Q0.0'))
+                            'LDS= "pwn\\n", VB100\n= Q0.0'))
     p.scan()
     assert "import" not in p.source and "pwn" not in p.source
     assert (get(p, 100), p["Q0.0"]) == (b"__import__('os')", 0)
@@ -443,10 +456,10 @@ def test_shapes():
 
 def test_ladder_draws_a_string_network():
     """A network with a string compare contact and a string box converts to LAD."""
-    prog = parse_sources(ob1_text('LDS= VB0, "ON"\nSCPY "RUN", VB100'))
+    prog = parse_sources(ob1_text('LDS= "ON", VB0\nSCPY "RUN", VB100'))
     lad = to_ladder(prog.pous[0].networks[0])
     assert lad.ok
-    assert isinstance(lad.rung.logic, Contact) and lad.rung.logic.below == '"ON"'
+    assert isinstance(lad.rung.logic, Contact) and lad.rung.logic.above == '"ON"'
     box = lad.rung.outs[0]
     assert isinstance(box, Box) and box.title == "STR_CPY"
 

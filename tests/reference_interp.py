@@ -24,7 +24,11 @@ Supported subset (anything else raises :class:`Unsupported`):
   with the SMB1 flags;
 * word logic ``ANDW ORW XORW`` (the test uses them only when the compiled
   engine has them);
-* ``TON`` for the 100 ms timers T37-T63 and T101-T255, and ``CTU``.
+* ``TON`` for the 100 ms timers T37-T63 and T101-T255, and ``CTU``;
+* strings in V memory and ``"..."`` constants: ``SLEN SCPY SCAT SSCPY SFND
+  CFND ITS DTS RTS STI STD STR`` and the compares ``LDS= LDS<> AS= AS<> OS=
+  OS<>`` (System Manual, "String instructions"; the choices of
+  docs/decisions.md, "Strings").
 
 Conventions that the manual leaves open follow the choices documented in
 plcrt's own docstrings (``plcrt/isa/math_int.py``, ``plcrt/engine/*.py``);
@@ -33,8 +37,11 @@ each is marked "plcrt convention" below.
 
 from __future__ import annotations
 
+import math
 import operator
 import re
+import struct
+from fractions import Fraction
 from typing import Callable
 
 from plcrt.compiler.operands import Addr, parse_address
@@ -85,6 +92,26 @@ WORD_LOGIC: dict[str, Callable[[int, int], int]] = {
 }
 
 MOVES: dict[str, int] = {"MOVB": 1, "MOVW": 2, "MOVD": 4}
+
+#: String compares: ``LDS=`` ... ``OS<>`` (the ``S`` is the string type).
+STRING_COMPARE_RE = re.compile(r"(LD|A|O)S(=|<>)")
+
+#: Longest string: a length byte of 0..254.
+MAX_STRING = 254
+
+#: Box instructions on strings.
+STRING_BOXES = ("SLEN", "SCPY", "SCAT", "SSCPY", "SFND", "CFND",
+                "ITS", "DTS", "RTS", "STI", "STD", "STR")
+
+#: ``STI``/``STD``: (bytes of OUT, smallest, largest); ``ITS``/``DTS``: (bytes of
+#: IN, characters of the string).
+STRING_TO_INT = {"STI": (2, -32768, 32767), "STD": (4, -2**31, 2**31 - 1)}
+INT_TO_STRING = {"ITS": (2, 8), "DTS": (4, 12)}
+
+#: The number forms of STI/STD and STR: spaces, a sign, digits (and for a
+#: real a point or comma with more digits).
+INTEGER_TEXT = re.compile(rb" *([+-]?)([0-9]+)")
+REAL_TEXT = re.compile(rb" *([+-]?)([0-9]*)(?:[.,]([0-9]*))?")
 
 
 class Unsupported(Exception):
@@ -288,6 +315,8 @@ class ReferencePlc:
                 self.top = self.top | bit
         elif COMPARE_RE.fullmatch(m):
             self._compare(m, ops)
+        elif STRING_COMPARE_RE.fullmatch(m):
+            self._string_compare(m, ops)
         elif m == "NOT":
             self.top = self.top ^ 1
         elif m in ("EU", "ED"):
@@ -319,7 +348,7 @@ class ReferencePlc:
         elif not self.top:
             # every other supported instruction is a box: it runs only when
             # the top of the stack is 1 and it never changes the stack
-            if m not in (*MOVES, *MATH, *DIVIDE, *INC_DEC, *WORD_LOGIC):
+            if m not in (*MOVES, *MATH, *DIVIDE, *INC_DEC, *WORD_LOGIC, *STRING_BOXES):
                 raise Unsupported(m)
         elif m in MOVES:
             nbytes = MOVES[m]
@@ -335,6 +364,8 @@ class ReferencePlc:
                                    self.read_value(ops[1], 2, False))
             self.write_value(ops[1], 2, result)
             self.write_bit("SM", 8 + SM1_ZERO, int(result == 0))
+        elif m in STRING_BOXES:
+            getattr(self, "_" + m.lower())(ops)
         else:
             raise Unsupported(m)
 
@@ -424,6 +455,202 @@ class ReferencePlc:
         result = wrap(result, nbytes, signed)
         self.write_value(ops[0], nbytes, result)
         self.set_flags(result == 0, overflow, result < 0)
+
+    # -- strings --------------------------------------------------------------
+    # A string is a length byte and that many characters.  A length over 254,
+    # or a string running past the end of V memory, is "operand out of range":
+    # the box does nothing (ENO 0, which this subset does not model).
+
+    def _string_place(self, text: str) -> tuple[bytearray, int]:
+        a = self.address(text)
+        if a is None or a.area != "V" or a.width != 1:
+            raise Unsupported(f"string operand {text}")
+        return self.mem["V"], a.offset
+
+    def read_string(self, text: str) -> bytes | None:
+        """The characters of a string operand, or None if it is out of range."""
+        if text.startswith('"'):
+            return text[1:-1].replace('""', '"').encode("cp1252")
+        buf, offset = self._string_place(text)
+        length = buf[offset]
+        if length > MAX_STRING or offset + 1 + length > len(buf):
+            return None
+        return bytes(buf[offset + 1:offset + 1 + length])
+
+    def write_string(self, text: str, chars: bytes) -> None:
+        buf, offset = self._string_place(text)
+        if offset + 1 + len(chars) <= len(buf):
+            buf[offset:offset + 1 + len(chars)] = bytes([len(chars)]) + chars
+
+    def _string_compare(self, mnemonic: str, ops: list[str]) -> None:
+        match = STRING_COMPARE_RE.fullmatch(mnemonic)
+        assert match is not None
+        how, relation = match.groups()
+        a, b = self.read_string(ops[0]), self.read_string(ops[1])
+        if a is None or b is None:
+            raise Unsupported("compare of an invalid string (a fatal error)")
+        result = int((a == b) == (relation == "="))
+        if how == "LD":
+            self.push(result)
+        elif how == "A":
+            self.top = self.top & result
+        else:
+            self.top = self.top | result
+
+    def _slen(self, ops: list[str]) -> None:
+        s = self.read_string(ops[0])
+        if s is not None:
+            self.write_value(ops[1], 1, len(s))
+
+    def _scpy(self, ops: list[str]) -> None:
+        s = self.read_string(ops[0])
+        if s is not None:
+            self.write_string(ops[1], s)
+
+    def _scat(self, ops: list[str]) -> None:
+        tail, head = self.read_string(ops[0]), self.read_string(ops[1])
+        if tail is not None and head is not None:
+            self.write_string(ops[1], (head + tail)[:MAX_STRING])
+
+    def _sscpy(self, ops: list[str]) -> None:
+        s = self.read_string(ops[0])
+        start = self.read_value(ops[1], 1, False)
+        count = self.read_value(ops[2], 1, False)
+        if s is not None and start >= 1 and start - 1 + count <= len(s):
+            self.write_string(ops[3], s[start - 1:start - 1 + count])
+
+    def _find(self, ops: list[str], match: Callable[[bytes, int, bytes], bool]) -> None:
+        """SFND / CFND: OUT holds the start position and gets the result."""
+        s, key = self.read_string(ops[0]), self.read_string(ops[1])
+        start = self.read_value(ops[2], 1, False)
+        if s is None or key is None or not 1 <= start <= len(s):
+            return
+        found = 0
+        for position in range(start, len(s) + 1):
+            if key and match(s, position - 1, key):
+                found = position
+                break
+        self.write_value(ops[2], 1, found)
+
+    def _sfnd(self, ops: list[str]) -> None:
+        self._find(ops, lambda s, i, key: s[i:i + len(key)] == key)
+
+    def _cfnd(self, ops: list[str]) -> None:
+        self._find(ops, lambda s, i, key: s[i] in key)
+
+    def _to_string(self, text: str, out: str, size: int) -> None:
+        """The right-justified text of ITS/DTS/RTS, or spaces if it is too long."""
+        self.write_string(out, text.rjust(size).encode() if len(text) <= size else b" " * size)
+
+    @staticmethod
+    def _decimal_text(magnitude: int, negative: bool, decimals: int, comma: bool) -> str:
+        """``magnitude`` / 10**decimals as digits with a separator."""
+        whole, fraction = divmod(magnitude, 10 ** decimals)
+        text = str(whole)
+        if decimals:
+            text += ("," if comma else ".") + str(fraction).rjust(decimals, "0")
+        return ("-" if negative else "") + text
+
+    def _its(self, ops: list[str]) -> None:
+        nbytes, size = INT_TO_STRING["ITS"]
+        self._integer_to_string(ops, nbytes, size)
+
+    def _dts(self, ops: list[str]) -> None:
+        nbytes, size = INT_TO_STRING["DTS"]
+        self._integer_to_string(ops, nbytes, size)
+
+    def _integer_to_string(self, ops: list[str], nbytes: int, size: int) -> None:
+        value = self.read_value(ops[0], nbytes, True)
+        fmt = self.read_value(ops[2], 1, False)
+        if fmt >= 16:
+            return                      # format bits 7..4 must be 0
+        decimals = fmt % 8
+        if decimals > 5:
+            self.write_string(ops[1], b" " * size)
+            return
+        text = self._decimal_text(abs(value), value < 0, decimals, fmt & 8 != 0)
+        self._to_string(text, ops[1], size)
+
+    def _rts(self, ops: list[str]) -> None:
+        value = self.read_real(ops[0])
+        fmt = self.read_value(ops[2], 1, False)
+        size, decimals = fmt // 16, fmt % 8
+        if size < 3:
+            return
+        if decimals > 5 or size < decimals + 3 or not math.isfinite(value):
+            self.write_string(ops[1], b" " * size)
+            return
+        exact = Fraction(value)
+        # round half away from zero: floor(|x| * 10**n + 1/2)
+        magnitude = math.floor(abs(exact) * 10 ** decimals + Fraction(1, 2))
+        negative = exact < 0 and magnitude != 0
+        self._to_string(self._decimal_text(magnitude, negative, decimals, fmt & 8 != 0),
+                        ops[1], size)
+
+    def read_real(self, text: str) -> float:
+        if text.startswith(("+", "-")) or text[:1].isdigit():
+            return struct.unpack(">f", struct.pack(">f", float(text)))[0]
+        buf, offset = self._location(text, 4)
+        return struct.unpack(">f", bytes(buf[offset:offset + 4]))[0]
+
+    def _string_number(self, ops: list[str], form: re.Pattern[bytes]
+                       ) -> tuple[bool, bytes, bytes] | None | bool:
+        """(negative, whole, fraction) at INDX; True if the instruction does
+        nothing at all (bad string, INDX 0); None if there is no number."""
+        s = self.read_string(ops[0])
+        start = self.read_value(ops[1], 1, False)
+        if s is None or start == 0:
+            return True
+        m = form.match(s, start - 1)
+        if m is None:
+            return None
+        sign, whole, fraction = (m.groups() + (None,))[:3]
+        if not whole and not fraction:
+            return None
+        return sign == b"-", whole, fraction or b""
+
+    def _string_result(self, out: str, nbytes: int, value: int | None) -> None:
+        """Store a converted value and clear SM1.1, or set SM1.1 (OUT kept)."""
+        if value is None:
+            self.write_bit("SM", 8 + SM1_OVERFLOW, 1)
+        else:
+            self.write_value(out, nbytes, value)
+            self.write_bit("SM", 8 + SM1_OVERFLOW, 0)
+
+    def _string_to_int(self, ops: list[str], mnemonic: str) -> None:
+        nbytes, low, high = STRING_TO_INT[mnemonic]
+        number = self._string_number(ops, INTEGER_TEXT)
+        if number is True:
+            return
+        value = None
+        if number is not None:
+            negative, whole, _ = number
+            value = -int(whole) if negative else int(whole)
+            if not low <= value <= high:
+                value = None
+        self._string_result(ops[2], nbytes, value)
+
+    def _sti(self, ops: list[str]) -> None:
+        self._string_to_int(ops, "STI")
+
+    def _std(self, ops: list[str]) -> None:
+        self._string_to_int(ops, "STD")
+
+    def _str(self, ops: list[str]) -> None:
+        number = self._string_number(ops, REAL_TEXT)
+        if number is True:
+            return
+        bits = None
+        if number is not None:
+            negative, whole, fraction = number
+            exact = int(whole or b"0") + Fraction(int(fraction or b"0"), 10 ** len(fraction))
+            try:
+                packed = struct.pack(">f", float(-exact if negative else exact))
+            except OverflowError:
+                packed = None
+            if packed is not None:
+                bits = int.from_bytes(packed, "big")
+        self._string_result(ops[2], 4, bits)
 
     # -- timers and counters --------------------------------------------------
     def _timer_number(self, operand: str) -> int:

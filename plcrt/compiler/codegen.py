@@ -21,6 +21,7 @@ from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
+from ..lang.codepage import string_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .emit import CodegenError, Gen
@@ -367,7 +368,8 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
     for info in unit.pous.values():
         p = info.pou
         unit.current = info
-        resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars)
+        resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars,
+                            string_codepage(unit.program.encoding))
         fnames: list[str] = []
         for piece in info.pieces:
             unit.current_piece = piece

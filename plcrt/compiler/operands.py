@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Union
 
 from ..memory.cpu import CpuModel
+from ..lang.codepage import DEFAULT_CODEPAGE, string_bytes
 from ..lang.limits import MAX_DIGITS, too_many_digits
 from ..safetext import excerpt
 
@@ -70,7 +71,10 @@ class Addr:
 
 @dataclass(frozen=True, slots=True)
 class Const:
-    """A literal: ``int``, ``float`` (REAL) or ``bytes`` (ASCII/string)."""
+    """A literal: ``int``, ``float`` (REAL) or ``bytes`` (ASCII/string).
+
+    A string constant (``is_string``) holds its length byte followed by the
+    characters, exactly as the string is laid out in memory."""
 
     value: int | float | bytes
     text: str = ""
@@ -126,7 +130,9 @@ def parse_constant(text: str) -> Const | None:
     if too_many_digits(t) and t[0] not in "'\"":
         raise OperandError(f"{excerpt(t)}: a number with more than {MAX_DIGITS} digits is "
                            f"out of range")
-    if t[0] == "'" or t[0] == '"':
+    if t[0] == '"':
+        return string_constant(t, DEFAULT_CODEPAGE)
+    if t[0] == "'":
         if len(t) < 2 or t[-1] != t[0]:
             raise OperandError(f"unterminated literal {excerpt(text)!r}")
         body = t[1:-1]
@@ -135,7 +141,7 @@ def parse_constant(text: str) -> Const | None:
         except UnicodeEncodeError:
             raise OperandError(f"literal {excerpt(text)!r} holds characters outside "
                                f"one byte") from None
-        return Const(data, text, is_string=t[0] == '"')
+        return Const(data, text)
     m = _HEX_RE.fullmatch(t)
     if m:
         return Const(int(m.group(1).replace("_", ""), 16), text)
@@ -155,6 +161,32 @@ def parse_constant(text: str) -> Const | None:
     if up in ("FALSE", "OFF"):
         return Const(0, text)
     return None
+
+
+def string_constant(text: str, codepage: str) -> Const:
+    """A double-quoted string constant (``"ABC"``) as a :class:`Const`
+    holding the length byte and the characters in ``codepage``.
+
+    Inside the quotes a doubled quote (``""``) stands for one, as in the
+    STL grammar and the data block; every other character, ``$`` included,
+    stands for itself (docs/decisions.md, "Strings").
+
+    Raises:
+        OperandError: unterminated or malformed literal, a character outside
+            the code page, or more than 254 characters.
+    """
+    t = text.strip()
+    if len(t) < 2 or t[0] != '"' or t[-1] != '"':
+        raise OperandError(f"unterminated string constant {excerpt(text)!r}")
+    raw = t[1:-1]
+    if raw.replace('""', "").count('"'):
+        raise OperandError(f"string constant {excerpt(text)!r}: a quote inside the "
+                           f"string is written twice (\"\")")
+    try:
+        data = string_bytes(raw.replace('""', '"'), codepage)
+    except ValueError as e:
+        raise OperandError(f"string constant {excerpt(text)!r}: {e}") from None
+    return Const(bytes((len(data),)) + data, text, is_string=True)
 
 
 def _check_range(model: CpuModel, area: str, offset: int, width: int, text: str) -> None:

@@ -14,10 +14,11 @@ from typing import Any, Mapping
 
 from ..isa.registry import Role
 from ..lang import ir
+from ..lang.codepage import DEFAULT_CODEPAGE
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
-from .operands import (Addr, Const, Indirect, Name, OperandError, Pointer,
-                       Resolved, parse_operand)
+from .operands import (Addr, Const, Indirect, Name, OperandError, Pointer, Resolved,
+                       parse_operand, string_constant)
 
 TYPE_WIDTH = {"BOOL": 0, "BYTE": 1, "CHAR": 1, "WORD": 2, "INT": 2,
               "DWORD": 4, "DINT": 4, "REAL": 4}
@@ -82,8 +83,11 @@ class Resolver:
 
     def __init__(self, model: CpuModel, symbols: Any = None,
                  system_symbols: Mapping[str, str] | None = None,
-                 local_vars: Mapping[str, LocalVar] | None = None) -> None:
+                 local_vars: Mapping[str, LocalVar] | None = None,
+                 codepage: str = DEFAULT_CODEPAGE) -> None:
         self.model = model
+        #: code page of double-quoted string constants (the program's)
+        self.codepage = codepage
         self.symbols = symbols
         self.system = {k.upper(): v for k, v in (system_symbols or {}).items()}
         self.locals = local_vars or {}
@@ -103,6 +107,8 @@ class Resolver:
                                    f"{excerpt(var.decl.type)}")
             return Indirect(var.addr, t)
         try:
+            if t.startswith('"'):
+                return string_constant(t, self.codepage)
             op = parse_operand(t, self.model)
         except OperandError as e:
             raise ResolveError(str(e)) from None
@@ -191,6 +197,8 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
         raise _bad(text, role)
     if role in (Role.BIT_R, Role.BIT_W, Role.BIT_TC, Role.IBIT, Role.QBIT, Role.SBIT):
         return _check_bit(op, role, text, model)
+    if role in (Role.STR_R, Role.STR_M, Role.STR_W):
+        return _check_string(op, role, text)
     width = _VALUE_WIDTH[role]
     writing = role in _WRITE_ROLES
     if isinstance(op, Const):
@@ -254,13 +262,34 @@ def _check_bit(op: Resolved, role: Role, text: str, model: CpuModel) -> Addr:
     return op
 
 
+def _check_string(op: Resolved, role: Role, text: str) -> Resolved:
+    """A string operand: its length byte in V or L memory (``VB100``,
+    ``LB4``), a pointer to it (``*VD``, ``*LD``, ``*AC``), or for inputs a
+    double-quoted constant (System Manual, "String instructions")."""
+    if isinstance(op, Const):
+        if role is Role.STR_W:
+            raise _bad(text, role, "a constant cannot be written")
+        if role is Role.STR_M:
+            raise _bad(text, role, "a string constant can only be the first operand")
+        if not op.is_string:
+            raise _bad(text, role, 'a string constant is written in double quotes: "ABC"')
+        return op
+    if isinstance(op, Indirect):
+        return op
+    if isinstance(op, Addr) and op.area in ("V", "L") and op.width == 1:
+        return op
+    raise _bad(text, role, "a string starts at its length byte, VBn or LBn")
+
+
 _CONST_RANGE = {1: (-128, 255), 2: (-32768, 65535), 4: (-2**31, 2**32 - 1)}
 
 
 def _check_const(op: Const, role: Role, text: str) -> Const:
     width = _VALUE_WIDTH[role]
     if isinstance(op.value, bytes):
-        if op.is_string or len(op.value) > width or not op.value:
+        if op.is_string:
+            raise _bad(text, role, "a string constant is only valid where a string is")
+        if len(op.value) > width or not op.value:
             raise _bad(text, role, "literal too long")
         return op
     if isinstance(op.value, float):

@@ -45,6 +45,9 @@ class Role(enum.Enum):
     COUNTER = "counter (C0..C255)"
     LABEL = "label number (0..255)"
     SBIT = "SCR bit (S)"
+    STR_R = 'string (VB, LB, *VD, *LD, *AC or a constant "...")'  #: string input
+    STR_M = "string in memory (VB, LB, *VD, *LD, *AC)"  #: string input, no constant
+    STR_W = "writable string (VB, LB, *VD, *LD, *AC)"  #: string output
     NONE = "-"
 
 
@@ -69,8 +72,7 @@ REGISTRY: dict[str, InsnSpec] = {}
 KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
     XMT RCV NETR NETW GPA SPA GET PUT
     ATT LIFO FIFO FND= FND<> FND< FND> TODR TODW TODRX TODWX
-    SLEN SCPY SCAT SSCPY SFND CFND ITA DTA RTA ATH HTA ITS DTS RTS STI STD STR
-    LDS= LDS<> AS= AS<> OS= OS<> DLED BITIM CITIM
+    ITA DTA RTA ATH HTA DLED BITIM CITIM
 """.split())
 
 

@@ -80,10 +80,10 @@ _RAIL = {"LBL", "LSCR", "SCRE", "NEXT", "RET", "MEND", "NOP", "RETI"}
 #: power inputs of boxes with more than one (System Manual, counters)
 _BOX_INPUTS = {"CTU": 2, "CTD": 2, "CTUD": 3}
 _OPS = {"LD": "load", "A": "and", "O": "or"}
-_COMPARE_TYPES = "BWDR"
+_COMPARE_TYPES = "BWDRS"
 _RELATIONS = ("=", "<>", "<=", ">=", "<", ">")
 #: compare contact insides as Micro/WIN draws them: ``LDW=`` is ``==I``
-_LAD_TYPE = {"B": "B", "W": "I", "D": "D", "R": "R"}
+_LAD_TYPE = {"B": "B", "W": "I", "D": "D", "R": "R", "S": "S"}
 _LAD_RELATION = {"=": "=="}
 #: insides of bit contacts by (negated, immediate)
 _LAD_BIT = {(False, False): " ", (True, False): "/", (False, True): "I", (True, True): "/I"}
@@ -161,6 +161,14 @@ _LAD: dict[str, tuple[str, str]] = {
     "DTI": ("DI_I", _MOVE), "DTR": ("DI_R", "IN=0 OUT>1r"), "ROUND": ("ROUND", "IN=0r OUT>1"),
     "TRUNC": ("TRUNC", "IN=0r OUT>1"), "BCDI": ("BCD_I", _UNARY), "IBCD": ("I_BCD", _UNARY),
     "DECO": ("DECO", _MOVE), "ENCO": ("ENCO", _MOVE), "SEG": ("SEG", _MOVE),
+    # strings (System Manual, "String instructions", "String conversion")
+    "SLEN": ("STR_LEN", _MOVE), "SCPY": ("STR_CPY", _MOVE), "SCAT": ("STR_CAT", _MOVE),
+    "SSCPY": ("SSTR_CPY", "IN=0 INDX=1 N=2 OUT>3"),
+    "SFND": ("STR_FIND", "IN1=0 IN2=1 OUT>2"), "CFND": ("CHR_FIND", "IN1=0 IN2=1 OUT>2"),
+    "ITS": ("I_S", "IN=0 FMT=2 OUT>1"), "DTS": ("DI_S", "IN=0 FMT=2 OUT>1"),
+    "RTS": ("R_S", "IN=0r FMT=2 OUT>1"),
+    "STI": ("S_I", "IN=0 INDX=1 OUT>2"), "STD": ("S_DI", "IN=0 INDX=1 OUT>2"),
+    "STR": ("S_R", "IN=0 INDX=1 OUT>2r"),
     # program control
     "FOR": ("FOR", "INDX=0 INIT=1 FINAL=2"), "CALL": ("CALL", ""),
 }

@@ -28,8 +28,11 @@ Choices made where the format is not documented:
   last value written, with the same width;
 * ``VB`` takes 0..255, ``VW`` -32768..65535, ``VD`` -2**31..2**32-1 (the
   negative values stored as two's complement), a REAL only fits ``VD``;
-* character literals must be ASCII; ``'ABC'`` stores its bytes and advances
-  by their count, ``"ABC"`` stores a length byte first (at most 254 chars);
+* character literals are stored in the code page of the data block file
+  (:mod:`plcrt.lang.codepage`; a character it cannot hold is an error);
+  ``'ABC'`` stores its bytes and advances by their count, ``"ABC"`` stores a
+  length byte first (at most 254 bytes); inside either a doubled quote
+  stands for one;
 * a later entry that overlaps an earlier one wins; each overlap is reported
   as a warning in :attr:`DataBlock.warnings`.
 """
@@ -42,6 +45,7 @@ from dataclasses import dataclass, field
 
 from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..safetext import excerpt
+from .codepage import DEFAULT_CODEPAGE, MAX_STRING, string_bytes
 from .limits import too_many_digits
 from .stl import raise_collected
 
@@ -146,11 +150,13 @@ def _check_extent(entries: list[DataEntry], size: int, sink: DiagnosticSink) -> 
 
 
 def parse_datablock(text: str, file: str = "<string>", *,
-                    v_bytes: int | None = None) -> DataBlock:
+                    v_bytes: int | None = None,
+                    codepage: str = DEFAULT_CODEPAGE) -> DataBlock:
     """Parse data block text and return its :class:`DataBlock`.
 
     With ``v_bytes`` (the V memory size of the CPU) entries past its end
     are reported together with the syntax errors, so one run lists both.
+    Character constants are stored in ``codepage`` (the file's code page).
 
     Raises :class:`PlcSyntaxError` listing every error (bad address, bad or
     out-of-range value, missing comma, entry past the end of V memory)
@@ -162,7 +168,7 @@ def parse_datablock(text: str, file: str = "<string>", *,
     block = DataBlock(file=file)
     cursor: _Cursor | None = None
     for number, line in enumerate(text.splitlines(), start=1):
-        cursor = _parse_line(line, number, file, cursor, block, sink)
+        cursor = _parse_line(line, number, file, cursor, block, sink, codepage)
     if v_bytes is not None:
         _check_extent(block.entries, v_bytes, sink)
     _note_overlaps(block)
@@ -183,7 +189,8 @@ def _tokens(line: str) -> list[tuple[str, str, int]]:
 
 
 def _parse_line(line: str, number: int, file: str, cursor: _Cursor | None,
-                block: DataBlock, sink: DiagnosticSink) -> _Cursor | None:
+                block: DataBlock, sink: DiagnosticSink,
+                codepage: str = DEFAULT_CODEPAGE) -> _Cursor | None:
     """Parse one line, append its entries, return the cursor after it."""
     items = _tokens(line)
     if not items:
@@ -240,16 +247,16 @@ def _parse_line(line: str, number: int, file: str, cursor: _Cursor | None,
         if kind == "open":
             sink.error("unterminated string literal", loc(column), code="datablock")
             return cursor
-        entries = _value_entries(text, kind, cursor, loc(column), sink)
+        entries = _value_entries(text, kind, cursor, loc(column), sink, codepage)
         block.entries.extend(entries)
     return cursor
 
 
 def _value_entries(text: str, kind: str, cursor: _Cursor, loc: SourceLoc,
-                   sink: DiagnosticSink) -> list[DataEntry]:
+                   sink: DiagnosticSink, codepage: str = DEFAULT_CODEPAGE) -> list[DataEntry]:
     """Entries for one value at ``cursor``; advances the cursor."""
     if kind == "string":
-        return _string_entry(text, cursor, loc, sink)
+        return _string_entry(text, cursor, loc, sink, codepage)
     if cursor.width == 0:  # bit form
         value = None if too_many_digits(text) else _integer(text)
         if value not in (0, 1):
@@ -312,20 +319,21 @@ def _integer(text: str) -> int | None:
 
 
 def _string_entry(text: str, cursor: _Cursor, loc: SourceLoc,
-                  sink: DiagnosticSink) -> list[DataEntry]:
+                  sink: DiagnosticSink, codepage: str) -> list[DataEntry]:
     quote = text[0]
     body = text[1:-1].replace(quote * 2, quote)
     if cursor.width == 0:
         sink.error("a character constant cannot initialise a bit", loc,
                    code="datablock")
         return []
-    if not body.isascii():
-        sink.error(f"character constant {excerpt(text)} is not ASCII", loc, code="datablock")
+    try:
+        raw = string_bytes(body, codepage, None)
+    except ValueError as e:
+        sink.error(f"character constant {excerpt(text)}: {e}", loc, code="datablock")
         return []
-    raw = body.encode("ascii")
     if quote == '"':
-        if len(raw) > 254:
-            sink.error(f"string of {len(raw)} characters is longer than 254",
+        if len(raw) > MAX_STRING:
+            sink.error(f"string of {len(raw)} characters is longer than {MAX_STRING}",
                        loc, code="datablock")
             return []
         raw = bytes((len(raw),)) + raw

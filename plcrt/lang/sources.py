@@ -18,6 +18,7 @@ from typing import Any, Callable, Sequence
 
 from ..errors import PlcConfigError, PlcError, PlcSyntaxError, SourceLoc
 from . import ir
+from .codepage import string_codepage
 from .datablock import parse_datablock
 from .encoding import Decoded, decode_files, encoding_note, resolve_encoding
 from .limits import check_text_size, file_limit
@@ -82,8 +83,11 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
     if tables[0] is not None:
         symbols = _parse(parse_symbols, tables[0], decoded.get(id(tables[0])))
     if tables[1] is not None:
-        data = _parse(partial(parse_datablock, v_bytes=v_bytes) if v_bytes else parse_datablock,
-                      tables[1], decoded.get(id(tables[1])))
+        table = decoded.get(id(tables[1]))
+        # its character constants in the code page the file was written in
+        codepage = string_codepage(table.encoding if table is not None else program.encoding)
+        data = _parse(partial(parse_datablock, v_bytes=v_bytes, codepage=codepage),
+                      tables[1], table)
     return program, symbols, data
 
 

@@ -612,6 +612,7 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
     them together with the program)."""
     from ..engine.runtime import _text_or_path
     from ..lang import parse_datablock, parse_symbols
+    from ..lang.codepage import string_codepage
     from ..lang.encoding import resolve_encoding
     encoding = resolve_encoding(encoding)
     if isinstance(plant, (str, Path, dict)):
@@ -620,7 +621,8 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
     if isinstance(symbols, (str, Path)):
         symbols = parse_symbols(*_text_or_path(symbols, encoding))
     if isinstance(data, (str, Path)):
-        data = parse_datablock(*_text_or_path(data, encoding))
+        data = parse_datablock(*_text_or_path(data, encoding),
+                               codepage=string_codepage(encoding or ""))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                instrument=instrument)
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import pytest
 
 import plcrt
+from plcrt.isa.registry import KNOWN_UNIMPLEMENTED
 from plcrt.lang import parse_program
 
 HEAD = "ORGANIZATION_BLOCK MAIN:OB1\nTITLE=t\nBEGIN\nNetwork 1\n"
@@ -20,8 +21,6 @@ CASES = [
     # (id, program text, expected fragments of the first error line)
     ("unknown mnemonic", _prog("LD     I0.0\nLDX    I0.1\n"),
      ["prog.awl:6:1: error: unknown instruction 'LDX' [OB1 network 1]"]),
-    ("unimplemented", _prog("LD     I0.0\nPID    VB100, 0\n"),
-     ["prog.awl:6:1: error: instruction PID is not implemented yet [OB1 network 1]"]),
     ("wrong operand kind", _prog("LD     VW0\n=      Q0.0\n"),
      ["prog.awl:5:8: error: LD operand 1:", "'VW0' is not a valid bit"]),
     ("word where byte", _prog("LD     SM0.0\nMOVB   VW0, VB2\n"),
@@ -47,6 +46,12 @@ CASES = [
     ("unknown symbol", _prog("LD     Start_Button\n=      Q0.0\n"),
      ["prog.awl:5:8: error: LD operand 1: unknown symbol 'Start_Button'"]),
 ]
+
+
+# an instruction the S7-200 has and plcrt does not run yet (none, once all are built)
+for _m in sorted(KNOWN_UNIMPLEMENTED)[:1]:
+    CASES.append(("unimplemented", _prog(f"LD     I0.0\n{_m}    VB100, 0\n"),
+                  [f"prog.awl:6:1: error: instruction {_m} is not implemented yet [OB1 network 1]"]))
 
 
 @pytest.mark.parametrize("text,fragments", [(c[1], c[2]) for c in CASES],

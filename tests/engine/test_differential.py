@@ -69,6 +69,21 @@ DWORD_CONST = ("0", "1", "-1", "+2", "32767", "32768", "-32768", "65536", "+1000
                "2147483647", "-2147483648", "-2147483647", "16#FFFFFFFF", "16#80000000",
                "16#7FFF0000")
 
+#: Strings start in the seeded bytes, so their length bytes are random (255,
+#: out of range, included); constants cover quoting and the number forms.
+STRING_AT = ("VB0", "VB3", "VB6", "VB9")
+#: Compared strings: their length bytes are written only by string
+#: instructions, which write valid strings, and no other string reaches them
+#: (a string at VB20 ends by VB275); a compare of an invalid string would stop
+#: the CPU.  IN1 of a compare may be a constant.
+STRING_COMPARED = ("VB300", "VB600")
+STRING_READ = STRING_AT + ("VB300", '"AB"', '""', '"  -12,5x"', '"A""1b2"', '"+7.25"')
+STRING_WRITE = STRING_AT + ("VB20",) + STRING_COMPARED
+STRING_COMPARE_IN1 = STRING_COMPARED + ('"AB"', '""', '"A""1b2"')
+STRING_INDEX = ("0", "1", "2", "3", "9", "VB1", "VB4", "VB7")
+STRING_FORMATS = ("0", "3", "5", "6", "16#0B", "16#13", "16#30", "16#61", "16#A6", "16#F5",
+                  "VB2", "VB5")
+
 #: Width letter -> (read pool, write pool, constants).
 POOLS = {
     "B": (BYTE_READ, BYTE_WRITE, BYTE_CONST),
@@ -93,6 +108,7 @@ SCAN_MS = (10, 20, 50, 100, 130, 1000, 7000, 60000)
 
 #: Width letter -> operands an input may be (addresses and constants).
 VALUE_INPUTS = {w: reads + consts for w, (reads, _writes, consts) in POOLS.items()}
+VALUE_INPUTS["S"] = STRING_COMPARE_IN1
 
 BIT_LOADS = tuple(f"{m} {b}" for m in ("LD", "LDN") for b in BIT_READ)
 BIT_COMBINES = tuple(f"{m} {b}" for m in ("A", "AN", "O", "ON") for b in BIT_READ)
@@ -102,6 +118,7 @@ SET_RESET_HEADS = (tuple(f"{m} {b}" for m in ("S", "R") for b in BIT_WRITE)
 
 #: (mnemonic, width) of the compares, per prefix.
 COMPARES = {prefix: tuple((f"{prefix}{w}{rel}", w) for w in "BWD" for rel in RELATIONS)
+            + tuple((f"{prefix}S{rel}", "S") for rel in ("=", "<>"))
             for prefix in ("LD", "A", "O")}
 COMPARES["A/O"] = COMPARES["A"] + COMPARES["O"]
 
@@ -132,7 +149,8 @@ _CHOICES: dict[tuple, st.SearchStrategy] = {}
 def _compare_insn(draw: st.DrawFn, prefix: str) -> str:
     mnemonic, width = draw(_choice(COMPARES[prefix]))
     inputs = _choice(VALUE_INPUTS[width])
-    return f"{mnemonic} {draw(inputs)}, {draw(inputs)}"
+    second = _choice(STRING_COMPARED) if width == "S" else inputs
+    return f"{mnemonic} {draw(inputs)}, {draw(second)}"
 
 
 COMPARE_INSN = {prefix: _compare_insn(prefix) for prefix in COMPARES}
@@ -149,6 +167,31 @@ def _box_insn(draw: st.DrawFn) -> str:
 
 
 BOX_INSN = _box_insn()
+
+#: String boxes: mnemonic -> operand pools in STL order.
+STRING_BOXES = {
+    "SLEN": (STRING_READ, BYTE_WRITE),
+    "SCPY": (STRING_READ, STRING_WRITE),
+    "SCAT": (STRING_READ, STRING_WRITE),
+    "SSCPY": (STRING_READ, STRING_INDEX, STRING_INDEX, STRING_WRITE),
+    "SFND": (STRING_READ, STRING_READ, BYTE_WRITE),
+    "CFND": (STRING_READ, STRING_READ, BYTE_WRITE),
+    "ITS": (VALUE_INPUTS["W"], STRING_WRITE, STRING_FORMATS),
+    "DTS": (VALUE_INPUTS["D"], STRING_WRITE, STRING_FORMATS),
+    "RTS": (("VD0", "VD4", "VD8", "MD0"), STRING_WRITE, STRING_FORMATS),
+    "STI": (STRING_READ, STRING_INDEX, WORD_WRITE),
+    "STD": (STRING_READ, STRING_INDEX, DWORD_WRITE),
+    "STR": (STRING_READ, STRING_INDEX, DWORD_WRITE),
+}
+
+
+@st.composite
+def _string_insn(draw: st.DrawFn) -> str:
+    mnemonic = draw(_choice(tuple(STRING_BOXES)))
+    return f"{mnemonic} " + ", ".join(draw(_choice(pool)) for pool in STRING_BOXES[mnemonic])
+
+
+STRING_INSN = _string_insn()
 LOAD_INSN = st.one_of(_choice(BIT_LOADS), COMPARE_INSN["LD"])
 DEEP_PUSH = st.one_of(_choice(BIT_LOADS), st.just("LPS"))
 DEEP_COUNT = _choice((0, 0, 0, 4, 6, 8, 9, 10))
@@ -162,7 +205,7 @@ RANGE_COUNT = {"T": st.integers(1, 3), "C": st.integers(1, 3),
 #: Instruction kinds and how they change the static stack depth.
 PUSHES = {"load": 1, "load_cmp": 1, "lps": 1, "ald/old": -1, "lpp": -1, "ctu": -1}
 ALWAYS = ("load", "load_cmp", "combine", "combine_cmp", "not", "edge", "lps", "out", "out",
-          "setreset", "box", "box")
+          "setreset", "box", "box", "string")
 WITH_TWO = ("ald/old", "ald/old", "lrd", "lpp")
 
 
@@ -208,6 +251,8 @@ def draw_network(draw: st.DrawFn, counters: list[str]) -> list[str]:
             lines.append(f"{head}, {draw(count)}")
         elif kind == "box":
             lines.append(draw(BOX_INSN))
+        elif kind == "string":
+            lines.append(draw(STRING_INSN))
         elif kind == "ald/old":
             lines.append(draw(_choice(("ALD", "OLD"))))
         elif kind == "lrd":

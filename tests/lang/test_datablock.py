@@ -91,7 +91,7 @@ def test_lower_case_addresses() -> None:
     ("VW0 1.5", 5, "needs a VD"),
     ("VD0 1E39", 5, "REAL value"),
     ("VB0 2#102", 5, "bad constant"),
-    ("VB0 'é'", 5, "not ASCII"),
+    ("VB0 'Ω'", 5, "not in code page CP1252"),
     ("VB0 'abc", 5, "unterminated"),
     ("VB0 1 2", 7, "expected ','"),
     ("VB0 1,,2", 7, "missing value"),

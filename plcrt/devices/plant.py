@@ -14,6 +14,7 @@
 
     [cpu]
     wire = { "I0.0" = "Q0.0" }  # the output Q0.0 (or its pulses) drives the input I0.0
+    clock = "2026-12-02T08:00:00"   # the real-time clock at power-up (TODR)
 
     [module.1]                  # a fieldbus master module with CiA 402 drives
     kind = "FIELDBUS"
@@ -91,6 +92,8 @@ class Plant:
     wiring: dict[int, int] = field(default_factory=dict)
     #: encoder signals: dicts of plcrt.engine.hsc.Encoder's arguments
     encoders: list[dict[str, Any]] = field(default_factory=list)
+    #: the real-time clock's reading at power-up (None: the default date)
+    clock: Any = None
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -133,6 +136,7 @@ def _build(data: dict, file: str) -> Plant:
         raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
                              f"(a plant file has [module.N] tables and a [cpu] table)")
     wiring, encoders = _cpu(data.get("cpu", {}), file)
+    clock = _clock(data.get("cpu", {}), file)
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -170,7 +174,7 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders)
+    return Plant(modules, file, wiring, encoders, clock)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
@@ -183,10 +187,10 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
-    unknown = set(cpu) - {"wire", "encoder"}
+    unknown = set(cpu) - {"wire", "encoder", "clock"}
     if unknown:
         raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(known: wire, encoder)")
+                             f"(known: wire, encoder, clock)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
@@ -199,6 +203,15 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
                                  f"Q0.0..Q1.7, got {str(src)[:20]!r}")
         out[inp] = int(m_out.group(2)) * 8 + int(m_out.group(3))
     return out, _encoders(cpu.get("encoder", []), where, out)
+
+
+def _clock(cpu: dict, file: str) -> Any:
+    """``[cpu] clock = "2026-12-02T08:00:00"`` (a TOML string or local
+    date-time): the real-time clock at power-up, checked here."""
+    if "clock" not in cpu:
+        return None
+    from ..engine.clock import start_time
+    return start_time(cpu["clock"], f"{file}: cpu.clock")
 
 
 _ENCODER_KEYS = {"inputs", "hz", "start", "stop", "direction"}

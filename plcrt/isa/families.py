@@ -12,3 +12,4 @@ from . import counters  # noqa: F401
 from . import control  # noqa: F401
 from . import interrupts  # noqa: F401
 from . import highspeed  # noqa: F401
+from . import clock  # noqa: F401

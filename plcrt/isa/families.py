@@ -13,3 +13,5 @@ from . import control  # noqa: F401
 from . import interrupts  # noqa: F401
 from . import highspeed  # noqa: F401
 from . import clock  # noqa: F401
+from . import table  # noqa: F401
+from . import ascii  # noqa: F401

@@ -68,8 +68,8 @@ REGISTRY: dict[str, InsnSpec] = {}
 #: ``plcrt check`` with their locations).
 KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
     XMT RCV NETR NETW GPA SPA GET PUT
-    ATT LIFO FIFO FND= FND<> FND< FND> PID
-    SLEN SCPY SCAT SSCPY SFND CFND ITA DTA RTA ATH HTA ITS DTS RTS STI STD STR
+    PID
+    SLEN SCPY SCAT SSCPY SFND CFND ITS DTS RTS STI STD STR
     LDS= LDS<> AS= AS<> OS= OS<> DLED BITIM CITIM
 """.split())
 

@@ -15,3 +15,4 @@ from . import highspeed  # noqa: F401
 from . import clock  # noqa: F401
 from . import table  # noqa: F401
 from . import ascii  # noqa: F401
+from . import smart  # noqa: F401

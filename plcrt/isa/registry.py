@@ -67,10 +67,10 @@ REGISTRY: dict[str, InsnSpec] = {}
 #: Mnemonics the S7-200 has but plcrt does not execute yet (reported by
 #: ``plcrt check`` with their locations).
 KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
-    XMT RCV NETR NETW GPA SPA GET PUT
+    XMT RCV NETR NETW GET PUT
     PID
     SLEN SCPY SCAT SSCPY SFND CFND ITS DTS RTS STI STD STR
-    LDS= LDS<> AS= AS<> OS= OS<> DLED BITIM CITIM
+    LDS= LDS<> AS= AS<> OS= OS<>
 """.split())
 
 

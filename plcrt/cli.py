@@ -468,6 +468,10 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         "mode": plc.mode if plc else None,
         "values": {k: json_number(v) for k, v in values.items()},
     }
+    if plc is not None:
+        # the CPU's own state the program sets: real-time clock and DLED
+        obj["clock"] = plc.clock.now().isoformat()
+        obj["dled"] = plc.station.led
     if plc is not None and getattr(args, "plant", None):
         obj["axes"] = [a.to_dict() for a in plc.axes()]
         drives = plc.drives()

@@ -470,7 +470,7 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
     }
     if plc is not None:
         # the CPU's own state the program sets: real-time clock and DLED
-        obj["clock"] = plc.clock.now().isoformat()
+        obj["clock"] = plc.clock.now(plc.now_us).isoformat()
         obj["dled"] = plc.station.led
     if plc is not None and getattr(args, "plant", None):
         obj["axes"] = [a.to_dict() for a in plc.axes()]

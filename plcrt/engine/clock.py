@@ -114,10 +114,11 @@ class Clock:
             t_us = self.owner._irq_t
         return self.base_s + (t_us - self.set_us) // 1_000_000
 
-    def now(self) -> _dt.datetime:
-        """The clock's reading now (the time a TODR would read), wrapping
-        from 2099 to 2000 as the two year digits do."""
-        s = self.seconds() % _CENTURY_S
+    def now(self, t_us: int | None = None) -> _dt.datetime:
+        """The clock's reading at simulated time *t_us* (default: the time
+        the running code executes at, what a TODR reads), wrapping from 2099
+        to 2000 as the two year digits do."""
+        s = self.seconds(t_us) % _CENTURY_S
         return _EPOCH + _dt.timedelta(seconds=s)
 
     def day_of_week(self, t: _dt.datetime) -> int:

@@ -76,7 +76,9 @@ def real_text(value: float, fmt: int) -> bytes | None:
     if size < 3:
         return None
     blank = bytes([SPACE]) * size
-    if nnn > 5 or size < nnn + 3 or value != value or value in (float("inf"), float("-inf")):
+    # 1e15 has 16 digits, more than the widest field: also keeps the
+    # rounding within the decimal context's 28 digits
+    if nnn > 5 or size < nnn + 3 or not abs(value) < 1e15:
         return blank
     scaled = int((Decimal(value) * (10 ** nnn)).quantize(Decimal(1), rounding=ROUND_HALF_UP))
     text = fixed(scaled, nnn, bool(fmt & 8))

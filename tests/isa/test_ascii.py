@@ -87,6 +87,9 @@ RTA = [
     ("too small fills spaces", 12345.0, 0x41, b"    ", 0),
     ("ssss < nnn + 3 fills spaces", 1.0, 0x33, b"   ", 0),
     ("nnn 6 fills spaces", 1.0, 0x86, b"        ", 0),
+    ("3e38 fills spaces", -3.0e38, 0xF0, b" " * 15, 0),
+    ("1e15 in float32 has 15 digits", 1.0e15, 0xF0, b"999999986991104", 1),
+    ("1e16 fills spaces", 1.0e16, 0xF0, b" " * 15, 0),
     ("ssss 2: no output", 1.0, 0x20, None, 0),
     ("ssss 0: no output", 1.0, 0x01, None, 0),
 ]

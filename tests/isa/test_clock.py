@@ -218,3 +218,40 @@ def test_buffer_past_area_end_is_refused():
     """TODRX's 19 bytes must fit the area (compile error with the location)."""
     with pytest.raises(plcrt.PlcCompileError, match="runs past the end"):
         _load("LD SM0.0\nTODRX VB10230")
+
+
+def test_harness_clock():
+    """Harness.load(clock=) starts the clock as load() does."""
+    from plcrt.testing import Harness
+    h = Harness.load(ob1_text(READ), clock="2026-12-02T08:00:00")
+    h.scan()
+    assert h.plc.clock.now().isoformat() == "2026-12-02T08:00:00"
+    assert h.read("VB7") == 4
+
+
+pytest_plugins = ["pytester"]
+
+
+def test_plugin_marker_clock(pytester):
+    """The plc marker and plc_factory take clock=; a bad one is a usage error."""
+    (pytester.path / "p.awl").write_text(ob1_text(READ))
+    pytester.makepyfile(test_clk="""\
+import pytest
+
+@pytest.mark.plc("p.awl", clock="2026-12-02T08:00:00")
+def test_marker(plc):
+    plc.scan()
+    assert plc.read("VB7") == 4 and plc.read("VB3") == 8
+
+def test_factory(plc_factory):
+    h = plc_factory("p.awl", clock="2030-06-01 12:00")
+    h.scan()
+    assert h.read("VB0") == 0x30 and h.read("VB3") == 0x12
+
+@pytest.mark.plc("p.awl", clock="soon")
+def test_bad(plc):
+    pass
+""")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    result.assert_outcomes(passed=2, errors=1)
+    result.stdout.fnmatch_lines(["*clock=*2026-12-02T08:00:00*"])

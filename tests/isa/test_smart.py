@@ -5,6 +5,8 @@ Manual, "Get Port Address and Set Port Address")."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 import plcrt
@@ -127,3 +129,37 @@ def test_fork_copies_led_and_addresses():
     twin.scan()
     assert (p.station.led, p.station.addresses[0]) == (True, 7)
     assert (twin.station.led, twin.station.addresses[0]) == (False, 8)
+
+
+@pytest.mark.parametrize("stl,title,pins", [
+    ("ATT VW0, VW200", "AD_T_TBL", ["DATA", "TBL"]),
+    ("FIFO VW200, VW0", "FIFO", ["TBL", "DATA"]),
+    ("LIFO VW200, VW0", "LIFO", ["TBL", "DATA"]),
+    ("FND< VW202, 5, AC1", "TBL_FIND", ["TBL", "PTN", "INDX", "CMD 3"]),
+    ("ITA VW0, VB10, 16#0B", "I_A", ["IN", "FMT", "OUT"]),
+    ("DTA VD0, VB10, 3", "DI_A", ["IN", "FMT", "OUT"]),
+    ("RTA VD0, VB10, 16#A3", "R_A", ["IN", "FMT", "OUT"]),
+    ("ATH VB0, VB10, 3", "ATH", ["IN", "LEN", "OUT"]),
+    ("HTA VB0, VB10, 3", "HTA", ["IN", "LEN", "OUT"]),
+    ("TODR VB0", "READ_RTC", ["T"]),
+    ("TODW VB0", "SET_RTC", ["T"]),
+    ("TODRX VB0", "READ_RTCX", ["T"]),
+    ("TODWX VB0", "SET_RTCX", ["T"]),
+    ("BITIM VD0", "BGN_ITIME", ["OUT"]),
+    ("CITIM VD0, VD4", "CAL_ITIME", ["IN", "OUT"]),
+    ("DLED VB0", "DIAG_LED", ["IN"]),
+    ("GPA VB0, 0", "GET_ADDR", ["ADDR", "PORT"]),
+    ("SPA VB0, 1", "SET_ADDR", ["ADDR", "PORT"]),
+])
+def test_new_boxes_draw(stl, title, pins):
+    """Every table, ASCII, clock and SMART box draws as Micro/WIN's LAD box,
+    with its pins (FND's compare as the CMD input 1..4)."""
+    from plcrt.engine.runtime import parse_sources
+    from plcrt.view.render import ladder_text
+    prog = parse_sources(ob1_text("LD I0.0\n" + stl))
+    pou = prog.pous[0]
+    text = ladder_text(pou, pou.networks[0], program=prog)
+    assert re.search(rf"│\s+{re.escape(title)}\s+│", text.splitlines()[2]), text   # title row
+    for pin in pins:
+        assert pin in text, (pin, text)
+    assert "ENO" in text

@@ -12,8 +12,10 @@ daylight-saving mode and its rule).
 What it is not: no wall clock.  The clock starts at a fixed date
 (:data:`DEFAULT_START`) unless the program is loaded with ``clock=`` (or
 ``--clock``, or the plant file's ``[cpu] clock``), and it advances with
-simulated time only, so runs are deterministic.  The daylight-saving
-settings are kept and read back; the clock does not jump by an hour.
+simulated time only, so runs are deterministic.  With a daylight-saving
+mode set by TODWX the reading is ahead by the correction inside the
+daylight-saving window (:mod:`plcrt.engine.dst`); the clock keeps standard
+time underneath.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import datetime as _dt
 from typing import Any
 
 from ..errors import PlcConfigError
+from . import dst as _dst
 
 #: the clock's reading at power-up when no start is given (a Monday)
 DEFAULT_START = _dt.datetime(2024, 1, 1, 0, 0, 0)
@@ -102,14 +105,14 @@ class Clock:
 
     def __init__(self, start: _dt.datetime, owner: Any) -> None:
         self.owner = owner
-        self.base_s = int((start - _EPOCH).total_seconds())   #: reading at set_us
+        self.base_s = int((start - _EPOCH).total_seconds())   #: standard time at set_us
         self.set_us = 0                 #: simulated time of the last set
         self.dow_shift = 0              #: TODW's day of week minus the calendar's (mod 7)
         self.dow_off = False            #: day of week written as 0 (disabled)
         self.dst = bytes(11)            #: TODWX bytes 8..18 as written
 
     def seconds(self, t_us: int | None = None) -> int:
-        """Seconds since 2000-01-01 00:00:00 of the clock's reading."""
+        """Seconds since 2000-01-01 00:00:00 of the clock's standard time."""
         if t_us is None:
             t_us = self.owner._irq_t
         return self.base_s + (t_us - self.set_us) // 1_000_000
@@ -119,7 +122,10 @@ class Clock:
         the running code executes at, what a TODR reads), wrapping from 2099
         to 2000 as the two year digits do."""
         s = self.seconds(t_us) % _CENTURY_S
-        return _EPOCH + _dt.timedelta(seconds=s)
+        standard = _EPOCH + _dt.timedelta(seconds=s)
+        if not self.dst[0]:
+            return standard
+        return standard + _dst.offset(standard, self.dst[0], self.dst[1:])
 
     def day_of_week(self, t: _dt.datetime) -> int:
         """1 = Sunday .. 7 = Saturday, shifted as TODW wrote it; 0 when disabled."""
@@ -146,7 +152,14 @@ class Clock:
         year, month, day, hour, minute, second = (from_bcd(b) for b in data[:6])
         t = (_dt.datetime(FIRST_YEAR + year, month, 1, hour, minute, second)
              + _dt.timedelta(days=day - 1))
-        self.base_s = int((t - _EPOCH).total_seconds()) % _CENTURY_S
+        standard = t
+        if self.dst[0]:
+            # the time written is the clock's reading: inside the daylight-
+            # saving window it is ahead of standard time by the correction
+            w = _dst.window(self.dst[0], self.dst[1:], t.year)
+            if w is not None and _dst.offset(t - w[2], self.dst[0], self.dst[1:]):
+                standard = t - w[2]
+        self.base_s = int((standard - _EPOCH).total_seconds()) % _CENTURY_S
         self.set_us = self.owner._irq_t
         dow = from_bcd(data[7])
         self.dow_off = dow == 0
@@ -162,15 +175,17 @@ class Clock:
         buf[off + 8:off + 19] = self.dst
 
     def write_ext(self, buf: bytearray, off: int) -> bool:
-        """TODWX: bytes 0..7 as TODW, byte 8 one of :data:`DST_MODES`, and
-        for the user rule (16#FF) bytes 9..18 valid BCD in their ranges;
-        False (nothing changed) otherwise."""
+        """TODWX: bytes 0..7 as TODW (the time under the new daylight-saving
+        setting), byte 8 one of :data:`DST_MODES`, and for the user rule
+        (16#FF) bytes 9..18 valid BCD in their ranges; False (nothing
+        changed) otherwise."""
         data = bytes(buf[off:off + 19])
         if data[8] not in DST_MODES or (data[8] == 0xFF and not _valid(data, _DST_RANGES)):
             return False
+        old, self.dst = self.dst, data[8:19]
         if not self.write(data, 0):
+            self.dst = old
             return False
-        self.dst = data[8:19]
         return True
 
 

@@ -5,7 +5,8 @@ S7-200 System Manual, "Clock instructions"; S7-200 SMART System Manual,
 8-byte BCD buffer at T (year, month, day, hour, minute, second, 0, day of
 week), ``TODW T`` sets it from that buffer; TODRX/TODWX add bytes 8..18,
 the daylight-saving settings.  The clock itself, and what plcrt simulates
-of it, is :mod:`plcrt.engine.clock`.
+of it, is :mod:`plcrt.engine.clock` (daylight-saving rules:
+:mod:`plcrt.engine.dst`).
 
 Errors: a buffer that is not valid BCD in range (month 13, hour 24, a
 non-decimal digit, a daylight-saving mode the SMART does not have) is run-

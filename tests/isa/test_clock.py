@@ -120,13 +120,69 @@ def test_todw_keeps_running_from_the_new_time():
 
 def test_todrx_reads_the_daylight_saving_settings_todwx_wrote():
     """TODWX stores mode and rule (bytes 8..18); TODRX reads them back with
-    the time; the clock itself does not shift by the correction."""
+    the time (here just before the rule's start: no shift yet)."""
     p = plcrt.load(ob1_text("LD SM0.1\nTODWX VB40\nAENO\nS Q0.0, 1", "LD SM0.0\nTODRX VB0"))
     data = bytes.fromhex("2603290159000001" + "FF" + "0100" + "03290200" + "10250300")
     p.mem.areas["V"][40:59] = data
     p.scan(2)
     assert p["Q0.0"] == 1
     assert _bytes(p, 0, 19) == data
+
+
+#: rule bytes 9..18 of a mode without a user rule
+NO_RULE = "00" * 10
+
+
+# (id, mode and rule, the time written, seconds run, the time read): the
+# clock jumps forward at the start and back at the end of daylight saving
+DST = [
+    ("EU UTC+1 spring", "02" + NO_RULE, "2603290159590001", 1, "260329030000"),
+    ("EU UTC+1 autumn", "02" + NO_RULE, "2610250259590001", 1, "261025020000"),
+    ("EU UTC spring", "01" + NO_RULE, "2603290059590001", 1, "260329020000"),
+    ("EU UTC+2 spring", "03" + NO_RULE, "2603290259590001", 1, "260329040000"),
+    ("EU UTC-1 spring", "08" + NO_RULE, "2603282359590007", 1, "260329010000"),
+    ("US spring", "10" + NO_RULE, "2603080159590001", 1, "260308030000"),
+    ("US autumn", "10" + NO_RULE, "2611010159590001", 1, "261101010000"),
+    ("Australia spring", "11" + NO_RULE, "2610040159590001", 1, "261004030000"),
+    ("Australia autumn", "11" + NO_RULE, "2604050259590001", 1, "260405020000"),
+    ("Tasmania spring", "12" + NO_RULE, "2610040159590001", 1, "261004030000"),
+    ("New Zealand spring", "13" + NO_RULE, "2609270159590001", 1, "260927030000"),
+    ("user rule 30 min", "FF0030" + "06010800" + "09010900", "2606010759590002", 1,
+     "260601083000"),
+    ("user rule end", "FF0030" + "06010800" + "09010900", "2609010859590003", 1,
+     "260901083000"),
+    ("summer reads as written", "02" + NO_RULE, "2607011200000004", 3600, "260701130000"),
+    ("winter reads as written", "02" + NO_RULE, "2601151200000005", 60, "260115120100"),
+    ("mode 0: no shift", "00" + NO_RULE, "2603290159590001", 1, "260329020000"),
+]
+
+
+@pytest.mark.parametrize("extra,written,seconds,reads", [c[1:] for c in DST],
+                         ids=[c[0] for c in DST])
+def test_daylight_saving(extra, written, seconds, reads):
+    """With a daylight-saving mode the clock goes forward by the correction
+    at the start and back at the end (EU at 01:00 UTC, US, Australia and
+    New Zealand at their civil rules, a user rule at its dates); a time
+    written inside the window is the daylight time."""
+    p = plcrt.load(ob1_text("LD SM0.1\nTODWX VB40\nAENO\nS Q0.0, 1", "LD SM0.0\nTODR VB0"),
+                   scan_ms=1000)
+    p.mem.areas["V"][40:59] = bytes.fromhex(written + extra)
+    p.scan(seconds + 1)
+    assert p["Q0.0"] == 1
+    assert _bytes(p, 0, 6).hex() == reads
+
+
+def test_autumn_hour_runs_twice():
+    """At the end of daylight saving the hour before it is read twice."""
+    p = plcrt.load(ob1_text("LD SM0.1\nTODWX VB40", "LD SM0.0\nTODR VB0"), scan_ms=60_000)
+    p.mem.areas["V"][40:59] = bytes.fromhex("2610250230000001" + "02" + NO_RULE)
+    hours = []
+    p.scan()
+    for _ in range(12):
+        hours.append(_bytes(p, 3, 2).hex())
+        p.scan(10)
+    assert hours == ["0230", "0240", "0250", "0200", "0210", "0220", "0230", "0240", "0250",
+                     "0300", "0310", "0320"]
 
 
 @pytest.mark.parametrize("extra", ["04" + "00" * 10, "FF" + "24" + "00" * 9,

@@ -212,7 +212,8 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 plant=Path(plant) if plant else None, instrument=instrument, library=library,
                 encoding=getattr(args, "encoding", None),
                 max_file_mb=getattr(args, "max_file_mb", None),
-                auto_symbols=getattr(args, "auto_symbols", False))
+                auto_symbols=getattr(args, "auto_symbols", False),
+                clock=getattr(args, "clock", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -314,9 +315,14 @@ SET_HELP = ("write before the first scan (inputs keep their value); "
             "VALUE: 12, -3, 16#FF, 2#1010, 1.5, NaN, Infinity")
 
 def add_scan_ms_arg(p: argparse.ArgumentParser) -> None:
-    """``--scan-ms MS``, the simulated scan time (``args.scan_ms``, default 10)."""
+    """``--scan-ms MS``, the simulated scan time (``args.scan_ms``, default 10),
+    and ``--clock DATETIME``, the real-time clock's start (``args.clock``)."""
     p.add_argument("--scan-ms", type=float, default=10.0, metavar="MS",
                    help="simulated scan time in ms (default 10)")
+    p.add_argument("--clock", metavar="DATETIME",
+                   help="the real-time clock at power-up, e.g. 2026-12-02T08:00:00, or 'now' "
+                        "for the host's clock (default: the plant file's, else 2024-01-01 "
+                        "00:00:00)")
 
 
 def add_run_length_args(p: argparse.ArgumentParser, *, required: bool = True,
@@ -467,6 +473,10 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         "mode": plc.mode if plc else None,
         "values": {k: json_number(v) for k, v in values.items()},
     }
+    if plc is not None:
+        # the CPU's own state the program sets: real-time clock and DLED
+        obj["clock"] = plc.clock.now(plc.now_us).isoformat()
+        obj["dled"] = plc.station.led
     if plc is not None and getattr(args, "plant", None):
         obj["axes"] = [a.to_dict() for a in plc.axes()]
         drives = plc.drives()

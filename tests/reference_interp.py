@@ -29,6 +29,9 @@ Supported subset (anything else raises :class:`Unsupported`):
   CFND ITS DTS RTS STI STD STR`` and the compares ``LDS= LDS<> AS= AS<> OS=
   OS<>`` (System Manual, "String instructions"; the choices of
   docs/decisions.md, "Strings").
+* tables ``ATT FIFO LIFO FND= FND<> FND< FND>`` (direct word addresses)
+  with SM1.4 / SM1.5 and the 0091 range error (SM4.3);
+* ASCII conversions ``ITA DTA RTA ATH HTA`` (direct byte addresses).
 
 Conventions that the manual leaves open follow the choices documented in
 plcrt's own docstrings (``plcrt/isa/math_int.py``, ``plcrt/engine/*.py``);
@@ -112,6 +115,16 @@ INT_TO_STRING = {"ITS": (2, 8), "DTS": (4, 12)}
 #: real a point or comma with more digits).
 INTEGER_TEXT = re.compile(rb" *([+-]?)([0-9]+)")
 REAL_TEXT = re.compile(rb" *([+-]?)([0-9]*)(?:[.,]([0-9]*))?")
+
+#: FND's compare (the entry on the left, PATRN on the right), INT values.
+FIND = {"FND=": operator.eq, "FND<>": operator.ne, "FND<": operator.lt, "FND>": operator.gt}
+TABLE_MAX = 100                     #: entries a table can hold
+SM1_TABLE_FULL, SM1_TABLE_EMPTY, SM1_ILLEGAL_ASCII = 4, 5, 7
+SM4_RUNTIME_ERROR = 3
+#: ASCII conversions: mnemonic -> characters written (RTA: from FMT)
+ASCII_WIDTH = {"ITA": 8, "DTA": 12}
+HEX_CHARS = "0123456789ABCDEF"
+NEW_BOXES = ("ATT", "FIFO", "LIFO", *FIND, "ITA", "DTA", "RTA", "ATH", "HTA")
 
 
 class Unsupported(Exception):
@@ -348,7 +361,8 @@ class ReferencePlc:
         elif not self.top:
             # every other supported instruction is a box: it runs only when
             # the top of the stack is 1 and it never changes the stack
-            if m not in (*MOVES, *MATH, *DIVIDE, *INC_DEC, *WORD_LOGIC, *STRING_BOXES):
+            if m not in (*MOVES, *MATH, *DIVIDE, *INC_DEC, *WORD_LOGIC, *STRING_BOXES,
+                         *NEW_BOXES):
                 raise Unsupported(m)
         elif m in MOVES:
             nbytes = MOVES[m]
@@ -366,6 +380,18 @@ class ReferencePlc:
             self.write_bit("SM", 8 + SM1_ZERO, int(result == 0))
         elif m in STRING_BOXES:
             getattr(self, "_" + m.lower())(ops)
+        elif m == "ATT":
+            self._att(ops)
+        elif m in ("FIFO", "LIFO"):
+            self._take(m == "FIFO", ops)
+        elif m in FIND:
+            self._find(m, ops)
+        elif m in ("ITA", "DTA", "RTA"):
+            self._number_to_ascii(m, ops)
+        elif m == "ATH":
+            self._ascii_to_hex(ops)
+        elif m == "HTA":
+            self._hex_to_ascii(ops)
         else:
             raise Unsupported(m)
 
@@ -519,7 +545,7 @@ class ReferencePlc:
         if s is not None and start >= 1 and start - 1 + count <= len(s):
             self.write_string(ops[3], s[start - 1:start - 1 + count])
 
-    def _find(self, ops: list[str], match: Callable[[bytes, int, bytes], bool]) -> None:
+    def _find_in_string(self, ops: list[str], match: Callable[[bytes, int, bytes], bool]) -> None:
         """SFND / CFND: OUT holds the start position and gets the result."""
         s, key = self.read_string(ops[0]), self.read_string(ops[1])
         start = self.read_value(ops[2], 1, False)
@@ -533,10 +559,10 @@ class ReferencePlc:
         self.write_value(ops[2], 1, found)
 
     def _sfnd(self, ops: list[str]) -> None:
-        self._find(ops, lambda s, i, key: s[i:i + len(key)] == key)
+        self._find_in_string(ops, lambda s, i, key: s[i:i + len(key)] == key)
 
     def _cfnd(self, ops: list[str]) -> None:
-        self._find(ops, lambda s, i, key: s[i] in key)
+        self._find_in_string(ops, lambda s, i, key: s[i] in key)
 
     def _to_string(self, text: str, out: str, size: int) -> None:
         """The right-justified text of ITS/DTS/RTS, or spaces if it is too long."""
@@ -710,3 +736,144 @@ class ReferencePlc:
                 current += 1
             self._counter_store(n, current, int(current >= pv))
         self.pop()
+
+    # -- tables (System Manual, "Table instructions") ---------------------------
+    def _byte_address(self, text: str) -> tuple[bytearray, int]:
+        """Area and byte offset of a direct V/M/I/Q/S/SM byte or word address."""
+        a = self.address(text)
+        if a is None or a.area not in ("I", "Q", "M", "V", "SM", "S") or not a.width:
+            raise Unsupported(f"table or text operand {text}")
+        return self.mem[a.area], a.offset
+
+    def _word_at(self, buf: bytearray, offset: int) -> int:
+        return int.from_bytes(buf[offset:offset + 2], "big", signed=True)
+
+    def _range_error(self) -> None:
+        """Run-time error 0091 (operand out of range): SM4.3, nothing else."""
+        self.write_bit("SM", 4 * 8 + SM4_RUNTIME_ERROR, 1)
+
+    def _entry_count(self, buf: bytearray, at: int) -> int | None:
+        count = self._word_at(buf, at)
+        if count < 0 or count > TABLE_MAX or at + 2 + 2 * count > len(buf):
+            self._range_error()
+            return None
+        return count
+
+    def _att(self, ops: list[str]) -> None:
+        data = self.read_value(ops[0], 2, True)
+        buf, tbl = self._byte_address(ops[1])
+        count = self._entry_count(buf, tbl + 2)
+        if count is None:
+            return
+        limit = min(self._word_at(buf, tbl), TABLE_MAX)
+        if count >= limit:
+            self.write_bit("SM", 8 + SM1_TABLE_FULL, 1)
+            return
+        place = tbl + 4 + 2 * count
+        if place + 2 > len(buf):
+            self._range_error()
+            return
+        buf[place:place + 2] = wrap(data, 2, False).to_bytes(2, "big")
+        buf[tbl + 2:tbl + 4] = (count + 1).to_bytes(2, "big")
+        self.write_bit("SM", 8 + SM1_TABLE_FULL, 0)
+
+    def _take(self, oldest: bool, ops: list[str]) -> None:
+        buf, tbl = self._byte_address(ops[0])
+        count = self._entry_count(buf, tbl + 2)
+        if count is None:
+            return
+        if count == 0:
+            self.write_bit("SM", 8 + SM1_TABLE_EMPTY, 1)
+            return
+        entries = [self._word_at(buf, tbl + 4 + 2 * i) for i in range(count)]
+        value = entries.pop(0) if oldest else entries.pop()
+        if oldest:   # the rest move up one place; the word after them keeps its value
+            for i, entry in enumerate(entries):
+                buf[tbl + 4 + 2 * i:tbl + 6 + 2 * i] = wrap(entry, 2, False).to_bytes(2, "big")
+        buf[tbl + 2:tbl + 4] = (count - 1).to_bytes(2, "big")
+        self.write_bit("SM", 8 + SM1_TABLE_EMPTY, 0)
+        self.write_value(ops[1], 2, value)
+
+    def _find(self, mnemonic: str, ops: list[str]) -> None:
+        buf, tbl = self._byte_address(ops[0])   # FND's TBL is the entry count
+        pattern = self.read_value(ops[1], 2, True)
+        start = self.read_value(ops[2], 2, False)
+        count = self._entry_count(buf, tbl)
+        if count is None:
+            return
+        index = count
+        for i in range(start, count):
+            if FIND[mnemonic](self._word_at(buf, tbl + 2 + 2 * i), pattern):
+                index = i
+                break
+        self.write_value(ops[2], 2, index)
+
+    # -- ASCII (System Manual, "Conversion instructions") -------------------------
+    def _put_text(self, ops: list[str], text: str) -> None:
+        buf, offset = self._byte_address(ops[1])
+        if offset + len(text) > len(buf):
+            self._range_error()
+            return
+        buf[offset:offset + len(text)] = text.encode("ascii")
+
+    def _number_to_ascii(self, mnemonic: str, ops: list[str]) -> None:
+        fmt = self.read_value(ops[2], 1, False)
+        places, comma = fmt & 7, fmt & 8
+        if mnemonic == "RTA":
+            width = fmt >> 4
+            if width < 3:
+                return                                  # illegal format: no output
+            raw = self.read_value(ops[0], 4, False).to_bytes(4, "big")
+            x = struct.unpack(">f", raw)[0]
+            if places > 5 or width < places + 3 or not math.isfinite(x):
+                self._put_text(ops, " " * width)
+                return
+            # exact value of the REAL, rounded half away from zero
+            scaled = Fraction(x) * 10 ** places
+            magnitude = math.floor(abs(scaled) + Fraction(1, 2))
+            value = -magnitude if scaled < 0 else magnitude
+        else:
+            width = ASCII_WIDTH[mnemonic]
+            if fmt & 0xF0:
+                return                                  # illegal format: no output
+            if places > 5:
+                self._put_text(ops, " " * width)
+                return
+            value = self.read_value(ops[0], 2 if mnemonic == "ITA" else 4, True)
+        whole, fraction = divmod(abs(value), 10 ** places)
+        text = ("-" if value < 0 else "") + str(whole)
+        if places:
+            text += ("," if comma else ".") + str(fraction).zfill(places)
+        if len(text) > width:
+            text = ""
+        self._put_text(ops, text.rjust(width))
+
+    def _ascii_to_hex(self, ops: list[str]) -> None:
+        src, s_off = self._byte_address(ops[0])
+        dst, d_off = self._byte_address(ops[1])
+        length = self.read_value(ops[2], 1, False)
+        if s_off + length > len(src) or d_off + (length + 1) // 2 > len(dst):
+            self._range_error()
+            return
+        for i in range(length):
+            char = chr(src[s_off + i])
+            if char not in HEX_CHARS:               # upper case only (30..39, 41..46 hex)
+                self.write_bit("SM", 8 + SM1_ILLEGAL_ASCII, 1)
+                return
+            nibble = HEX_CHARS.index(char)
+            byte = d_off + i // 2
+            if i % 2 == 0:
+                dst[byte] = nibble << 4 | dst[byte] & 0x0F
+            else:
+                dst[byte] = dst[byte] & 0xF0 | nibble
+        self.write_bit("SM", 8 + SM1_ILLEGAL_ASCII, 0)
+
+    def _hex_to_ascii(self, ops: list[str]) -> None:
+        src, s_off = self._byte_address(ops[0])
+        dst, d_off = self._byte_address(ops[1])
+        length = self.read_value(ops[2], 1, False)
+        if s_off + (length + 1) // 2 > len(src) or d_off + length > len(dst):
+            self._range_error()
+            return
+        digits = "".join(f"{src[s_off + i]:02X}" for i in range((length + 1) // 2))
+        dst[d_off:d_off + length] = digits[:length].encode("ascii")

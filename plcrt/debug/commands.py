@@ -297,7 +297,10 @@ def _cmd_status(s: Session, args: list[str]) -> None:
     rows = [("time", f"{sim_time(plc)} s"),
             ("scans", f"{plc.scans} done"),
             ("mode", mode(plc)),
-            ("scan time", f"{ms(plc.scan_us)} ms")]
+            ("scan time", f"{ms(plc.scan_us)} ms"),
+            ("clock", plc.clock.now(plc.now_us).isoformat(sep=" "))]
+    if plc.station.led:
+        rows.append(("DLED", "on"))
     if s._paused is not None:
         rows.append(("paused", f"in scan {plc.scans + 1}, before {s._label(s._paused)}"))
     names = [s.coverage.networks[k].name for k in sorted(s._breaks)]
@@ -490,7 +493,7 @@ _TABLE = (
     Command("drives", _cmd_drives, "drives",
             "the bus drives: mode, position, velocity, statusword and its meaning"),
     Command("status", _cmd_status, "status",
-            "time, scans, mode, scan time, breakpoints, forces"),
+            "time, scans, mode, scan time, real-time clock, DLED, breakpoints, forces"),
     Command("continue", _cmd_continue, "continue",
             "paused: resume the scan and the run", aliases=("c",), paused_only=True),
     Command("next", _cmd_next, "next",

@@ -52,8 +52,10 @@ def mode(plc: Plc) -> str:
 
 
 def status_line(plc: Plc) -> str:
-    """The line printed after every command that runs scans."""
-    return f"t={sim_time(plc)} s  scan {plc.scans}  {mode(plc)}"
+    """The line printed after every command that runs scans (with ``DLED
+    on`` while the program lights the SMART's diagnostic LED)."""
+    led = "  DLED on" if plc.station.led else ""
+    return f"t={sim_time(plc)} s  scan {plc.scans}  {mode(plc)}{led}"
 
 
 def watch_table(rows: Sequence[tuple[str, str, bool]]) -> list[str]:

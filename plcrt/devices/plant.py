@@ -14,6 +14,7 @@
 
     [cpu]
     wire = { "I0.0" = "Q0.0" }  # the output Q0.0 (or its pulses) drives the input I0.0
+    clock = "2026-12-02T08:00:00"   # the real-time clock at power-up (TODR)
 
     [module.1]                  # a fieldbus master module with CiA 402 drives
     kind = "FIELDBUS"
@@ -110,6 +111,8 @@ class Plant:
     pwm: dict[int, PwmConfig] = field(default_factory=dict)
     #: first-order processes between an AQW and an AIW ([[cpu.process]])
     processes: list[dict[str, Any]] = field(default_factory=list)
+    #: the real-time clock's reading at power-up (None: the default date)
+    clock: Any = None
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -157,6 +160,7 @@ def _build(data: dict, file: str) -> Plant:
     pto = parse_pto(data.get("pto", {}), file)
     pwm = parse_pwm(data.get("pwm", {}), file)
     check_outputs(pto, pwm, file)
+    clock = _clock(data.get("cpu", {}), file)
     raw = data.get("module", {})
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [module] must be a table of slots")
@@ -194,7 +198,7 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders, pto, pwm, processes)
+    return Plant(modules, file, wiring, encoders, pto, pwm, processes, clock)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)
@@ -207,10 +211,10 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
-    unknown = set(cpu) - {"wire", "encoder", "process"}
+    unknown = set(cpu) - {"wire", "encoder", "process", "clock"}
     if unknown:
         raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(known: wire, encoder, process)")
+                             f"(known: wire, encoder, process, clock)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
@@ -223,6 +227,15 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
                                  f"Q0.0..Q1.7, got {str(src)[:20]!r}")
         out[inp] = int(m_out.group(2)) * 8 + int(m_out.group(3))
     return out, _encoders(cpu.get("encoder", []), where, out)
+
+
+def _clock(cpu: dict, file: str) -> Any:
+    """``[cpu] clock = "2026-12-02T08:00:00"`` (a TOML string or local
+    date-time): the real-time clock at power-up, checked here."""
+    if "clock" not in cpu:
+        return None
+    from ..engine.clock import start_time
+    return start_time(cpu["clock"], f"{file}: cpu.clock")
 
 
 _ENCODER_KEYS = {"inputs", "hz", "start", "stop", "direction"}

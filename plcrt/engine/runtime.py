@@ -31,6 +31,7 @@ from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigErr
                       PlcRuntimeError, SourceLoc)
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
+from .clock import Clock, Station, start_time
 from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
@@ -65,7 +66,7 @@ class Plc(AddressAccess):
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False, library: bool = False,
-                 auto_symbols: bool = False) -> None:
+                 auto_symbols: bool = False, clock: Any = None) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
@@ -96,7 +97,8 @@ class Plc(AddressAccess):
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
-                            pace=pace, plant=plant, instrument=instrument, library=library)
+                            pace=pace, plant=plant, instrument=instrument, library=library,
+                            clock=clock)
         #: network/output coverage and breakpoints (``instrument=True`` only)
         self.coverage: CoverageMap | None = CoverageMap() if instrument else None
         #: callables ``fn(plc)`` run after every scan (traces, test harness)
@@ -156,6 +158,12 @@ class Plc(AddressAccess):
         self._sources_on = False   #: a PLS, HDEF or T32/T96 ATCH ran (perf: see _scan_once)
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
         self._int_l = bytearray(self.model.l_bytes)
+        #: the real-time clock (TODR/TODW): from ``clock=``, else the plant
+        #: file's ``[cpu] clock``, else the fixed default date
+        self.clock = Clock(start_time(clock if clock is not None
+                                      else getattr(plant, "clock", None)), self)
+        #: the diagnostic LED and port station addresses (DLED, GPA, SPA)
+        self.station = Station()
         self._acc_sm = (self.mem.areas["AC"], self.mem.areas["SM"])
         if system_symbols is None:
             from ..lang.symbols import SYSTEM_SYMBOLS
@@ -598,6 +606,7 @@ class Plc(AddressAccess):
                                         *zip(self.pulse, dst.pulse),
                                         (self.pid, dst.pid),
                                         (self.edges, dst.edges),
+                                        (self.clock, dst.clock), (self.station, dst.station),
                                         *zip(self.hsc, dst.hsc)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
@@ -711,6 +720,10 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
             empty one, is a :class:`PlcCompileError`.
         max_file_mb: the largest program, symbol or data file read, in MB
             (default: :data:`plcrt.lang.limits.MAX_FILE_MB`).
+        clock: the real-time clock's reading at power-up (TODR): a
+            ``datetime``, a text ``"2026-12-02T08:00:00"`` or ``"now"`` (the
+            host's clock); default the plant file's ``[cpu] clock``, else
+            2024-01-01 00:00:00 (:mod:`plcrt.engine.clock`).
 
     Raises:
         PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.

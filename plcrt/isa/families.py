@@ -14,3 +14,7 @@ from . import interrupts  # noqa: F401
 from . import highspeed  # noqa: F401
 from . import pid  # noqa: F401
 from . import strings  # noqa: F401
+from . import clock  # noqa: F401
+from . import table  # noqa: F401
+from . import ascii  # noqa: F401
+from . import smart  # noqa: F401

@@ -70,9 +70,7 @@ REGISTRY: dict[str, InsnSpec] = {}
 #: Mnemonics the S7-200 has but plcrt does not execute yet (reported by
 #: ``plcrt check`` with their locations).
 KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
-    XMT RCV NETR NETW GPA SPA GET PUT
-    ATT LIFO FIFO FND= FND<> FND< FND> TODR TODW TODRX TODWX
-    ITA DTA RTA ATH HTA DLED BITIM CITIM
+    XMT RCV NETR NETW GET PUT
 """.split())
 
 

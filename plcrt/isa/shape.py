@@ -169,9 +169,29 @@ _LAD: dict[str, tuple[str, str]] = {
     "RTS": ("R_S", "IN=0r FMT=2 OUT>1"),
     "STI": ("S_I", "IN=0 INDX=1 OUT>2"), "STD": ("S_DI", "IN=0 INDX=1 OUT>2"),
     "STR": ("S_R", "IN=0 INDX=1 OUT>2r"),
+    # ASCII conversions (System Manual, "Conversion instructions")
+    "ITA": ("I_A", "IN=0 FMT=2 OUT>1"), "DTA": ("DI_A", "IN=0 FMT=2 OUT>1"),
+    "RTA": ("R_A", "IN=0r FMT=2 OUT>1"),
+    "ATH": ("ATH", "IN=0 LEN=2 OUT>1"), "HTA": ("HTA", "IN=0 LEN=2 OUT>1"),
+    # tables (System Manual, "Table instructions"): FND's CMD (1 =, 2 <>,
+    # 3 <, 4 >) is written in the box, see FIND_CMD
+    "ATT": ("AD_T_TBL", "DATA=0 TBL=1"),
+    "FIFO": ("FIFO", "TBL=0 DATA>1"), "LIFO": ("LIFO", "TBL=0 DATA>1"),
+    "FND=": ("TBL_FIND", "TBL=0 PTN=1 INDX=2"), "FND<>": ("TBL_FIND", "TBL=0 PTN=1 INDX=2"),
+    "FND<": ("TBL_FIND", "TBL=0 PTN=1 INDX=2"), "FND>": ("TBL_FIND", "TBL=0 PTN=1 INDX=2"),
+    # clock (System Manual, "Clock instructions"; SMART: the extended ones)
+    "TODR": ("READ_RTC", "T>0"), "TODW": ("SET_RTC", "T=0"),
+    "TODRX": ("READ_RTCX", "T>0"), "TODWX": ("SET_RTCX", "T=0"),
+    # SMART: interval timers, diagnostic LED; port addresses (communication)
+    "BITIM": ("BGN_ITIME", "OUT>0"), "CITIM": ("CAL_ITIME", "IN=0 OUT>1"),
+    "DLED": ("DIAG_LED", "IN=0"),
+    "GPA": ("GET_ADDR", "ADDR>0 PORT=1"), "SPA": ("SET_ADDR", "ADDR=0 PORT=1"),
     # program control
     "FOR": ("FOR", "INDX=0 INIT=1 FINAL=2"), "CALL": ("CALL", ""),
 }
+
+#: the CMD input of Micro/WIN's TBL_FIND box for each STL FND mnemonic
+FIND_CMD = {"FND=": 1, "FND<>": 2, "FND<": 3, "FND>": 4}
 
 
 def _contact(mnemonic: str) -> Shape | None:
@@ -209,4 +229,4 @@ def shape(mnemonic: str) -> Shape:
     return Shape("box", _BOX_INPUTS.get(m, 1), lad=lad or m, pins=pins)
 
 
-__all__ = ["Shape", "shape"]
+__all__ = ["FIND_CMD", "Shape", "shape"]

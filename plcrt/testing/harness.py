@@ -159,14 +159,15 @@ class Harness:
              data: Any = None, plant: Any = None, scan_ms: float = 10.0,
              cpu: str | None = None, watch: Sequence[str] = (), history: int = 20,
              instrument: bool = False, max_time: Duration | None = None,
-             encoding: str | None = None) -> Harness:
+             encoding: str | None = None, clock: Any = None) -> Harness:
         """Load a program (paths, STL text, or an already parsed
         :class:`plcrt.lang.ir.Program`) and wrap it.
 
         ``instrument=True`` compiles the network-coverage and breakpoint
         probes in (slightly slower scans).  ``max_time`` limits the simulated
         time (see :meth:`limit_time`).  ``encoding`` is the text encoding of
-        the files (detected by default, as in :func:`plcrt.load`).
+        the files (detected by default, as in :func:`plcrt.load`);
+        ``clock`` the real-time clock's start (as in :func:`plcrt.load`).
         """
         from ..lang import ir
 
@@ -179,11 +180,12 @@ class Harness:
             # session and compiles it per test)
             plc = _plc_from_parsed(program, symbols=symbols, data=data, plant=plant,
                                    scan_ms=scan_ms, cpu=cpu, instrument=instrument,
-                                   encoding=encoding)
+                                   encoding=encoding, clock=clock)
             return cls(plc, watch=watch, history=history, max_time=max_time)
         program = path(program)
         plc = load(program, symbols=symbols, data=data, plant=plant,
-                   scan_ms=scan_ms, cpu=cpu, instrument=instrument, encoding=encoding)
+                   scan_ms=scan_ms, cpu=cpu, instrument=instrument, encoding=encoding,
+                   clock=clock)
         return cls(plc, watch=watch, history=history, max_time=max_time)
 
     def __repr__(self) -> str:
@@ -605,7 +607,8 @@ def _release(plc: Plc, addresses: Iterable[str]) -> None:
 
 
 def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,
-                     cpu: str | None, instrument: bool, encoding: str | None = None) -> Plc:
+                     cpu: str | None, instrument: bool, encoding: str | None = None,
+                     clock: Any = None) -> Plc:
     """:func:`plcrt.load` for a program that is already parsed: the same
     handling of the symbol table, data block and plant arguments (the tables
     are decoded alone here; :func:`plcrt.lang.sources.read_program` decodes
@@ -624,7 +627,7 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
         data = parse_datablock(*_text_or_path(data, encoding),
                                codepage=string_codepage(encoding or ""))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
-               instrument=instrument)
+               instrument=instrument, clock=clock)
 
 
 def _mapping(values: Any, method: str) -> Mapping[str, Any]:

@@ -4,8 +4,9 @@ Registered through the ``pytest11`` entry point, so every pytest run in an
 environment where plcrt is installed loads it.  It provides:
 
 * the marker ``@pytest.mark.plc(program, symbols=, data=, plant=, scan_ms=,
-  cpu=, watch=[...], history=, max_time=, encoding=)`` naming the program of a test (the closest
-  marker wins: function over class over module ``pytestmark``);
+  cpu=, watch=[...], history=, max_time=, encoding=, clock=)`` naming the
+  program of a test (the closest marker wins: function over class over
+  module ``pytestmark``);
 * the fixture ``plc``: a fresh :class:`~plcrt.testing.Harness` at power-up,
   built from the marker;
 * the fixture ``plc_factory``: ``plc_factory(program, **same options)`` for
@@ -39,7 +40,7 @@ if TYPE_CHECKING:
 
 #: keyword arguments of the marker and of ``plc_factory``
 OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "max_time",
-           "encoding")
+           "encoding", "clock")
 DEFAULT_SCAN_MS = 10.0
 DEFAULT_HISTORY = 20
 #: name of the JUnit XML property that carries the trace of a failing test
@@ -49,7 +50,8 @@ WORKEROUTPUT_KEY = "plcrt_coverage"
 
 MARKER_HELP = (
     "plc(program, *, symbols=None, data=None, plant=None, scan_ms=None, cpu=None, "
-    "watch=(), history=None, max_time=None, encoding=None): the S7-200 STL program "
+    "watch=(), history=None, max_time=None, encoding=None, clock=None): the S7-200 STL "
+    "program "
     "(a .awl path or a list of them, relative to the test file or the rootdir) that the "
     "`plc` fixture loads"
 )
@@ -95,6 +97,7 @@ class _Spec:
     history: int | None = None
     max_time: float | None = None
     encoding: str | None = None         #: codec name, None to detect
+    clock: Any = None                   #: the real-time clock's start (load's clock=)
 
 
 _SESSION = pytest.StashKey[_Session]()
@@ -285,6 +288,14 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
             spec.encoding = resolve_encoding(encoding)
         except PlcConfigError as e:
             raise PlcUsageError(e.message) from None
+    clock = kwargs.get("clock")
+    if clock is not None:
+        from ..engine.clock import start_time
+        from ..errors import PlcConfigError
+        try:
+            spec.clock = start_time(clock, "clock=")
+        except PlcConfigError as e:
+            raise PlcUsageError(e.message) from None
     return spec
 
 
@@ -328,7 +339,7 @@ def _build(sess: _Session, spec: _Spec) -> Harness:
                      history=spec.history if spec.history is not None else sess.history,
                      instrument=sess.coverage,
                      max_time=spec.max_time if spec.max_time is not None else sess.max_time,
-                     encoding=spec.encoding)
+                     encoding=spec.encoding, clock=spec.clock)
     for address in spec.watch:
         try:
             h.watch(address)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from typing import Union
 
 from ..errors import PlcError
-from ..isa.shape import Shape, shape
+from ..isa.shape import FIND_CMD, Shape, shape
 from ..lang import ir
 
 #: Logic stack depth of the S7-200 (System Manual, "logic stack"); deeper
@@ -378,6 +378,9 @@ def _element(insn: ir.Insn, shp: Shape, program: ir.Program | None) -> Coil | Bo
         # Micro/WIN writes the resolution, fixed by the timer number, in the box
         from ..engine.timers import resolution_ms
         note = f"{resolution_ms(int(above[1:]))} ms"
+    elif insn.mnemonic in FIND_CMD:
+        # STL's FND= .. FND> are one LAD box whose CMD input picks the compare
+        note = f"CMD {FIND_CMD[insn.mnemonic]}"
     # a box without power pins of its own has EN and ENO; a rail box neither
     plain = not power and shp.kind == "box"
     return Box(insn, shp.lad, above, ("EN",) if plain else tuple(power), tuple(pins),

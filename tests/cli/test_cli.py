@@ -58,13 +58,13 @@ def test_check_lists_unknown_and_unimplemented_with_locations(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     prog = write(tmp_path, "p.awl", ob1(
         "LD     I0.0\nLDX    I0.1\n=      Q0.0",
-        "LD     SM0.1\nTODR   VB0\nXMT    VB100, 0",
+        "LD     SM0.1\nRCV    VB0, 0\nXMT    VB100, 0",
     ))
     code, _, err = run_cli(capsys, "check", prog)
     assert code == 1
     lines = err.splitlines()
     assert f"{prog}:6:1: error: unknown instruction 'LDX' [OB1 network 1]" in lines
-    assert f"{prog}:10:1: error: instruction TODR is not implemented yet [OB1 network 2]" in lines
+    assert f"{prog}:10:1: error: instruction RCV is not implemented yet [OB1 network 2]" in lines
     assert f"{prog}:11:1: error: instruction XMT is not implemented yet [OB1 network 2]" in lines
     assert lines[-1] == f"{prog}: 3 errors, 0 warnings"
 
@@ -159,7 +159,8 @@ def test_run_json(capsys: pytest.CaptureFixture[str]) -> None:
     assert code == 0
     obj = json.loads(out)
     assert obj == {"program": TIMERS, "scans": 250, "time_s": 2.5, "mode": "RUN",
-                   "values": {"T37": 24, "Q0.0": 1}}
+                   "values": {"T37": 24, "Q0.0": 1}, "clock": "2024-01-01T00:00:02",
+                   "dled": False}
 
 
 def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -488,7 +489,8 @@ def test_check_lists_only_unimplemented_instructions_of_a_real_export(capsys) ->
     mnemonics = {line.split("instruction ")[1].split()[0] for line in errors}
     assert mnemonics == set(uses)
     assert not {"ATCH", "DTCH", "ENI", "DISI", "RETI", "CRETI", "PLS", "HDEF", "HSC",
-                "PID", "SLEN", "SCPY", "SCAT", "SSCPY", "SFND", "CFND"} & mnemonics
+                "PID", "SLEN", "SCPY", "SCAT", "SSCPY", "SFND", "CFND", "TODR", "TODW",
+                "ATT", "FIFO", "FND=", "ITA", "ATH", "BITIM", "DLED"} & mnemonics
     assert "MOVW" not in mnemonics
 
 

@@ -222,7 +222,7 @@ def test_no_marker(plc):
     result.stdout.fnmatch_lines([
         "test_errors.py::test_unknown_argument: @pytest.mark.plc: unknown argument(s) "
         "'watchh' (did you mean 'watch'?); the options are symbols, data, plant, scan_ms, "
-        "cpu, watch, history, max_time, encoding",
+        "cpu, watch, history, max_time, encoding, clock",
         "test_errors.py::test_missing_program: @pytest.mark.plc: program file 'missing.awl' "
         "not found (looked for */missing.awl)",
         "test_errors.py::test_wrong_type: @pytest.mark.plc: watch= must be a list of "

@@ -61,6 +61,7 @@ from typing import Any
 from ..errors import PlcConfigError, PlcError
 from ..lang.limits import file_limit, read_capped
 from .cia402.coupler import IMAGE_BYTES
+from .keys import checked_table
 from .em253.axis import AxisPlant
 from .ptowizard.config import PtoConfig, PwmConfig, check_outputs, parse_pto, parse_pwm
 
@@ -268,12 +269,7 @@ def _processes(raw: Any, where: str) -> list[dict[str, Any]]:
     inputs: set[int] = set()
     for i, p in enumerate(raw):
         pw = f"{where}.process[{i}]"
-        if not isinstance(p, dict):
-            raise PlcConfigError(f"{pw} must be a table")
-        unknown = set(p) - _PROCESS_KEYS
-        if unknown:
-            raise PlcConfigError(f"{pw}: unknown key(s) {', '.join(sorted(unknown))} "
-                                 f"(known: {', '.join(sorted(_PROCESS_KEYS))})")
+        checked_table(p, pw, _PROCESS_KEYS)
         for key in ("output", "input", "tau"):
             if key not in p:
                 raise PlcConfigError(f"{pw}: {key} is missing")
@@ -316,12 +312,7 @@ def _encoders(raw: Any, where: str, wired: dict[int, int]) -> list[dict[str, Any
     out, used = [], set(wired)
     for i, enc in enumerate(raw):
         ew = f"{where}.encoder[{i}]"
-        if not isinstance(enc, dict):
-            raise PlcConfigError(f"{ew} must be a table")
-        unknown = set(enc) - _ENCODER_KEYS
-        if unknown:
-            raise PlcConfigError(f"{ew}: unknown key(s) {', '.join(sorted(unknown))} "
-                                 f"(known: {', '.join(sorted(_ENCODER_KEYS))})")
+        checked_table(enc, ew, _ENCODER_KEYS)
         inputs = enc.get("inputs")
         if not isinstance(inputs, list) or not 1 <= len(inputs) <= 2:
             raise PlcConfigError(f"{ew}.inputs must be [\"I0.0\"] or [\"I0.0\", \"I0.1\"] "

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any, Optional
 
 from ...errors import PlcConfigError
+from ..keys import checked_table
 from .plan import cycle_us, ramp_pulses, speed_of
 
 #: limits the plant accepts (decisions in docs/pto-wizard.md)
@@ -96,16 +97,6 @@ def _int(v: Any, where: str, lo: int, hi: int, what: str = "") -> int:
     return v
 
 
-def _table(raw: Any, where: str, keys: set[str]) -> dict:
-    if not isinstance(raw, dict):
-        raise PlcConfigError(f"{where} must be a table")
-    unknown = set(raw) - keys
-    if unknown:
-        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(map(str, unknown)))} "
-                             f"(known: {', '.join(sorted(keys))})")
-    return raw
-
-
 def _outputs(raw: Any, file: str, name: str) -> list[tuple[int, dict, str]]:
     if not isinstance(raw, dict):
         raise PlcConfigError(f"{file}: [{name}] must be a table of outputs "
@@ -123,7 +114,7 @@ def parse_pto(raw: Any, file: str) -> dict[int, PtoConfig]:
     """``[pto.N]`` tables by output number."""
     result: dict[int, PtoConfig] = {}
     for n, table, where in _outputs(raw, file, "pto"):
-        t = _table(table, where, _PTO_KEYS)
+        t = checked_table(table, where, _PTO_KEYS)
         for key in ("max_speed", "ss_speed"):
             if key not in t:
                 raise PlcConfigError(f"{where}.{key} is missing (pulses/s)")
@@ -158,7 +149,7 @@ def _profile(raw: Any, where: str, cfg: PtoConfig) -> Profile:
     if not isinstance(mode, str) or mode not in _PROFILE_KEYS:
         raise PlcConfigError(f"{where}.mode must be \"relative\" or \"continuous\", got "
                              f"{str(mode)[:20]!r}")
-    _table(raw, where, _PROFILE_KEYS[mode])
+    checked_table(raw, where, _PROFILE_KEYS[mode])
     if mode == "continuous":
         if "speed" not in raw:
             raise PlcConfigError(f"{where}.speed is missing (pulses/s)")
@@ -178,7 +169,7 @@ def _profile(raw: Any, where: str, cfg: PtoConfig) -> Profile:
     prev = cfg.ss_speed
     for i, s in enumerate(steps_raw):
         sw = f"{where}.steps[{i}]"
-        s = _table(s, sw, _STEP_KEYS)
+        s = checked_table(s, sw, _STEP_KEYS)
         if "speed" not in s or "pulses" not in s:
             raise PlcConfigError(f"{sw} needs speed and pulses")
         speed = _speed(s["speed"], f"{sw}.speed", cfg)
@@ -199,7 +190,7 @@ def parse_pwm(raw: Any, file: str) -> dict[int, PwmConfig]:
     """``[pwm.N]`` tables by output number."""
     result: dict[int, PwmConfig] = {}
     for n, table, where in _outputs(raw, file, "pwm"):
-        t = _table(table, where, _PWM_KEYS)
+        t = checked_table(table, where, _PWM_KEYS)
         base = t.get("time_base")
         if not isinstance(base, str) or base not in TIME_BASES:
             raise PlcConfigError(f"{where}.time_base must be \"us\" or \"ms\", got "

@@ -21,7 +21,7 @@ from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
-from ..lang.codepage import string_codepage
+from ..lang.codepage import program_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .emit import CodegenError, Gen
@@ -365,11 +365,20 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
     """Emit the module source for all POUs (diagnostics go to ``unit.diag``)."""
     out: list[str] = []
     line_locs: dict[int, SourceLoc] = {}
+    constants = [op.text for info in unit.pous.values() for net in info.pou.networks
+                 for insn in net.insns for op in insn.operands if op.text.startswith('"')]
+    codepage, chosen = program_codepage(unit.program.encoding, constants)
+    if chosen:
+        first = next(info.pou.loc for info in unit.pous.values())
+        unit.diag.items.append(Diagnostic(
+            "note", f"the program is Unicode text and its string constants do not fit "
+                    f"CP1252: they are stored in {codepage.upper()}, the first ANSI code page "
+                    f"that holds them (docs/strings.md)", first, "codepage"))
     for info in unit.pous.values():
         p = info.pou
         unit.current = info
         resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars,
-                            string_codepage(unit.program.encoding))
+                            codepage)
         fnames: list[str] = []
         for piece in info.pieces:
             unit.current_piece = piece

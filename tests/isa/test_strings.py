@@ -390,7 +390,7 @@ def test_string_constant_in_the_file_code_page(tmp_path: Path):
 
 
 @pytest.mark.parametrize("line,fragment", [
-    ('SCPY "Ω", VB0', "not in code page CP1252"),
+    ('SCPY "\U0001F600", VB0', "not in code page CP1252"),   # in no ANSI code page
     ('SCPY "' + "z" * 255 + '", VB0', "at most 254"),
     ('MOVB "A", VB0', "only valid where a string is"),
     ("SCPY 'ABC', VB0", "double quotes"),
@@ -571,3 +571,21 @@ def test_rts_then_str_is_the_rounded_value(x, nnn):
     want = Decimal(x).quantize(Decimal(1).scaleb(-nnn), rounding="ROUND_HALF_UP")
     assert p["Q0.0"] == 1
     assert p.read("VD10", "REAL") == _f32(float(abs(want) if want == 0 else want))
+
+
+def test_a_unicode_program_with_chinese_constants_stores_them_in_gbk_with_a_note():
+    """A UTF-8 export names no code page: CP1252 cannot hold 温度, GBK is the
+    first ANSI code page that can, and a note says so."""
+    plc = plcrt.load("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD SM0.0\n"
+                     "SCPY \"温度\", VB100\nEND_ORGANIZATION_BLOCK\n")
+    plc.scan()
+    assert bytes(plc.mem.areas["V"][100:105]) == b"\x04" + "温度".encode("gbk")
+    assert any(d.code == "codepage" and "GBK" in d.message for d in plc.diagnostics)
+
+
+def test_a_unicode_program_whose_constants_fit_cp1252_gets_no_note():
+    plc = plcrt.load("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD SM0.0\n"
+                     "SCPY \"Müller\", VB100\nEND_ORGANIZATION_BLOCK\n")
+    plc.scan()
+    assert bytes(plc.mem.areas["V"][100:107]) == b"\x06" + "Müller".encode("cp1252")
+    assert not [d for d in plc.diagnostics if d.code == "codepage"]

@@ -41,6 +41,8 @@ from .edges import SignalEdges
 from .hsc import Encoder, make_counters
 from .pid import make_loops
 from .pulse import make_outputs
+from .ports import make_ports
+from .netjobs import make_ethernet, netr_netw
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
 
@@ -141,8 +143,17 @@ class Plc(AddressAccess):
         #: one time line for the scan interval: event sources in priority order
         #: (a counter joins when HDEF gives it a pulse output to count)
         self.edges = SignalEdges(self)
-        self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse],
-                                   self._instant)
+        #: the network of linked CPUs this one is in (plcrt.link), or None
+        self.network: Any = None
+        #: the communication ports 0 (and 1): XMT, RCV, NETR, NETW, and the
+        #: Ethernet interface: GET, PUT (plcrt.engine.ports, .netjobs)
+        self.ports = make_ports(self, plant)
+        self.ethernet = make_ethernet(self, plant)
+        self.interrupts.ports = len(self.ports)
+        self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse,
+                                          *self.ports, self.ethernet], self._instant)
+        if any(p.items for p in self.ports):
+            self._sources_on = True    # a plant device sends at given times
         #: I0.0–I0.3 whose edges come from a signal at exact times, not from
         #: the scan start (a pulse output or an encoder drives them)
         driven = {b for b, out in self.wiring.items() if out in (0, 1)} | set(self.encoders)
@@ -229,6 +240,9 @@ class Plc(AddressAccess):
         """
         if type(n) is not int or n < 0:  # perf: one test for the usual scan(1)
             n = scan_number(n)
+        if self.network is not None:
+            raise PlcConfigError("this PLC is linked to others: run them together with the "
+                                 "network's run() (plcrt.link), not scan() or run()")
         for _ in range(n):
             if self.mode != "RUN":
                 return
@@ -250,6 +264,13 @@ class Plc(AddressAccess):
         self.scan(scan_total(self.scan_us, seconds, scans))
 
     def _scan_once(self) -> None:
+        now = self._t_us
+        self._scan_begin()
+        self._timeline(now, now + self.scan_us, True)
+        self._scan_end(now)
+
+    def _scan_begin(self) -> None:
+        """A scan up to and including the main program, at its start instant."""
         # perf: buffers are bound once in __init__ (self._bufs)
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
@@ -296,19 +317,35 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            # perf: the time line only once a source may have events (a timed
-            # interrupt attached, or ever a PLS, an HDEF or a CT=PT interrupt)
-            if irq.timed_next or self._sources_on:
-                self.scheduler.run(now, now + self.scan_us)
-            elif self.devices:
-                t_to = now + self.scan_us
-                for dev in self.devices:
-                    dev.step(self, now, t_to)
         except PlcError as e:
             self._fail(e)
         except Exception as e:  # an internal fault: map it to the program location
             self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
                                        self._loc_from_tb(e)), e)
+
+    def _timeline(self, t_from: int, t_to: int, first: bool) -> None:
+        """The scan's time line over (t_from, t_to]: events, routines, devices
+        (*first*: t_from is the scan's start; a linked network runs a scan's
+        time line in pieces, plcrt.engine.link)."""
+        try:
+            # perf: the time line only once a source may have events (a timed
+            # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
+            # a port's traffic)
+            if self.interrupts.timed_next or self._sources_on:
+                self.scheduler.run(t_from, t_to, first)
+            elif self.devices:
+                for dev in self.devices:
+                    dev.step(self, t_from, t_to)
+        except PlcError as e:
+            self._fail(e)
+        except Exception as e:  # an internal fault: map it to the program location
+            self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
+                                       self._loc_from_tb(e)), e)
+
+    def _scan_end(self, now: int) -> None:
+        """The scan's end: forces, outputs, the plant's wires, time."""
+        pi, q, pq = self._bufs[1], self._bufs[4], self._bufs[5]
+        scans = self.scans
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
@@ -389,6 +426,23 @@ class Plc(AddressAccess):
         self.pulse[number].pls(self._irq_t)
         self._sources_on = True
         self.scheduler.touch()
+
+    def _wake(self) -> None:
+        """A port's next event moved (a character on its way, a job)."""
+        self._sources_on = True
+        self.scheduler.touch()
+
+    def _xmt(self, port: int, ptr: int) -> bool:
+        return self.ports[port].xmt(self._irq_t, ptr)
+
+    def _rcv(self, port: int, ptr: int) -> bool:
+        return self.ports[port].rcv(self._irq_t, ptr)
+
+    def _net(self, port: int, ptr: int, kind: str) -> bool:
+        return netr_netw(self.ports[port], self._irq_t, ptr, kind)
+
+    def _getput(self, ptr: int, kind: str) -> bool:
+        return self.ethernet.get_put(self._irq_t, ptr, kind)
 
     def _irq_warn(self, message: str, key: str) -> None:
         self.warn(message, None, key)
@@ -598,7 +652,9 @@ class Plc(AddressAccess):
                                         *zip(self.pulse, dst.pulse),
                                         (self.pid, dst.pid),
                                         (self.edges, dst.edges),
-                                        *zip(self.hsc, dst.hsc)]
+                                        *zip(self.hsc, dst.hsc),
+                                        *zip(self.ports, dst.ports),
+                                        (self.ethernet, dst.ethernet)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
             other = dst.unit.bindings.get(name)
@@ -621,6 +677,12 @@ class Plc(AddressAccess):
                                      f"{type(obj).__name__}")
         for a, b in pairs:
             memo[id(a)] = b
+        # a twin is not linked: what links other CPUs stays here
+        if self.network is not None:
+            memo[id(self.network)] = None
+            for port in self.ports:
+                if port.peer is not None and hasattr(port.peer, "other"):
+                    memo[id(port.peer)] = None
         states = copy.deepcopy([a.__dict__ for a, _ in pairs], memo)
         for (_, b), state in zip(pairs, states):
             b.__dict__.clear()
@@ -629,7 +691,10 @@ class Plc(AddressAccess):
         dst._int_l[:] = self._int_l
         dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
         dst._defined[:] = [dst.hsc[c.number] for c in self._defined]
-        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse, *dst._counted])
+        for port in (*dst.ports, dst.ethernet):
+            port.drop_links()
+        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse, *dst.ports, dst.ethernet,
+                             *dst._counted])
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))

@@ -13,3 +13,4 @@ from . import control  # noqa: F401
 from . import interrupts  # noqa: F401
 from . import highspeed  # noqa: F401
 from . import pid  # noqa: F401
+from . import comm  # noqa: F401

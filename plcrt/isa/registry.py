@@ -67,7 +67,7 @@ REGISTRY: dict[str, InsnSpec] = {}
 #: Mnemonics the S7-200 has but plcrt does not execute yet (reported by
 #: ``plcrt check`` with their locations).
 KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
-    XMT RCV NETR NETW GPA SPA GET PUT
+    GPA SPA
     ATT LIFO FIFO FND= FND<> FND< FND> TODR TODW TODRX TODWX
     SLEN SCPY SCAT SSCPY SFND CFND ITA DTA RTA ATH HTA ITS DTS RTS STI STD STR
     LDS= LDS<> AS= AS<> OS= OS<> DLED BITIM CITIM

@@ -68,14 +68,14 @@ class Network:
             return self
         if getattr(plc, "network", None) is not None:
             raise PlcConfigError("this PLC is already in another network")
-        if self.plcs and plc.time_us != self.plcs[0].time_us:
+        if self.plcs and plc.now_us != self.plcs[0].now_us:
             raise PlcConfigError(f"a PLC joins a network at the others' time: it is at "
-                                 f"{plc.time_us} µs, the network at {self.plcs[0].time_us} µs")
+                                 f"{plc.now_us} µs, the network at {self.plcs[0].now_us} µs")
         plc.network = self
         plc.ethernet.network = self
         self.plcs.append(plc)
         self._scan[id(plc)] = None
-        self._pos[id(plc)] = plc.time_us
+        self._pos[id(plc)] = plc.now_us
         ip = plc.ethernet.ip
         if ip is not None and sum(p.ethernet.ip == ip for p in self.plcs) > 1:
             raise PlcConfigError(f"two PLCs in one network have the IP address "
@@ -139,7 +139,7 @@ class Network:
         while True:
             start = self._scan[key]
             if start is None:
-                s = plc.time_us
+                s = plc.now_us
                 if s > limit or plc.mode != "RUN":
                     self._pos[key] = max(self._pos[key], limit)
                     return

@@ -34,7 +34,7 @@ from typing import Any, Callable, Optional
 
 from .serial import Framing, Inbox, framing_of
 
-__all__ = ["Port", "make_ports", "PORTS_OF", "STATUS"]
+__all__ = ["Port", "make_ports", "attach_devices", "PORTS_OF", "STATUS"]
 
 #: SM layout per port: (SMB30-style control, receive status, receive control,
 #: receive-character event, transmit-complete event, message event, SMB4 idle bit)
@@ -64,16 +64,16 @@ class _Receive:
 class Port(Inbox):
     """Port *number* of one CPU.
 
-    *post(event, t)* posts an interrupt event, *warn(message, key)* reports
-    once, *touch()* tells the scheduler that the next event moved."""
+    *irq* is the CPU's interrupt system (its events are posted there),
+    *warn(message, key)* reports once, *touch()* tells the scheduler that
+    the next event moved."""
 
-    def __init__(self, number: int, areas: dict[str, bytearray],
-                 post: Callable[[int, int], None], warn: Callable[[str, str], None],
-                 touch: Callable[[], None]) -> None:
+    def __init__(self, number: int, areas: dict[str, bytearray], irq: Any,
+                 warn: Callable[[str, str], None], touch: Callable[[], None]) -> None:
         super().__init__(touch)
         self.number = number
         self.areas, self.sm = areas, areas["SM"]
-        self.post, self.warn = post, warn
+        self.irq, self.post, self.warn = irq, irq.post, warn
         (self.control, self.status, self.rcontrol, self.ev_char, self.ev_xmt, self.ev_msg,
          self.idle_bit) = _LAYOUT[number]
         self.peer: Any = None              #: scripted device or linked port
@@ -254,7 +254,7 @@ class Port(Inbox):
                       f"with SMB{self.status}.6 set (parameter error), ENO = 0",
                       f"port-rcv-param-{self.number}")
             sm[self.status] = STATUS["parameter"]
-            self.post(self.ev_msg, t)
+            self._post_now(self.ev_msg, t)
             return False
         rx.idle_ref = t
         any_char = il and not idle_ms and not sc and not rx.brk
@@ -268,9 +268,10 @@ class Port(Inbox):
             rx.phase = "first"
         self.rx = rx
         rx.buf[rx.off] = 0
-        if any_char and rx.timeout_us:
-            # "any character": the timer runs from the RCV, so that a
-            # missing answer ends the receive (System Manual, RCV)
+        if any_char and rx.timeout_us and rx.message_timer:
+            # "any character": the message timer runs from the RCV, so that a
+            # missing answer ends the receive (System Manual, RCV); the
+            # inter-character timer starts with the first character
             self._arm(t)
         return True
 
@@ -316,8 +317,8 @@ class Port(Inbox):
                 return
         if phase != "msg":
             rx.phase = "msg"
-            if rx.timeout_us and rx.message_timer:
-                self._arm(t)
+            if rx.timeout_us and rx.message_timer and rx.gen == 0:
+                self._arm(t)                     # the message timer starts
         rx.buf[rx.off + 1 + rx.count] = byte
         rx.count += 1
         rx.buf[rx.off] = rx.count
@@ -333,7 +334,17 @@ class Port(Inbox):
     def _end(self, t: int, status: int) -> None:
         self.sm[self.status] = status
         self.rx = None
-        self.post(self.ev_msg, t)
+        self._post_now(self.ev_msg, t)
+
+    def _post_now(self, event: int, t: int) -> None:
+        """Post *event* at *t*, the time of the running code or event: an
+        instruction of the main program gets its routine run at this
+        instant, after the main program (an empty item at *t* makes the time
+        line stop there); in a routine or an event the interrupt system runs
+        it at this instant anyway."""
+        self.post(event, t)
+        if not self.irq.running:
+            self.push(t, _nothing)
 
     # ------------------------------------------------------------ state
     def state(self) -> dict[str, Any]:
@@ -344,10 +355,14 @@ class Port(Inbox):
                 "received": self.received, "unanswered": self.unanswered_count}
 
 
+def _nothing(t: int) -> None:
+    """An instant on the time line (see Port._post_now)."""
+
+
 def make_ports(plc: Any, plant: Any) -> list[Port]:
     """The ports of *plc*'s CPU, with what the plant puts at their other end."""
     n = PORTS_OF.get(plc.model.name, 2)
-    ports = [Port(k, plc.mem.areas, plc.interrupts.post, plc._irq_warn, plc._wake)
+    ports = [Port(k, plc.mem.areas, plc.interrupts, plc._irq_warn, plc._wake)
              for k in range(n)]
     cfgs = getattr(plant, "ports", None) or {}
     for k, cfg in cfgs.items():
@@ -355,7 +370,13 @@ def make_ports(plc: Any, plant: Any) -> list[Port]:
             from ..errors import PlcConfigError
             raise PlcConfigError(f"{cfg.where}: the {plc.model.name} has port 0 only")
         ports[k].address, ports[k].ppi_baud = cfg.address, cfg.ppi_baud
+    return ports
+
+
+def attach_devices(ports: list[Port], plant: Any) -> None:
+    """Put the plant's scripted devices at the ports (once the scheduler
+    that their first messages wake exists)."""
+    for k, cfg in (getattr(plant, "ports", None) or {}).items():
         if cfg.device is not None:
             from ..devices.portdev import ScriptedDevice
             ScriptedDevice(cfg.device).attach(ports[k])
-    return ports

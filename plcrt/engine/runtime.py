@@ -41,7 +41,7 @@ from .edges import SignalEdges
 from .hsc import Encoder, make_counters
 from .pid import make_loops
 from .pulse import make_outputs
-from .ports import make_ports
+from .ports import attach_devices, make_ports
 from .netjobs import make_ethernet, netr_netw
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
@@ -152,8 +152,6 @@ class Plc(AddressAccess):
         self.interrupts.ports = len(self.ports)
         self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse,
                                           *self.ports, self.ethernet], self._instant)
-        if any(p.items for p in self.ports):
-            self._sources_on = True    # a plant device sends at given times
         #: I0.0–I0.3 whose edges come from a signal at exact times, not from
         #: the scan start (a pulse output or an encoder drives them)
         driven = {b for b, out in self.wiring.items() if out in (0, 1)} | set(self.encoders)
@@ -223,6 +221,7 @@ class Plc(AddressAccess):
         # are read-only to the program, so they are written once.
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
         self.mem.areas["SM"][22:28] = ms * 3
+        attach_devices(self.ports, plant)   # a plant device sends at given times
 
     # -- time -----------------------------------------------------------
     @property

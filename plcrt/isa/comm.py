@@ -31,21 +31,21 @@ def _table(g: Gen, resolver, text: str, what: str) -> str:
     try:
         op = resolver.parse(text)
     except ResolveError as e:
-        g.fail(f"{what} TBL: {e}")
+        g.fail(f"TBL: {e}")
     if isinstance(op, Indirect):
         return g.rd(op.ptr, "DU")
     if not (isinstance(op, Addr) and op.width == 1 and op.area in _TABLE_AREAS):
-        g.fail(f"{what} TBL must be a byte address in I, Q, M, S, SM or V (the table's first "
+        g.fail(f"TBL must be a byte address in I, Q, M, S, SM or V (the table's first "
                f"byte) or *VD/*AC/*LD, got '{excerpt(text)}'")
     return str(POINTER_AREAS[op.area] << 24 | op.offset)
 
 
 def _port(g: Gen, resolver, text: str, what: str) -> int:
-    port = int_constant(g, resolver, text, f"{what} PORT",
-                        f"{what} PORT must be the constant 0 or 1, got '{excerpt(text)}'")
+    port = int_constant(g, resolver, text, "PORT",
+                        f"PORT must be the constant 0 or 1, got '{excerpt(text)}'")
     ports = PORTS_OF.get(g.unit.model.name, 2)
     if not 0 <= port < ports:
-        g.fail(f"{what} PORT {port}: the {g.unit.model.name} has "
+        g.fail(f"PORT {port}: the {g.unit.model.name} has "
                f"{'port 0 only' if ports == 1 else 'ports 0 and 1'}")
     return port
 

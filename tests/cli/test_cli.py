@@ -58,14 +58,14 @@ def test_check_lists_unknown_and_unimplemented_with_locations(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     prog = write(tmp_path, "p.awl", ob1(
         "LD     I0.0\nLDX    I0.1\n=      Q0.0",
-        "LD     SM0.1\nTODR   VB0\nXMT    VB100, 0",
+        "LD     SM0.1\nTODR   VB0\nXMT    VB100, 2",
     ))
     code, _, err = run_cli(capsys, "check", prog)
     assert code == 1
     lines = err.splitlines()
     assert f"{prog}:6:1: error: unknown instruction 'LDX' [OB1 network 1]" in lines
     assert f"{prog}:10:1: error: instruction TODR is not implemented yet [OB1 network 2]" in lines
-    assert f"{prog}:11:1: error: instruction XMT is not implemented yet [OB1 network 2]" in lines
+    assert f"{prog}:11:1: error: XMT: PORT 2: the CPU226 has ports 0 and 1 [OB1 network 2]" in lines
     assert lines[-1] == f"{prog}: 3 errors, 0 warnings"
 
 

@@ -20,8 +20,8 @@ CASES = [
     # (id, program text, expected fragments of the first error line)
     ("unknown mnemonic", _prog("LD     I0.0\nLDX    I0.1\n"),
      ["prog.awl:6:1: error: unknown instruction 'LDX' [OB1 network 1]"]),
-    ("unimplemented", _prog("LD     I0.0\nPID    VB100, 0\n"),
-     ["prog.awl:6:1: error: instruction PID is not implemented yet [OB1 network 1]"]),
+    ("unimplemented", _prog("LD     I0.0\nGPA    VB100, 0\n"),
+     ["prog.awl:6:1: error: instruction GPA is not implemented yet [OB1 network 1]"]),
     ("wrong operand kind", _prog("LD     VW0\n=      Q0.0\n"),
      ["prog.awl:5:8: error: LD operand 1:", "'VW0' is not a valid bit"]),
     ("word where byte", _prog("LD     SM0.0\nMOVB   VW0, VB2\n"),

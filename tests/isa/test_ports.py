@@ -146,7 +146,7 @@ def test_port_1_is_a_compile_error_on_a_one_port_cpu():
 
 @pytest.mark.parametrize("operand", ["AC0", "VW100", "T37", "LB0"])
 def test_the_table_must_be_a_byte_address(operand):
-    with pytest.raises(PlcCompileError, match="XMT TBL must be a byte address"):
+    with pytest.raises(PlcCompileError, match="XMT: TBL must be a byte address"):
         plcrt.load(program(f"LD SM0.0\nXMT {operand}, 0"))
 
 

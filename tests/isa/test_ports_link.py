@@ -315,3 +315,22 @@ def test_get_of_a_remote_area_too_small_is_error_4():
     b = plcrt.load(program("LD SM0.0\n= Q0.0"), plant=ethernet("192.168.2.20"), scan_ms=1)
     plcrt.Network(a, b).run(0.01)
     assert a["VB450"] == 0xA4 and a["VB400"] == 0x80
+
+
+# ---------------------------------------------------------------- the sample
+def test_the_scale_sample_reads_a_weight_every_100_ms():
+    """programs/ports/scale.awl: the request 'W' CR goes at 100 ms (timed
+    interrupt), ends at 102084 µs; the scale answers 20 ms later with 8
+    characters, whose ETX ends at 122084 + 8334 µs: the message routine
+    runs then.  In 1 s: 9 answers (the 10th request goes at 1.0 s)."""
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2] / "programs" / "ports"
+    plc = plcrt.load(root / "scale.awl", plant=root / "scale_plant.toml")
+    runs = record(plc)
+    plc.run(1.0)
+    assert plc.diagnostics == []
+    assert plc["VW10"] == 9 and plc["VW12"] == 0
+    assert bytes(plc[f"VB{20 + k}"] for k in range(6)) == b"+012.5"
+    first = [t for n, t in runs if n == 0][0]
+    assert first == end(end(100_000, 2, 10, 9600) + 20_000, 8, 10, 9600) == 130_418
+    assert (1, 102_084) in runs and (2, 100_000) in runs

@@ -173,7 +173,7 @@ class Ethernet(Inbox):
     network of linked CPUs that can be reached (:mod:`.link`)."""
 
     def __init__(self, areas: dict[str, bytearray], warn: Callable[[str, str], None],
-                 touch: Callable[[], None], ip: Optional[bytes] = None,
+                 touch: Callable[[Any], None], ip: Optional[bytes] = None,
                  latency_us: int = LATENCY_US) -> None:
         super().__init__(touch)
         self.areas, self.warn = areas, warn

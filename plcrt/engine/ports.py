@@ -69,7 +69,7 @@ class Port(Inbox):
     the next event moved."""
 
     def __init__(self, number: int, areas: dict[str, bytearray], irq: Any,
-                 warn: Callable[[str, str], None], touch: Callable[[], None]) -> None:
+                 warn: Callable[[str, str], None], touch: Callable[[Any], None]) -> None:
         super().__init__(touch)
         self.number = number
         self.areas, self.sm = areas, areas["SM"]

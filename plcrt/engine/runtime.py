@@ -150,8 +150,10 @@ class Plc(AddressAccess):
         self.ports = make_ports(self, plant)
         self.ethernet = make_ethernet(self, plant)
         self.interrupts.ports = len(self.ports)
-        self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse,
-                                          *self.ports, self.ethernet], self._instant)
+        # perf: a port or the Ethernet interface joins the time line when it
+        # first has something to do (a program without traffic asks nothing)
+        self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse],
+                                   self._instant)
         #: I0.0–I0.3 whose edges come from a signal at exact times, not from
         #: the scan start (a pulse output or an encoder drives them)
         driven = {b for b, out in self.wiring.items() if out in (0, 1)} | set(self.encoders)
@@ -426,10 +428,15 @@ class Plc(AddressAccess):
         self._sources_on = True
         self.scheduler.touch()
 
-    def _wake(self) -> None:
-        """A port's next event moved (a character on its way, a job)."""
+    def _wake(self, source: Any) -> None:
+        """A port's (or the Ethernet interface's) next event moved: a
+        character on its way, a job; it joins the time line the first time."""
         self._sources_on = True
-        self.scheduler.touch()
+        if source.joined:
+            self.scheduler.touch()
+        else:
+            source.joined = True
+            self.scheduler.add(source)
 
     def _xmt(self, port: int, ptr: int) -> bool:
         return self.ports[port].xmt(self._irq_t, ptr)
@@ -692,8 +699,12 @@ class Plc(AddressAccess):
         dst._defined[:] = [dst.hsc[c.number] for c in self._defined]
         for port in (*dst.ports, dst.ethernet):
             port.drop_links()
-        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse, *dst.ports, dst.ethernet,
-                             *dst._counted])
+        # the sources that joined the time line, in the order they joined
+        twin = {id(c): dst.hsc[c.number] for c in self._counted}
+        twin.update({id(p): dst.ports[p.number] for p in self.ports})
+        twin[id(self.ethernet)] = dst.ethernet
+        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse,
+                             *(twin[id(s)] for s in self.scheduler.sources[4:])])
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))

@@ -80,21 +80,23 @@ class Inbox:
     An item is ``(t, seq, fn, args, link)``: at *t* the scheduler's fire
     calls ``fn(t, *args)``; *seq* keeps the order of items at one instant;
     *link* marks items that came from a linked CPU (a fork drops them).
-    *touch()* tells the owner's scheduler that the next event moved."""
+    *touch(inbox)* tells the owner's scheduler that the next event moved
+    (the first time, the inbox joins the scheduler's sources: ``joined``)."""
 
     #: the next event changes only through push (which touches) or fire
     cacheable = True
 
-    def __init__(self, touch: Callable[[], None]) -> None:
+    def __init__(self, touch: Callable[[Any], None]) -> None:
         self.touch = touch
         self.items: list[tuple[int, int, Any, tuple, bool]] = []
         self._seq = 0
+        self.joined = False       #: in the scheduler's sources
 
     def push(self, t: int, fn: Callable[..., None], *args: Any, link: bool = False) -> None:
         """Run ``fn(t, *args)`` at *t*."""
         self._seq += 1
         heapq.heappush(self.items, (t, self._seq, fn, args, link))
-        self.touch()
+        self.touch(self)
 
     def live(self) -> bool:
         return bool(self.items)
@@ -107,7 +109,7 @@ class Inbox:
 
     def fire(self, t: int) -> None:
         items = self.items
-        while items and items[0][0] == t:
+        while items and items[0][0] <= t:
             _, _, fn, args, _ = heapq.heappop(items)
             fn(t, *args)
 

@@ -267,7 +267,11 @@ class Plc(AddressAccess):
     def _scan_once(self) -> None:
         now = self._t_us
         self._scan_begin()
-        self._timeline(now, now + self.scan_us, True)
+        # perf: the time line only once a source may have events (a timed
+        # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
+        # a port's traffic), or a device runs
+        if self.interrupts.timed_next or self._sources_on or self.devices:
+            self._timeline(now, now + self.scan_us, True)
         self._scan_end(now)
 
     def _scan_begin(self) -> None:

@@ -111,7 +111,8 @@ class Network:
     def ethernet_of(self, ip: bytes) -> Optional[Any]:
         """The Ethernet interface with address *ip* in this network."""
         for plc in self.plcs:
-            if plc.ethernet.ip == ip and plc.mode == "RUN":
+            # a CPU in STOP still serves GET/PUT (its server runs)
+            if plc.ethernet.ip == ip:
                 return plc.ethernet
         return None
 
@@ -138,9 +139,15 @@ class Network:
         key = id(plc)
         while True:
             start = self._scan[key]
+            if plc.mode != "RUN":
+                # STOP (a STOP instruction, a fault): its time stands; the
+                # others run on, and what reaches it waits in its inbox
+                self._scan[key] = None
+                self._pos[key] = max(self._pos[key], limit)
+                return
             if start is None:
                 s = plc.now_us
-                if s > limit or plc.mode != "RUN":
+                if s > limit:
                     self._pos[key] = max(self._pos[key], limit)
                     return
                 plc._scan_begin()

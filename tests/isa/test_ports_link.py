@@ -334,3 +334,55 @@ def test_the_scale_sample_reads_a_weight_every_100_ms():
     first = [t for n, t in runs if n == 0][0]
     assert first == end(end(100_000, 2, 10, 9600) + 20_000, 8, 10, 9600) == 130_418
     assert (1, 102_084) in runs and (2, 100_000) in runs
+
+
+def test_two_ports_of_one_cpu_can_be_linked():
+    """Port 0 to port 1 of one CPU 226: what port 0 sends, port 1 receives
+    (its message routine at the 4th stop bit's end)."""
+    src = program("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#09, SMB130\nMOVB 16#90, SMB187\n"
+                  "MOVW +0, SMW190\nMOVB 4, SMB194\nATCH INT_0, 24\nENI\nRCV VB200, 1\n"
+                  "MOVB 4, VB100\nMOVD 16#0A0B0C0D, VD101\nXMT VB100, 0",
+                  "LD SM0.0\nINCW VW0\nMOVB SMB186, VB10")
+    plc = plcrt.load(src, scan_ms=10)
+    runs = record(plc)
+    plcrt.link(plc, 0, plc, 1).run(0.02)
+    assert runs == [(0, end(0, 4, 10, 9600))] and plc["VB10"] == 0x02
+    assert received(plc) == bytes.fromhex("0A 0B 0C 0D")
+
+
+def test_a_fork_of_a_linked_cpu_is_not_linked():
+    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
+    b = plcrt.load(program(SLAVE, ECHO), scan_ms=3)
+    net = plcrt.link(a, 0, b, 0)
+    net.run(0.002)                      # A's 4 bytes are on their way to B
+    twin = b.fork()
+    assert twin.network is None and twin.ports[0].peer is None
+    assert twin.ports[0].items == []    # what A sent stays with the linked B
+    twin.run(0.02)                      # runs alone: nothing arrives
+    assert twin["VW0"] == 0
+    net.run(0.02)
+    assert b["VW0"] == 1 and a["VW0"] == 1
+
+
+def test_a_cpu_that_stops_stands_while_the_other_runs_on():
+    """B executes STOP in its first scan: its time stands, A runs on and its
+    request goes unanswered (A's message timer ends the receive)."""
+    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
+    b = plcrt.load(program("LD SM0.1\nSTOP"), scan_ms=10)
+    net = plcrt.link(a, 0, b, 0)
+    net.run(0.1)
+    assert b.mode == "STOP" and b.time == pytest.approx(0.01)
+    assert a.time == pytest.approx(0.1) and a["VB10"] == 0x04      # A's timer ended it
+
+
+def test_plcrt_run_lists_the_ports_as_json(capsys):
+    import json
+    from pathlib import Path
+    from plcrt.cli import main
+    root = Path(__file__).resolve().parents[2] / "programs" / "ports"
+    code = main(["run", str(root / "scale.awl"), "--plant", str(root / "scale_plant.toml"),
+                 "--seconds", "0.5", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert out["ports"] == [{"port": 0, "mode": "freeport", "baud": 9600, "sent": 10,
+                             "received": 32, "unanswered": 0}]

@@ -210,10 +210,10 @@ class Port(Inbox):
         rx = self.rx
         if rx is None or self.framing().protocol != "freeport":
             return
-        if rx.phase == "break":
+        if rx.brk and rx.phase in ("break", "start", "first"):
             rx.phase = "start" if rx.start is not None else "first"
-        elif rx.phase in ("idle", "start", "first") and rx.brk:
-            rx.phase = "start" if rx.start is not None else "first"
+        elif rx.phase == "idle":
+            rx.idle_ref = t              # a break is activity: the idle time starts again
 
     # ------------------------------------------------------------ RCV
     def rcv(self, t: int, ptr: int) -> bool:

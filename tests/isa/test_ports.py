@@ -320,3 +320,12 @@ def test_characters_to_a_port_in_ppi_mode_are_ignored():
                      scan_ms=1)
     plc.run(0.02)
     assert plc["VW2"] == 0 and plc["M0.0"] == 0
+
+
+def test_a_break_keeps_the_line_busy_for_the_idle_line_condition():
+    """SMW90 = 5 ms: a break ending at 4 ms restarts the idle time, so '33'
+    at 7 ms is not yet a message start; '44' at 15 ms is."""
+    plc = plcrt.load(rcv_program(EN | IL, idle_ms=5, max_count=1),
+                     plant=sends((0.0023, ""), (0.007, "33"), (0.015, "44")), scan_ms=1)
+    plc.run(0.03)
+    assert received(plc) == bytes.fromhex("44") and plc["VB10"] == 0x02

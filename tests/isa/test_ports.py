@@ -329,3 +329,19 @@ def test_a_break_keeps_the_line_busy_for_the_idle_line_condition():
                      plant=sends((0.0023, ""), (0.007, "33"), (0.015, "44")), scan_ms=1)
     plc.run(0.03)
     assert received(plc) == bytes.fromhex("44") and plc["VB10"] == 0x02
+
+
+def test_every_character_interrupts_with_smb2_at_its_stop_bit():
+    """Event 8 without RCV: each character's routine runs when its stop bit
+    ends, with the character in SMB2 (the routine stores them through a
+    pointer); port 1's characters use event 25 and the same SMB2."""
+    src = program("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#05, SMB130\nMOVD &VB300, VD50\n"
+                  "ATCH INT_0, 8\nATCH INT_0, 25\nENI",
+                  "LD SM0.0\nMOVB SMB2, *VD50\nINCD VD50")
+    plant = sends((0.001, "31 32 33")) + "[port.1]\n[[port.1.send]]\nat = 0.010\ndata = \"7E\"\n"
+    plc = plcrt.load(src, plant=plant, scan_ms=1)
+    runs = record(plc)
+    plc.run(0.02)
+    assert runs == [(0, end(1000, k, 10, 9600)) for k in (1, 2, 3)] + \
+        [(0, end(10_000, 1, 10, 19200))]
+    assert bytes(plc[f"VB{300 + k}"] for k in range(4)) == b"123~"

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
-from .serial import Framing, Inbox
+from .serial import Framing, Inbox, table_at
 
 __all__ = ["Ethernet", "netr_netw", "make_ethernet", "PPI_CHARS", "NO_ANSWER_US", "LATENCY_US"]
 
@@ -184,10 +184,10 @@ class Ethernet(Inbox):
 
     def get_put(self, t: int, ptr: int, kind: str) -> bool:
         """GET or PUT at *t* with the table *ptr* points to; the ENO."""
-        at = _table(self.areas, ptr)
+        at = table_at(self.areas, ptr, 16)
         if at is None:
-            self.warn(f"{kind}: the table at pointer 16#{ptr:08X} is not 16 bytes in I, Q, M "
-                      f"or V; nothing is done, ENO = 0", "getput-table")
+            self.warn(f"{kind}: the table at pointer 16#{ptr:08X} is not 16 bytes in I, Q, M, "
+                      f"S, SM or V; nothing is done, ENO = 0", "getput-table")
             return False
         buf, off = at
         if _active(self.jobs, buf, off):
@@ -232,10 +232,6 @@ class Ethernet(Inbox):
     def drop_links(self) -> None:
         super().drop_links()
         self.network = None
-
-
-def _table(areas: dict[str, bytearray], ptr: int) -> Optional[tuple[bytearray, int]]:
-    return _area(areas, ptr, 16)
 
 
 def _unicast(ip: bytes) -> bool:

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
-from .serial import Framing, Inbox, framing_of
+from .serial import Framing, Inbox, framing_of, table_at
 
 __all__ = ["Port", "make_ports", "attach_devices", "PORTS_OF", "STATUS"]
 
@@ -44,8 +44,6 @@ PORTS_OF = {"CPU221": 1, "CPU222": 1, "CPU224": 1, "CPU224XP": 2, "CPU226": 2}
 #: SMB86 status bits: why the receive ended
 STATUS = {"user": 0x80, "parameter": 0x40, "end": 0x20, "timer": 0x04, "count": 0x02,
           "parity": 0x01}
-#: pointer area code (plcrt.compiler.operands.POINTER_AREAS) -> area a table may be in
-_TABLE_AREAS = {0x01: "I", 0x02: "Q", 0x03: "M", 0x04: "S", 0x05: "SM", 0x08: "V"}
 #: the first unanswered transmissions reported one by one (then one summary)
 REPORTED = 20
 
@@ -96,11 +94,7 @@ class Port(Inbox):
 
     def table(self, ptr: int) -> Optional[tuple[bytearray, int]]:
         """The buffer and offset a TBL pointer names, or None."""
-        name = _TABLE_AREAS.get(ptr >> 24)
-        off = ptr & 0xFFFFFF
-        if name is None or off >= len(self.areas[name]):
-            return None
-        return self.areas[name], off
+        return table_at(self.areas, ptr)
 
     def _refuse(self, what: str, t: int, fr: Framing) -> bool:
         self.warn(f"{what} on port {self.number} at {t / 1e6:.6f} s: SMB{self.control} selects "

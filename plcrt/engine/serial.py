@@ -24,7 +24,8 @@ import heapq
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
-__all__ = ["Framing", "Inbox", "BAUDS", "PROTOCOLS", "framing_of", "MIN_CHAR_US"]
+__all__ = ["Framing", "Inbox", "BAUDS", "PROTOCOLS", "framing_of", "MIN_CHAR_US",
+           "table_at"]
 
 #: baud code (bits 4..2 of SMB30/SMB130) -> bits per second (System Manual,
 #: "SMB30 and SMB130": 000 = 38400 ... 101 = 1200; 110 = 115200 and
@@ -36,6 +37,21 @@ PROTOCOLS: tuple[str, ...] = ("PPI slave", "freeport", "PPI master", "PPI slave"
 #: baud: 9 bits = 78.125 µs), whole µs below it: the longest lockstep window
 #: of linked CPUs (plcrt.engine.link)
 MIN_CHAR_US = 9 * 1_000_000 // 115200
+
+
+#: pointer area code (plcrt.compiler.operands.POINTER_AREAS) -> the areas an
+#: instruction's table may be in (System Manual, XMT/RCV/NETR/NETW operands)
+TABLE_AREAS = {0x01: "I", 0x02: "Q", 0x03: "M", 0x04: "S", 0x05: "SM", 0x08: "V"}
+
+
+def table_at(areas: dict[str, bytearray], ptr: int,
+             size: int = 1) -> Optional[tuple[bytearray, int]]:
+    """The buffer and offset of a *size*-byte table *ptr* points to, or None."""
+    name = TABLE_AREAS.get(ptr >> 24)
+    off = ptr & 0xFFFFFF
+    if name is None or off + size > len(areas[name]):
+        return None
+    return areas[name], off
 
 
 @dataclass(frozen=True, slots=True)

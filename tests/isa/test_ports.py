@@ -345,3 +345,18 @@ def test_every_character_interrupts_with_smb2_at_its_stop_bit():
     assert runs == [(0, end(1000, k, 10, 9600)) for k in (1, 2, 3)] + \
         [(0, end(10_000, 1, 10, 19200))]
     assert bytes(plc[f"VB{300 + k}"] for k in range(4)) == b"123~"
+
+
+@pytest.mark.parametrize("insn", ["XMT *VD50, 0", "RCV *VD50, 0", "NETR *VD50, 0",
+                                  "GET *VD50"])
+def test_a_pointer_to_no_table_area_gives_eno_0(insn):
+    """A pointer to T memory (area code 9) or past the end of V names no
+    table: nothing is done, ENO 0, and the diagnostics say so."""
+    for ptr in ("16#09000000", "16#08002800"):
+        src = program(f"LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#90, SMB87\nMOVB 5, SMB94\n"
+                      f"MOVD {ptr}, VD50\n{insn}\nAENO\n= M0.0")
+        plc = plcrt.load(src)
+        plc.scan()
+        assert plc["M0.0"] == 0
+        assert any("16#" + ptr[3:] in d.message and "ENO = 0" in d.message
+                   for d in plc.diagnostics), [d.message for d in plc.diagnostics]

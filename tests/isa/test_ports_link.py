@@ -133,8 +133,8 @@ MASTER = ("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#9C, SMB87\nMOVW +0, SMW90\nMOVW 
 #: the slave echoes each message with every byte + 1, from its message routine
 SLAVE = ("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#90, SMB87\nMOVW +0, SMW90\nMOVB 4, SMB94\n"
          "ATCH INT_0, 23\nENI\nRCV VB200, 0")
-ECHO = ("LD SM0.0\nINCW VW0\nMOVB SMB86, VB10\nMOVD VD201, VD220\nMOVD VD201, VD101\n+D 16#01010101, VD101\n"
-        "MOVB 4, VB100\nXMT VB100, 0\nRCV VB200, 0")
+ECHO = ("LD SM0.0\nINCW VW0\nMOVB SMB86, VB10\nMOVD VD201, VD220\nMOVD VD201, VD101\n"
+        "+D 16#01010101, VD101\nMOVB 4, VB100\nXMT VB100, 0\nRCV VB200, 0")
 
 
 def test_two_linked_cpus_exchange_xmt_and_rcv_at_the_exact_times():

@@ -626,13 +626,18 @@ class Plc(AddressAccess):
         Raises:
             PlcConfigError: ``snapshot`` is not a snapshot, or it was taken
                 from a different program, or from the same parsed program
-                compiled with other options (symbols, CPU, plant, probes).
+                compiled with other options (symbols, CPU, plant, probes), or this
+                PLC is linked to others (plcrt.link).
         """
         if not isinstance(snapshot, Plc):
             raise PlcConfigError(f"restore() needs a snapshot made by snapshot(), got "
                                  f"{type(snapshot).__name__}")
         if snapshot.program is not self.program:
             raise PlcConfigError("this snapshot was taken from a different program")
+        if self.network is not None:
+            raise PlcConfigError("this PLC is linked to others (plcrt.link): going back in time "
+                                 "would break what they exchanged; restore before linking, or "
+                                 "fork and restore the unlinked twin")
         if (snapshot.source != self.source or snapshot.model != self.model
                 or len(snapshot.devices) != len(self.devices)
                 or (snapshot.coverage is None) != (self.coverage is None)):

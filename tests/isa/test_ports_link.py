@@ -386,3 +386,15 @@ def test_plcrt_run_lists_the_ports_as_json(capsys):
     assert code == 0
     assert out["ports"] == [{"port": 0, "mode": "freeport", "baud": 9600, "sent": 10,
                              "received": 32, "unanswered": 0}]
+
+
+def test_a_linked_cpu_cannot_go_back_in_time():
+    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
+    b = plcrt.load(program(SLAVE, ECHO), scan_ms=3)
+    snap = a.snapshot()
+    plcrt.link(a, 0, b, 0).run(0.01)
+    with pytest.raises(PlcConfigError, match="linked to others"):
+        a.restore(snap)
+    twin = a.fork()
+    twin.restore(snap)                  # an unlinked twin may
+    assert twin.now_us == 0

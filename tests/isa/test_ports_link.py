@@ -398,3 +398,21 @@ def test_a_linked_cpu_cannot_go_back_in_time():
     twin = a.fork()
     twin.restore(snap)                  # an unlinked twin may
     assert twin.now_us == 0
+
+
+def test_a_short_ethernet_latency_shortens_the_lockstep_window():
+    """latency_ms = 0.01 (10 µs one way): B's memory is written at 10 µs,
+    A's PUT is done at 20 µs, although the windows are otherwise 78 µs."""
+    a = plcrt.load(program(GETPUT), plant=ethernet("192.168.2.10", "latency_ms = 0.01"),
+                   scan_ms=1)
+    b = plcrt.load(program("LD SM0.0\n= Q0.0"), plant=ethernet("192.168.2.20"), scan_ms=1)
+    seen = []
+    for t in (9, 10, 11):                # B's memory as its own time line sees it
+        b.ethernet.push(t, lambda t: seen.append((t, b["VD700"] & 0xFFFFFFFF)))
+    net = plcrt.Network(a, b)
+    net.run(0.000019)
+    assert a["VB400"] == 0x40
+    net.run(0.000001)
+    assert a["VB400"] == 0x80
+    # at 10 µs the probe scheduled first runs first, then the PUT's write
+    assert seen == [(9, 0), (10, 0), (11, 0x11223344)]

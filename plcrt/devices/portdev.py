@@ -192,8 +192,8 @@ def parse_ethernet(raw: Any, file: str) -> EthernetConfig:
     if ip[0] in (0, 127) or ip[0] >= 224 or ip[3] in (0, 255):
         raise PlcConfigError(f"{where}.ip {raw['ip']} is not an address a CPU can have")
     latency = _seconds(raw.get("latency_ms", 1.0), f"{where}.latency_ms", 10_000) // 1000
-    if latency < 1:
-        raise PlcConfigError(f"{where}.latency_ms must be at least 0.001")
+    if latency < 2:
+        raise PlcConfigError(f"{where}.latency_ms must be at least 0.002 (2 µs)")
     return EthernetConfig(ip, latency)
 
 

@@ -15,8 +15,8 @@ after the other.  Whatever a CPU sends at a time s in a window arrives at
 the other end no earlier than one character later, after the end of the
 window, which the receiver has not yet run: the character, an answer to
 NETR/NETW or GET/PUT, is put into the receiver's time line before its time
-comes.  (An Ethernet latency below 78 µs in a plant makes the windows that
-short.)  A scan is cut into windows only here (the main program runs at the
+comes.  (A plant's Ethernet latency below 79 µs makes the windows one µs
+shorter than it.)  A scan is cut into windows only here (the main program runs at the
 scan's start as always); a CPU that is not linked runs its scans whole.
 
 What it is not: no collisions on the wire (two ports that send at once
@@ -129,8 +129,10 @@ class Network:
         span = scan_total(1, seconds, None)          # µs, validated
         end = self.time_us + span
         t = self.time_us
-        # no window longer than the quickest way from one CPU to another
-        window = min([MIN_CHAR_US] + [p.ethernet.latency_us for p in self.plcs])
+        # a window shorter than the quickest way from one CPU to another
+        # (a character: at least 79 µs; Ethernet: the latency), so that what
+        # a CPU sends at the window's start arrives after its end
+        window = min([MIN_CHAR_US] + [p.ethernet.latency_us - 1 for p in self.plcs])
         while t < end:
             t = min(t + window, end)
             for plc in self.plcs:

@@ -90,6 +90,8 @@ def _serve(areas: dict[str, bytearray], job: _Job, refused: int) -> None:
 def _finish(jobs: list[_Job], job: _Job) -> None:
     jobs.remove(job)
     buf, off = job.buf, job.off
+    if not job.error and job.kind in ("NETR", "GET") and len(job.data) != job.n:
+        job.error = 1 if job.kind == "NETR" else 5     # no answer came (never by design)
     if job.error:
         buf[off] = 0xA0 | job.error         # D and E, the error code
         return

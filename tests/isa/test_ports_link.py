@@ -104,6 +104,7 @@ def test_many_unanswered_transmissions_are_summarised():
     ("[ethernet]\nip = \"300.1.1.1\"\n", "IPv4 address"),
     ("[ethernet]\nip = \"192.168.2.255\"\n", "not an address a CPU can have"),
     ("[ethernet]\n", "ip is missing"),
+    ("[ethernet]\nip = \"10.0.0.1\"\nlatency_ms = 0.001\n", "at least 0.002"),
 ])
 def test_plant_port_keys_are_validated_with_their_location(plant, match):
     with pytest.raises(PlcConfigError, match=match) as e:
@@ -409,7 +410,7 @@ def test_a_short_ethernet_latency_shortens_the_lockstep_window():
     seen = []
     for t in (9, 10, 11):                # B's memory as its own time line sees it
         b.ethernet.push(t, lambda t: seen.append((t, b["VD700"] & 0xFFFFFFFF)))
-    net = plcrt.Network(a, b)
+    net = plcrt.Network(b, a)            # B's windows run before A's
     net.run(0.000019)
     assert a["VB400"] == 0x40
     net.run(0.000001)

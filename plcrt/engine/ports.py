@@ -12,7 +12,8 @@ instructions" (Transmit, Receive) and "Freeport mode":
 * ``XMT TBL, PORT``: TBL holds a count byte and the characters (count 0
   sends a break of 16 bit times).  SM4.5 / SM4.6 are the transmitters'
   idle bits; the transmit-complete event 9 / 26 occurs when the last stop
-  bit ends.
+  bit ends.  The port is half duplex: XMT while a receive runs, or RCV
+  while a transmission runs, is the manual's error 0009 / 000B.
 * ``RCV TBL, PORT``: the receive message function, set up by SMB87..SMB94 /
   SMB187..SMB194 (control byte ``en sc ec il c/m tmr bk 0``, start and end
   character, idle-line time SMW90, timer SMW92, maximum count SMB94); it
@@ -104,13 +105,14 @@ class Port(Inbox):
 
     def _busy(self, what: str, t: int) -> bool:
         # System Manual, XMT/RCV: error 0009 (port 0) / 000B (port 1),
-        # simultaneous XMT/RCV; a run-time programming error (SM4.3)
+        # simultaneous XMT/RCV; a run-time programming error (SM4.3).  The
+        # port is half duplex: one transmission or one receive at a time.
         self.sm[4] |= 0x08
         code = "0009" if self.number == 0 else "000B"
-        self.warn(f"{what} on port {self.number} at {t / 1e6:.6f} s while its "
-                  f"{'transmission' if what == 'XMT' else 'receive'} is still running: "
-                  f"error {code} (simultaneous XMT/RCV), nothing is done, ENO = 0, SM4.3 set",
-                  f"port-busy-{self.number}-{what}")
+        running = "a transmission" if self.tx_end is not None else "a receive (RCV)"
+        self.warn(f"{what} on port {self.number} at {t / 1e6:.6f} s while {running} is still "
+                  f"running: error {code} (simultaneous XMT/RCV; the port is half duplex), "
+                  f"nothing is done, ENO = 0, SM4.3 set", f"port-busy-{self.number}-{what}")
         return False
 
     def _bad_table(self, what: str, ptr: int, why: str) -> bool:
@@ -124,7 +126,7 @@ class Port(Inbox):
         fr = self.framing()
         if fr.protocol != "freeport":
             return self._refuse("XMT", t, fr)
-        if self.tx_end is not None:
+        if self.tx_end is not None or self.rx is not None:
             return self._busy("XMT", t)
         at = self.table(ptr)
         if at is None:
@@ -222,7 +224,7 @@ class Port(Inbox):
             if self.rx is not None:
                 self._end(t, STATUS["user"])
             return True
-        if self.rx is not None:
+        if self.rx is not None or self.tx_end is not None:
             return self._busy("RCV", t)
         at = self.table(ptr)
         if at is None:

@@ -360,3 +360,21 @@ def test_a_pointer_to_no_table_area_gives_eno_0(insn):
         assert plc["M0.0"] == 0
         assert any("16#" + ptr[3:] in d.message and "ENO = 0" in d.message
                    for d in plc.diagnostics), [d.message for d in plc.diagnostics]
+
+
+def test_the_port_is_half_duplex():
+    """XMT while the port's receive runs, and RCV while it transmits, are the
+    manual's 'simultaneous XMT/RCV' (error 0009): ENO 0, SM4.3."""
+    src = program("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#90, SMB87\nMOVW +0, SMW90\n"
+                  "MOVB 10, SMB94\nMOVB 2, VB100\nRCV VB200, 0\nXMT VB100, 0\nAENO\n"
+                  "S M0.0, 1\n\nLD I0.0\nMOVB 16#10, SMB87\nRCV VB200, 0\nMOVB 16#90, SMB87\n"
+                  "XMT VB100, 0\nRCV VB200, 0\nAENO\nS M0.1, 1")
+    plc = plcrt.load(src, scan_ms=1)
+    plc.scan()
+    assert plc["M0.0"] == 0 and plc["SM4.3"] == 1 and plc.ports[0].sent == 0
+    assert any("while a receive (RCV) is still running: error 0009" in d.message
+               for d in plc.diagnostics)
+    plc["I0.0"] = 1                      # end the receive, send, then RCV: refused
+    plc.scan()
+    assert plc.ports[0].sent == 2 and plc["M0.1"] == 0 and plc.ports[0].rx is None
+    assert any("while a transmission is still running" in d.message for d in plc.diagnostics)

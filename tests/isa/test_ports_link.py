@@ -25,14 +25,16 @@ request = "02"
 reply = "DD"
 """
 
-#: XMT the VB100 table once; RCV into VB200 any character, 20 ms message timer
+#: XMT the VB100 table once; when it is out (event 9, the port is half
+#: duplex) RCV into VB200 any character, with a 20 ms message timer
 ASK = ("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#9C, SMB87\nMOVW +0, SMW90\nMOVW +20, SMW92\n"
-       "MOVB 10, SMB94\nATCH INT_0, 23\nENI\nRCV VB200, 0\nXMT VB100, 0")
+       "MOVB 10, SMB94\nATCH INT_0, 23\nATCH INT_1, 9\nENI\nXMT VB100, 0")
 DONE = "LD SM0.0\nINCW VW0\nMOVB SMB86, VB10"
+LISTEN = "LD SM0.0\nRCV VB200, 0"
 
 
 def ask(data: str, plant: str = DEVICE) -> plcrt.Plc:
-    plc = plcrt.load(program(ASK, DONE), plant=plant, scan_ms=1)
+    plc = plcrt.load(program(ASK, DONE, LISTEN), plant=plant, scan_ms=1)
     raw = bytes.fromhex(data)
     plc["VB100"] = len(raw)
     for k, b in enumerate(raw):
@@ -41,14 +43,14 @@ def ask(data: str, plant: str = DEVICE) -> plcrt.Plc:
 
 
 def test_the_scripted_device_answers_a_request_after_its_delay():
-    """'01 03' ends at 2084 µs; the reply starts 5 ms later; its three
-    characters end at 7084 + 3125 µs; the 20 ms message timer ends the
-    receive with the reply in the buffer."""
+    """'01 03' ends at 2084 µs, when the RCV starts; the reply starts 5 ms
+    later; its three characters end at 7084 + 3125 µs; the 20 ms message
+    timer (from the RCV) ends the receive with the reply in the buffer."""
     plc = ask("01 03")
     runs = record(plc)
-    plc.run(0.03)
+    plc.run(0.04)
     assert received(plc) == bytes.fromhex("AA BB CC")
-    assert runs == [(0, 20_000)] and plc["VB10"] == 0x04
+    assert runs == [(1, 2084), (0, 22_084)] and plc["VB10"] == 0x04
     assert plc.ports[0].peer.answered == 1 and plc.ports[0].unanswered == []
     assert plc.ports[0].items == []
     t_reply = end(0, 2, 10, 9600) + 5000
@@ -57,11 +59,13 @@ def test_the_scripted_device_answers_a_request_after_its_delay():
 
 
 def test_two_requests_in_one_transmission_are_answered_in_turn():
-    """'02 01 03': 02 is answered at once (its reply 'DD'), then 01 03 after
-    5 ms; the second reply waits for nothing (the first has ended)."""
+    """'02 01 03': 02 is answered at once: 'DD' arrives while the port
+    still sends 01 03, before its RCV (half duplex), so it is a character
+    (SMB2) but not in the message; 01 03 is answered 5 ms later."""
     plc = ask("02 01 03")
-    plc.run(0.03)
-    assert received(plc) == bytes.fromhex("DD AA BB CC")
+    plc.run(0.04)
+    assert received(plc) == bytes.fromhex("AA BB CC")
+    assert plc.ports[0].received == 4 and plc.ports[0].peer.answered == 2
 
 
 def test_bytes_nobody_answers_are_in_the_diagnostics():
@@ -128,44 +132,47 @@ def test_a_fork_with_a_receive_in_progress_runs_the_same():
 
 
 # ---------------------------------------------------------------- two CPUs
+#: A sends 4 bytes, then (event 9) receives 4, with a 50 ms message timer
 MASTER = ("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#9C, SMB87\nMOVW +0, SMW90\nMOVW +50, SMW92\n"
-          "MOVB 4, SMB94\nATCH INT_0, 23\nENI\nRCV VB200, 0\nMOVB 4, VB100\n"
+          "MOVB 4, SMB94\nATCH INT_0, 23\nATCH INT_1, 9\nENI\nMOVB 4, VB100\n"
           "MOVD 16#01020304, VD101\nXMT VB100, 0")
-#: the slave echoes each message with every byte + 1, from its message routine
+#: B echoes each message with every byte + 1 from its message routine and
+#: receives again when the echo is out
 SLAVE = ("LD SM0.1\nMOVB 16#09, SMB30\nMOVB 16#90, SMB87\nMOVW +0, SMW90\nMOVB 4, SMB94\n"
-         "ATCH INT_0, 23\nENI\nRCV VB200, 0")
+         "ATCH INT_0, 23\nATCH INT_1, 9\nENI\nRCV VB200, 0")
 ECHO = ("LD SM0.0\nINCW VW0\nMOVB SMB86, VB10\nMOVD VD201, VD220\nMOVD VD201, VD101\n"
-        "+D 16#01010101, VD101\nMOVB 4, VB100\nXMT VB100, 0\nRCV VB200, 0")
+        "+D 16#01010101, VD101\nMOVB 4, VB100\nXMT VB100, 0")
 
 
 def test_two_linked_cpus_exchange_xmt_and_rcv_at_the_exact_times():
-    """A sends 4 bytes at 0; B's receive ends by count when the 4th stop
-    bit ends (4167 µs) and its routine sends the answer then; A has it when
-    that answer's 4th stop bit ends (8334 µs).  Both CPUs see the same
-    times although their scans differ (10 ms and 3 ms)."""
-    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
-    b = plcrt.load(program(SLAVE, ECHO), scan_ms=3)
+    """A sends 4 bytes at 0 and starts receiving when they are out (4167 µs);
+    B's receive ends by count when the 4th stop bit ends (4167 µs) and its
+    routine sends the answer then; A has it when that answer's 4th stop bit
+    ends (8334 µs).  Both CPUs see the same times although their scans
+    differ (10 ms and 3 ms)."""
+    a = plcrt.load(program(MASTER, DONE, LISTEN), scan_ms=10)
+    b = plcrt.load(program(SLAVE, ECHO, LISTEN), scan_ms=3)
     runs_a, runs_b = record(a), record(b)
     net = plcrt.link(a, 0, b, 0)
     net.run(0.03)
     t1 = end(0, 4, 10, 9600)
-    assert runs_b == [(0, t1)] and b["VB10"] == 0x02
+    assert runs_b == [(0, t1), (1, end(t1, 4, 10, 9600))] and b["VB10"] == 0x02
     assert b["VD220"] == 0x01020304 and b["VB200"] == 0     # copied; receiving again
-    assert runs_a == [(0, end(t1, 4, 10, 9600))] and a["VB10"] == 0x02
+    assert runs_a == [(1, t1), (0, end(t1, 4, 10, 9600))] and a["VB10"] == 0x02
     assert received(a) == bytes.fromhex("02 03 04 05")
     assert a.time == pytest.approx(0.03) and b.time == pytest.approx(0.030)
 
 
 def test_linked_cpus_with_other_baud_rates_receive_errors():
-    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
-    b = plcrt.load(program(SLAVE.replace("16#09", "16#05"), ECHO), scan_ms=3)
+    a = plcrt.load(program(MASTER, DONE, LISTEN), scan_ms=10)
+    b = plcrt.load(program(SLAVE.replace("16#09", "16#05"), ECHO, LISTEN), scan_ms=3)
     plcrt.link(a, 0, b, 0).run(0.02)
     assert b["VB10"] == 0x01             # the first character ends the receive: parity
     assert any("the port is set to 19200 baud" in d.message for d in b.diagnostics)
 
 
 def test_a_linked_plc_is_run_by_its_network_only():
-    a, b = plcrt.load(program(SLAVE, DONE)), plcrt.load(program(SLAVE, DONE))
+    a, b = plcrt.load(program(SLAVE, DONE, LISTEN)), plcrt.load(program(SLAVE, DONE, LISTEN))
     plcrt.link(a, 0, b, 0)
     with pytest.raises(PlcConfigError, match="run them together"):
         a.scan()
@@ -174,7 +181,8 @@ def test_a_linked_plc_is_run_by_its_network_only():
 
 
 def test_link_arguments_are_checked():
-    a, b = plcrt.load(program(SLAVE, DONE)), plcrt.load(program(SLAVE, DONE), cpu="CPU224")
+    a = plcrt.load(program(SLAVE, DONE, LISTEN))
+    b = plcrt.load(program(SLAVE, DONE, LISTEN), cpu="CPU224")
     with pytest.raises(PlcConfigError, match="port"):
         plcrt.link(a, 0, b, 1)
     with pytest.raises(PlcConfigError, match="loaded PLCs"):
@@ -352,8 +360,8 @@ def test_two_ports_of_one_cpu_can_be_linked():
 
 
 def test_a_fork_of_a_linked_cpu_is_not_linked():
-    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
-    b = plcrt.load(program(SLAVE, ECHO), scan_ms=3)
+    a = plcrt.load(program(MASTER, DONE, LISTEN), scan_ms=10)
+    b = plcrt.load(program(SLAVE, ECHO, LISTEN), scan_ms=3)
     net = plcrt.link(a, 0, b, 0)
     net.run(0.002)                      # A's 4 bytes are on their way to B
     twin = b.fork()
@@ -368,7 +376,7 @@ def test_a_fork_of_a_linked_cpu_is_not_linked():
 def test_a_cpu_that_stops_stands_while_the_other_runs_on():
     """B executes STOP in its first scan: its time stands, A runs on and its
     request goes unanswered (A's message timer ends the receive)."""
-    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
+    a = plcrt.load(program(MASTER, DONE, LISTEN), scan_ms=10)
     b = plcrt.load(program("LD SM0.1\nSTOP"), scan_ms=10)
     net = plcrt.link(a, 0, b, 0)
     net.run(0.1)
@@ -390,8 +398,8 @@ def test_plcrt_run_lists_the_ports_as_json(capsys):
 
 
 def test_a_linked_cpu_cannot_go_back_in_time():
-    a = plcrt.load(program(MASTER, DONE), scan_ms=10)
-    b = plcrt.load(program(SLAVE, ECHO), scan_ms=3)
+    a = plcrt.load(program(MASTER, DONE, LISTEN), scan_ms=10)
+    b = plcrt.load(program(SLAVE, ECHO, LISTEN), scan_ms=3)
     snap = a.snapshot()
     plcrt.link(a, 0, b, 0).run(0.01)
     with pytest.raises(PlcConfigError, match="linked to others"):

@@ -8,6 +8,8 @@ Public API::
     plc.scan()            # one scan cycle
     plc.run(seconds=2.0)  # simulated time, deterministic
     plc["Q0.0"], plc["VW100"], plc.time
+    net = plcrt.link(plc_a, 0, plc_b, 0)   # two CPUs port to port, run together
+    net.run(1.0)
 
 Everything else is internal and may change.
 """
@@ -22,6 +24,7 @@ from .errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigErro
 __version__ = "0.1.0"
 
 if TYPE_CHECKING:
+    from .engine.link import Network, link
     from .engine.runtime import Plc, load
 
 
@@ -31,10 +34,13 @@ def __getattr__(name: str) -> Any:
     if name in ("Plc", "load"):
         from .engine import runtime
         return getattr(runtime, name)
+    if name in ("link", "Network"):
+        from .engine import link
+        return getattr(link, name)
     raise AttributeError(f"module 'plcrt' has no attribute {name!r}")
 
 __all__ = [
-    "load", "Plc", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",
+    "load", "Plc", "link", "Network", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",
     "PlcCompileError", "PlcRuntimeError", "PlcAddressError", "PlcConfigError",
     "__version__",
 ]

@@ -491,6 +491,11 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
             obj["counters"] = [dict(zip(HSC_COLUMNS, r)) | {"mode": int(r[1]), "CV": int(r[2]),
                                                              "PV": int(r[3])}
                                for r in counters]
+        ports = port_rows(plc)
+        if ports:
+            obj["ports"] = [dict(zip(PORT_COLUMNS, r)) | {k: int(r[i]) for i, k in
+                                                          enumerate(PORT_COLUMNS) if i != 1}
+                            for r in ports]
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
@@ -597,6 +602,24 @@ def pulse_rows(plc: Any) -> list[list[str]]:
     return rows
 
 
+#: columns of the communication port table
+PORT_COLUMNS = ("port", "mode", "baud", "sent", "received", "unanswered")
+
+
+def port_rows(plc: Any) -> list[list[str]]:
+    """The ports that sent or received characters (plcrt.engine.ports):
+    mode, baud rate, characters sent and received, transmissions nobody
+    answered."""
+    rows = []
+    for p in plc.ports:
+        st = p.state()
+        if not (st["sent"] or st["received"] or st["unanswered"]):
+            continue
+        rows.append([str(p.number), st["mode"], str(st["baud"]), str(st["sent"]),
+                     str(st["received"]), str(st["unanswered"])])
+    return rows
+
+
 def hsc_rows(plc: Any) -> list[list[str]]:
     """The high-speed counters an HDEF defined: mode, CV, PV, enabled."""
     rows = []
@@ -617,13 +640,15 @@ def _print_devices(plc: Any) -> None:
         _print_table(_AXIS_COLUMNS, axis_rows(axes))
     if drives:
         _print_table(DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
-    pulses, counters = pulse_rows(plc), hsc_rows(plc)
+    pulses, counters, ports = pulse_rows(plc), hsc_rows(plc), port_rows(plc)
     if pulses:
         _print_table(PULSE_COLUMNS, pulses, left=(0, 1))
     if counters:
         _print_table(HSC_COLUMNS, counters, left=(0,))
+    if ports:
+        _print_table(PORT_COLUMNS, ports, left=(1,))
     # a plant that only wires the CPU's own inputs has no axes to speak of
-    if not axes and not drives and not pulses and not counters and (
+    if not axes and not drives and not pulses and not counters and not ports and (
             plc.modules or not (plc.wiring or plc.encoders or plc.devices)):
         print("axes: none configured in the plant")
 

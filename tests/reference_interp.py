@@ -238,6 +238,10 @@ class ReferencePlc:
         # SM66.7 / SM76.7: both pulse outputs idle (no PLS in these programs)
         if self.scans == 0:
             self.mem["SM"][66] = self.mem["SM"][76] = 0x80
+            # SM4.5 / SM4.6: the ports' transmitters idle (no XMT in these
+            # programs); a CPU 221/222/224 has port 0 only
+            one_port = self.model.name in ("CPU221", "CPU222", "CPU224")
+            self.mem["SM"][4] |= 0x20 if one_port else 0x60
 
     # -- operands -------------------------------------------------------------
     def address(self, text: str) -> Addr | None:

@@ -44,6 +44,15 @@
     [pwm.1]                     # the PWM wizard of Q0.1
     time_base = "us"
 
+    [port.0]                    # the CPU's port 0 (docs/ports.md, plcrt.devices.portdev)
+    address = 2                 # PPI station address
+    [[port.0.reply]]            # a scripted device answers a request
+    request = "01 03 00 00 00 01 84 0A"
+    reply = "01 03 02 00 2A 38 5B"
+    delay_ms = 5
+    [ethernet]                  # GET/PUT
+    ip = "192.168.2.10"
+
 Only this module reads the format; it returns plain dataclasses that the
 device implementations consume.  Every problem is a PlcConfigError naming
 the file and the key.
@@ -63,6 +72,7 @@ from ..lang.limits import file_limit, read_capped
 from .cia402.coupler import IMAGE_BYTES
 from .keys import checked_table
 from .em253.axis import AxisPlant
+from .portdev import EthernetConfig, PortConfig, parse_ethernet, parse_ports
 from .ptowizard.config import PtoConfig, PwmConfig, check_outputs, parse_pto, parse_pwm
 
 KINDS = ("EM253", "FIELDBUS")
@@ -114,6 +124,10 @@ class Plant:
     processes: list[dict[str, Any]] = field(default_factory=list)
     #: the real-time clock's reading at power-up (None: the default date)
     clock: Any = None
+    #: the communication ports' set-up and devices ([port.N], plcrt.devices.portdev)
+    ports: dict[int, PortConfig] = field(default_factory=dict)
+    #: the Ethernet interface for GET/PUT ([ethernet])
+    ethernet: EthernetConfig | None = None
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -151,11 +165,14 @@ def _build(data: dict, file: str) -> Plant:
     modules: dict[int, ModuleConfig] = {}
     # A misspelt table ([modules.0]) would otherwise give a plant without
     # modules and only run-time warnings: reject unknown keys at every level.
-    unknown = set(data) - {"module", "cpu", "pto", "pwm"}
+    unknown = set(data) - {"module", "cpu", "pto", "pwm", "port", "ethernet"}
     if unknown:
         raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
-                             f"(a plant file has [module.N] tables, a [cpu] table and "
-                             f"[pto.N] / [pwm.N] tables)")
+                             f"(a plant file has [module.N] tables, a [cpu] table, "
+                             f"[pto.N] / [pwm.N] tables, [port.N] tables and an [ethernet] "
+                             f"table)")
+    ports = parse_ports(data.get("port", {}), file)
+    ethernet = parse_ethernet(data["ethernet"], file) if "ethernet" in data else None
     wiring, encoders = _cpu(data.get("cpu", {}), file)
     processes = _processes(data.get("cpu", {}).get("process", []), f"{file}: cpu")
     pto = parse_pto(data.get("pto", {}), file)
@@ -199,7 +216,8 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders, pto, pwm, processes, clock)
+    return Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports,
+                 ethernet)
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)

@@ -76,8 +76,11 @@ class Scheduler:
         """A source's next event may have moved: ask them all again."""
         self.gen += 1
 
-    def run(self, t_from: int, t_to: int) -> None:
-        """Run (t_from, t_to]: events in time order, devices advanced to each."""
+    def run(self, t_from: int, t_to: int, first: bool = True) -> None:
+        """Run (t_from, t_to]: events in time order, devices advanced to each.
+        *first*: t_from is the scan's start (a linked network runs a scan in
+        pieces; the events at a later piece's t_from fired in the piece
+        before)."""
         plc, devices, on_instant = self.plc, self.plc.devices, self.after
         t = t_from
         # perf: a source's next event is asked once and kept until it fires
@@ -89,7 +92,7 @@ class Scheduler:
         # events that the program itself caused at the scan's instant (a
         # pulse train started by PLS reaching a counter's PV at once) are
         # asked for from just before it
-        after = t_from - 1
+        after = t_from - 1 if first else t_from
         while True:
             best = _NEVER
             gen = self.gen

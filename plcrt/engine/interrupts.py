@@ -85,6 +85,8 @@ GROUP_OF: dict[int, int] = {n: e.group for n, e in EVENTS.items()}
 GROUPS: tuple[tuple[str, int, int], ...] = (
     ("communications", 4, 0x01), ("discrete", 16, 0x02), ("timed", 8, 0x04))
 
+#: communication event -> its port (System Manual, table "Interrupt events")
+PORT_OF_EVENT: dict[int, int] = {8: 0, 9: 0, 23: 0, 25: 1, 26: 1, 24: 1}
 #: timed interrupt event -> its interval byte in SM (SMB34, SMB35)
 TIMED: dict[int, int] = {10: 34, 11: 35}
 #: input edge events: I0.x bit -> (rising event, falling event)
@@ -118,19 +120,20 @@ class Interrupts:
         #: something touches the sources; not while T32/T96 CT=PT is attached
         #: (a routine's TON moves that time without touching anything)
         self.cacheable = True
-        #: whether the CPU's communication ports are simulated (their events 8,
-        #: 9 and 23–26 can occur); until then ATCH to them is diagnosed
-        self.ports = False
+        #: how many communication ports the CPU has (plcrt.engine.ports sets
+        #: it; their events 8, 9, 23 / 24, 25, 26 occur); ATCH to the events
+        #: of a port it lacks is diagnosed
+        self.ports = 0
 
     # ------------------------------------------------------------ instructions
     def attach(self, int_number: int, event: int, t: int) -> None:
         """ATCH: *event* runs INT *int_number* from now on."""
         self.attached[event] = int_number
         self._attached_changed()
-        if EVENTS[event].group == 0 and not self.ports:
-            self.warn(f"event {event} ({EVENTS[event].name}) comes from a freeport "
-                      f"communication port, which this run does not simulate: INT "
-                      f"{int_number} is attached but never runs", f"irq-port-{event}")
+        if EVENTS[event].group == 0 and PORT_OF_EVENT[event] >= self.ports:
+            self.warn(f"event {event} ({EVENTS[event].name}) comes from a communication "
+                      f"port, which this CPU does not have: INT {int_number} is attached "
+                      f"but never runs", f"irq-port-{event}")
         sm_byte = TIMED.get(event)
         if sm_byte is None:
             return

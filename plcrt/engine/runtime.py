@@ -42,6 +42,8 @@ from .edges import SignalEdges
 from .hsc import Encoder, make_counters
 from .pid import make_loops
 from .pulse import make_outputs
+from .ports import attach_devices, make_ports
+from .netjobs import make_ethernet, netr_netw
 from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
 
@@ -143,6 +145,15 @@ class Plc(AddressAccess):
         #: one time line for the scan interval: event sources in priority order
         #: (a counter joins when HDEF gives it a pulse output to count)
         self.edges = SignalEdges(self)
+        #: the network of linked CPUs this one is in (plcrt.link), or None
+        self.network: Any = None
+        #: the communication ports 0 (and 1): XMT, RCV, NETR, NETW, and the
+        #: Ethernet interface: GET, PUT (plcrt.engine.ports, .netjobs)
+        self.ports = make_ports(self, plant)
+        self.ethernet = make_ethernet(self, plant)
+        self.interrupts.ports = len(self.ports)
+        # perf: a port or the Ethernet interface joins the time line when it
+        # first has something to do (a program without traffic asks nothing)
         self.scheduler = Scheduler(self, [self.interrupts, self.edges, *self.pulse],
                                    self._instant)
         #: I0.0–I0.3 whose edges come from a signal at exact times, not from
@@ -220,6 +231,7 @@ class Plc(AddressAccess):
         # are read-only to the program, so they are written once.
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
         self.mem.areas["SM"][22:28] = ms * 3
+        attach_devices(self.ports, plant)   # a plant device sends at given times
 
     # -- time -----------------------------------------------------------
     @property
@@ -237,6 +249,9 @@ class Plc(AddressAccess):
         """
         if type(n) is not int or n < 0:  # perf: one test for the usual scan(1)
             n = scan_number(n)
+        if self.network is not None:
+            raise PlcConfigError("this PLC is linked to others: run them together with the "
+                                 "network's run() (plcrt.link), not scan() or run()")
         for _ in range(n):
             if self.mode != "RUN":
                 return
@@ -258,6 +273,17 @@ class Plc(AddressAccess):
         self.scan(scan_total(self.scan_us, seconds, scans))
 
     def _scan_once(self) -> None:
+        now = self._t_us
+        self._scan_begin()
+        # perf: the time line only once a source may have events (a timed
+        # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
+        # a port's traffic), or a device runs
+        if self.interrupts.timed_next or self._sources_on or self.devices:
+            self._timeline(now, now + self.scan_us, True)
+        self._scan_end(now)
+
+    def _scan_begin(self) -> None:
+        """A scan up to and including the main program, at its start instant."""
         # perf: buffers are bound once in __init__ (self._bufs)
         i_img, pi, sm, l_ob1, q, pq = self._bufs
         now = self._t_us
@@ -304,19 +330,35 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-            # perf: the time line only once a source may have events (a timed
-            # interrupt attached, or ever a PLS, an HDEF or a CT=PT interrupt)
-            if irq.timed_next or self._sources_on:
-                self.scheduler.run(now, now + self.scan_us)
-            elif self.devices:
-                t_to = now + self.scan_us
-                for dev in self.devices:
-                    dev.step(self, now, t_to)
         except PlcError as e:
             self._fail(e)
         except Exception as e:  # an internal fault: map it to the program location
             self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
                                        self._loc_from_tb(e)), e)
+
+    def _timeline(self, t_from: int, t_to: int, first: bool) -> None:
+        """The scan's time line over (t_from, t_to]: events, routines, devices
+        (*first*: t_from is the scan's start; a linked network runs a scan's
+        time line in pieces, plcrt.engine.link)."""
+        try:
+            # perf: the time line only once a source may have events (a timed
+            # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
+            # a port's traffic)
+            if self.interrupts.timed_next or self._sources_on:
+                self.scheduler.run(t_from, t_to, first)
+            elif self.devices:
+                for dev in self.devices:
+                    dev.step(self, t_from, t_to)
+        except PlcError as e:
+            self._fail(e)
+        except Exception as e:  # an internal fault: map it to the program location
+            self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
+                                       self._loc_from_tb(e)), e)
+
+    def _scan_end(self, now: int) -> None:
+        """The scan's end: forces, outputs, the plant's wires, time."""
+        pi, q, pq = self._bufs[1], self._bufs[4], self._bufs[5]
+        scans = self.scans
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
@@ -397,6 +439,28 @@ class Plc(AddressAccess):
         self.pulse[number].pls(self._irq_t)
         self._sources_on = True
         self.scheduler.touch()
+
+    def _wake(self, source: Any) -> None:
+        """A port's (or the Ethernet interface's) next event moved: a
+        character on its way, a job; it joins the time line the first time."""
+        self._sources_on = True
+        if source.joined:
+            self.scheduler.touch()
+        else:
+            source.joined = True
+            self.scheduler.add(source)
+
+    def _xmt(self, port: int, ptr: int) -> bool:
+        return self.ports[port].xmt(self._irq_t, ptr)
+
+    def _rcv(self, port: int, ptr: int) -> bool:
+        return self.ports[port].rcv(self._irq_t, ptr)
+
+    def _net(self, port: int, ptr: int, kind: str) -> bool:
+        return netr_netw(self.ports[port], self._irq_t, ptr, kind)
+
+    def _getput(self, ptr: int, kind: str) -> bool:
+        return self.ethernet.get_put(self._irq_t, ptr, kind)
 
     def _irq_warn(self, message: str, key: str) -> None:
         self.warn(message, None, key)
@@ -570,13 +634,18 @@ class Plc(AddressAccess):
         Raises:
             PlcConfigError: ``snapshot`` is not a snapshot, or it was taken
                 from a different program, or from the same parsed program
-                compiled with other options (symbols, CPU, plant, probes).
+                compiled with other options (symbols, CPU, plant, probes), or this
+                PLC is linked to others (plcrt.link).
         """
         if not isinstance(snapshot, Plc):
             raise PlcConfigError(f"restore() needs a snapshot made by snapshot(), got "
                                  f"{type(snapshot).__name__}")
         if snapshot.program is not self.program:
             raise PlcConfigError("this snapshot was taken from a different program")
+        if self.network is not None:
+            raise PlcConfigError("this PLC is linked to others (plcrt.link): going back in time "
+                                 "would break what they exchanged; restore before linking, or "
+                                 "fork and restore the unlinked twin")
         if (snapshot.source != self.source or snapshot.model != self.model
                 or len(snapshot.devices) != len(self.devices)
                 or (snapshot.coverage is None) != (self.coverage is None)):
@@ -607,7 +676,9 @@ class Plc(AddressAccess):
                                         (self.pid, dst.pid),
                                         (self.edges, dst.edges),
                                         (self.clock, dst.clock), (self.station, dst.station),
-                                        *zip(self.hsc, dst.hsc)]
+                                        *zip(self.hsc, dst.hsc),
+                                        *zip(self.ports, dst.ports),
+                                        (self.ethernet, dst.ethernet)]
         pairs += list(zip(self.devices, dst.devices))
         for name, obj in self.unit.bindings.items():
             other = dst.unit.bindings.get(name)
@@ -630,6 +701,12 @@ class Plc(AddressAccess):
                                      f"{type(obj).__name__}")
         for a, b in pairs:
             memo[id(a)] = b
+        # a twin is not linked: what links other CPUs stays here
+        if self.network is not None:
+            memo[id(self.network)] = None
+            for port in self.ports:
+                if port.peer is not None and hasattr(port.peer, "other"):
+                    memo[id(port.peer)] = None
         states = copy.deepcopy([a.__dict__ for a, _ in pairs], memo)
         for (_, b), state in zip(pairs, states):
             b.__dict__.clear()
@@ -638,7 +715,14 @@ class Plc(AddressAccess):
         dst._int_l[:] = self._int_l
         dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
         dst._defined[:] = [dst.hsc[c.number] for c in self._defined]
-        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse, *dst._counted])
+        for port in (*dst.ports, dst.ethernet):
+            port.drop_links()
+        # the sources that joined the time line, in the order they joined
+        twin = {id(c): dst.hsc[c.number] for c in self._counted}
+        twin.update({id(p): dst.ports[p.number] for p in self.ports})
+        twin[id(self.ethernet)] = dst.ethernet
+        dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse,
+                             *(twin[id(s)] for s in self.scheduler.sources[4:])])
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))

@@ -18,3 +18,4 @@ from . import clock  # noqa: F401
 from . import table  # noqa: F401
 from . import ascii  # noqa: F401
 from . import smart  # noqa: F401
+from . import comm  # noqa: F401

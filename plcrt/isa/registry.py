@@ -67,11 +67,9 @@ class InsnSpec:
 
 REGISTRY: dict[str, InsnSpec] = {}
 
-#: Mnemonics the S7-200 has but plcrt does not execute yet (reported by
-#: ``plcrt check`` with their locations).
-KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset("""
-    XMT RCV NETR NETW GET PUT
-""".split())
+#: Mnemonics the S7-200 has but plcrt does not execute (reported by ``plcrt
+#: check`` with their locations, apart from unknown ones): none.
+KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset()
 
 
 def insn(mnemonic: str, *roles: Role, family: str, summary: str,

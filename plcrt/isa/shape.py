@@ -117,6 +117,10 @@ _LAD: dict[str, tuple[str, str]] = {
     "HDEF": ("HDEF", "HSC=0 MODE=1"), "HSC": ("HSC", "N=0"),
     # the PID loop (System Manual, PID: the table and the loop number)
     "PID": ("PID", "TBL=0 LOOP=1"),
+    # communications (System Manual, XMT/RCV/NETR/NETW; SMART manual, GET/PUT)
+    "XMT": ("XMT", "TBL=0 PORT=1"), "RCV": ("RCV", "TBL=0 PORT=1"),
+    "NETR": ("NETR", "TABLE=0 PORT=1"), "NETW": ("NETW", "TABLE=0 PORT=1"),
+    "GET": ("GET", "TABLE=0"), "PUT": ("PUT", "TABLE=0"),
     # modifiers: contacts without an operand
     "NOT": ("NOT", ""), "EU": ("P", ""), "ED": ("N", ""),
     # rail elements: coils, or boxes (a name without parentheses)

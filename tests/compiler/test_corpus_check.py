@@ -36,6 +36,11 @@ GROUPS = [
     ([X + "new_pressure_test__MAIN.awl", X + "new_pressure_test__PRESSURE_TEST.awl"], None),
 ]
 
+#: lines of the corpus that are wrong in Micro/WIN too: the probe file tries
+#: NETR/NETW with one operand (the instructions take a table and a port; the
+#: SMART rejects NETR/NETW altogether, reference digest "Communication")
+INVALID = {P + "probe_ops.awl": ["NETR takes a table and a port", "NETW takes a table and a port"]}
+
 pytestmark = pytest.mark.skipif(not CORPUS.is_dir(), reason="shared/corpus not available")
 
 
@@ -64,7 +69,9 @@ def test_only_unimplemented_instructions_are_reported(files: list[str], symbols:
         reported = Counter(d.message.split()[1] for d in errors if d.code == "unimplemented")
         for d in errors:
             assert d.loc is not None and d.loc.line > 0 and d.loc.block is not None
-    assert others == []
+    invalid = [w for f in files for w in INVALID.get(f, [])]
+    assert len(others) == len(invalid)
+    assert all(any(w in o for o in others) for w in invalid)
     assert reported == expected
 
 

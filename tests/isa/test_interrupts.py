@@ -88,14 +88,27 @@ def test_interval_zero_never_fires_and_is_diagnosed():
     assert any("SMB34 = 0" in d.message for d in plc.diagnostics)
 
 
-@pytest.mark.parametrize("event", [8, 9, 23, 24, 25, 26])
-def test_attaching_a_communication_event_without_simulated_ports_is_diagnosed(event):
-    """The freeport ports are not simulated yet: their routines never run,
-    and ATCH says so instead of leaving the learner to wonder."""
-    plc = plcrt.load(program(f"LD SM0.1\nATCH INT_0, {event}\nENI", COUNT))
+@pytest.mark.parametrize("port, event", [(0, 9), (1, 26)])
+def test_a_transmit_complete_event_runs_its_routine(port, event):
+    """The ports are simulated (plcrt.engine.ports): XMT of 3 characters at
+    9600 baud 8N1 ends 3 x 10 / 9600 s = 3125 µs later, and the attached
+    routine of the port's transmit-complete event runs then."""
+    ctrl = "SMB30" if port == 0 else "SMB130"
+    plc = plcrt.load(program(f"LD SM0.1\nMOVB 16#09, {ctrl}\nMOVB 3, VB100\n"
+                             f"ATCH INT_0, {event}\nENI\nXMT VB100, {port}", COUNT))
+    plc.scan()
+    assert plc["VW0"] == 1
+    assert not any("never runs" in d.message for d in plc.diagnostics)
+
+
+@pytest.mark.parametrize("event", [24, 25, 26])
+def test_attaching_an_event_of_a_port_the_cpu_lacks_is_diagnosed(event):
+    """A CPU 224 has port 0 only: the events of port 1 never occur, and ATCH
+    says so instead of leaving the learner to wonder."""
+    plc = plcrt.load(program(f"LD SM0.1\nATCH INT_0, {event}\nENI", COUNT), cpu="CPU224")
     plc.run(0.1)
     assert plc["VW0"] == 0
-    assert any(f"event {event} (port" in d.message and "never runs" in d.message
+    assert any(f"event {event} (port 1" in d.message and "never runs" in d.message
                for d in plc.diagnostics)
 
 

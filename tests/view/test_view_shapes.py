@@ -99,6 +99,13 @@ def test_coils(stl: str, picture: str, above: str, below: str) -> None:
     ("TONR T1, +20", "TONR", ["┤IN", "+20─┤PT", "10 ms", "T1"]),
     ("TOF T32, +5", "TOF", ["┤IN", "+5─┤PT", "1 ms", "T32"]),
     ("PID VB300, 0", "PID", ["VB300─┤", "0─┤"]),   # not run by plcrt: unnamed pins
+    # communications: the manual's pin names
+    ("XMT VB100, 0", "XMT", ["VB100─┤TBL", "0─┤PORT"]),
+    ("RCV VB200, 1", "RCV", ["VB200─┤TBL", "1─┤PORT"]),
+    ("NETR VB300, 0", "NETR", ["VB300─┤TABLE", "0─┤PORT"]),
+    ("NETW VB300, 0", "NETW", ["VB300─┤TABLE", "0─┤PORT"]),
+    ("GET VB400", "GET", ["VB400─┤TABLE"]),
+    ("PUT VB400", "PUT", ["VB400─┤TABLE"]),
 ])
 def test_boxes(stl: str, title: str, pins: list[str]) -> None:
     text = _draw("LD I0.0\n" + stl)

@@ -95,29 +95,35 @@ class Scheduler:
         after = t_from - 1 if first else t_from
         while True:
             best = _NEVER
+            due: Any = None            # the row due first
+            ties: Optional[list[Any]] = None   # all rows due, when several are
             gen = self.gen
-            for row in rows:
+            for row in rows:           # in priority order: ties fire in this order
                 if row[1] != gen or not row[3]:
                     src = row[0]
                     row[2] = src.next_time(after, _NEVER) if src.live() else None
                     row[1], row[3] = gen, src.cacheable
                 te = row[2]
-                if te is not None and te < best:
-                    best = te
+                if te is None or te > best:
+                    continue
+                if te < best:
+                    best, due, ties = te, row, None
+                elif ties is None:
+                    ties = [due, row]
+                else:
+                    ties.append(row)
             if best > t_to:
                 break
             if best > t:
                 for dev in devices:
                     dev.step(plc, t, best)
                 t = best
-            # perf: the rows due are found by their kept times (no list per
-            # instant); firing changes no other row's time
-            for row in rows:           # in priority order: ties fire in this order
-                if row[2] == best:
-                    row[1] = -1
-                    row[0].fire(best)
-                    if row[4]:
-                        self.gen += 1  # e.g. a train ended: a counter on it moves too
+            # perf: one row due is the common case (no list per instant)
+            for row in (ties or (due,)):
+                row[1] = -1
+                row[0].fire(best)
+                if row[4]:
+                    self.gen += 1      # e.g. a train ended: a counter on it moves too
             if on_instant is not None:
                 on_instant(best)
             after = best

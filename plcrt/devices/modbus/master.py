@@ -35,11 +35,12 @@ from .rtu import READS, WRITES, check_crc, frame, gap_us, pack_bits
 
 __all__ = ["Master", "master_of", "modbus_call", "CTRL_ERRORS", "MSG_ERRORS", "RANGES"]
 
-#: MBUS_CTRL Error (System Manual, MBUS_CTRL error codes)
-CTRL_ERRORS = {0: "no error", 1: "parity selection invalid", 2: "baud rate selection invalid",
-               3: "timeout selection invalid", 4: "mode selection invalid",
-               5: "port selection invalid (S7-200 SMART Port input)"}
-#: MBUS_MSG Error (System Manual, "Modbus master execution error codes")
+#: MBUS_CTRL Error (S7-200 SMART System Manual V2.3, 9.3.2.4 "Modbus RTU
+#: master execution error codes"; 0..4 as the S7-200 System Manual's table)
+CTRL_ERRORS = {0: "no error", 1: "invalid parity type", 2: "invalid baud rate",
+               3: "invalid timeout", 4: "invalid mode", 9: "invalid port number",
+               10: "port 1 missing or not configured (the CPU has one port)"}
+#: MBUS_MSG Error (same table; 107 and 108 are plcrt's: PLCRT_CHOICES)
 MSG_ERRORS = {0: "no error", 1: "parity error in response", 2: "not used",
               3: "receive timeout (no response from the slave)",
               4: "error in request parameter (Slave, RW, Addr, Count or DataPtr)",
@@ -53,10 +54,10 @@ MSG_ERRORS = {0: "no error", 1: "parity error in response", 2: "not used",
               104: "slave device failure (exception 4)",
               105: "slave accepted the message, the response is delayed (exception 5)",
               106: "slave busy, message rejected (exception 6)",
-              107: "slave rejected the message (other exception)",
+              107: "slave rejected the message (another exception code)",
               108: "slave memory parity error (exception 8)"}
 #: the numbers plcrt decided (no manual entry found): docs/modbus.md
-PLCRT_CHOICES = {"MBUS_CTRL": (5,), "MBUS_MSG": (107,)}
+PLCRT_CHOICES = {"MBUS_MSG": (107, 108)}
 #: Modbus address ranges of Addr -> (first, last, table, bits, writable)
 #: (System Manual, MBUS_MSG: 00001-09999 coils, 10001-19999 inputs,
 #: 30001-39999 input registers, 40001-49999 holding registers)
@@ -162,7 +163,7 @@ class Master:
 
     def _finish(self, t: int, req: Request, error: int) -> None:
         req.error = error
-        req.times["done"] = t
+        req.times["finished"] = t
         self.log.append({**req.times, "error": error})
         # the time line stops here, so the scan after sees it (Port._post_now)
         self.plc._sources_on = True
@@ -214,12 +215,11 @@ class _Block:
         if "load" in once:
             return
         once.add("load")
-        ctrl = ", ".join(f"{k} ({CTRL_ERRORS[k]})" for k in PLCRT_CHOICES["MBUS_CTRL"])
         msg = ", ".join(f"{k} ({MSG_ERRORS[k]})" for k in PLCRT_CHOICES["MBUS_MSG"])
         g.warn(f"{itf.name}: the Modbus RTU master library (MBUS_CTRL, MBUS_MSG) is emulated; "
                f"its library memory and interrupt routines are not simulated; Error numbers "
-               f"not confirmed from the manual are plcrt's choice: MBUS_CTRL {ctrl}, "
-               f"MBUS_MSG {msg} (docs/modbus.md)", "modbus-library")
+               f"not confirmed from the manual are plcrt's choice: MBUS_MSG {msg} "
+               f"(docs/modbus.md)", "modbus-library")
 
 
 @register_block("MBUS_CTRL")
@@ -236,8 +236,8 @@ class MbusCtrl(_Block):
             return 1, 0
         # System Manual, MBUS_CTRL: the checks in the order of its error codes
         for code, bad in ((1, parity not in PARITY_BITS), (2, baud not in BAUD_CODE),
-                          (3, not 1 <= timeout <= 32767),
-                          (5, not 0 <= port < len(self.plc.ports))):
+                          (3, not 1 <= timeout <= 32767), (9, port not in (0, 1)),
+                          (10, port >= len(self.plc.ports))):
             if bad:
                 self.warn(f"Error {code}: {CTRL_ERRORS[code]} (Mode 1, Baud {baud}, Parity "
                           f"{parity}, Port {port}, Timeout {timeout})", f"err{code}")

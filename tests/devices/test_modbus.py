@@ -388,3 +388,19 @@ def test_export_block_with_code_or_other_interface_runs_its_own_code():
     own = [d.message for d in plc.diagnostics if "own subroutine runs" in d.message]
     assert len(own) == 2 and any("IN WORD" in w for w in own)
     assert plc["SMB30"] == 0 and plc["M9.0"] == 1
+
+
+# ---------------------------------------------------------------- the sample
+def test_sample_poll_reads_and_writes_back():
+    """programs/modbus/poll.awl: 12 read/write rounds in 1 s of 10 ms scans;
+    the slave's 40005 holds VW100 + 1; the first read's times are exact
+    (9600 baud, the slave's 5 ms delay)."""
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2] / "programs" / "modbus"
+    plc = plcrt.load(root / "poll.awl", plant=root / "slave_plant.toml", scan_ms=10)
+    plc.run(1.0)
+    assert (plc["VW100"], plc["VW102"], plc["VW20"], plc["MB3"]) == (1200, 35, 12, 0)
+    assert plc.ports[0].peer.holding[4] == 1201
+    first = master_of(plc).log[0]
+    assert (first["sent"], first["sent_end"]) == (0, 8334)
+    assert first["last_char"] == 8334 + 3646 + 5000 + 13 * 10 * 1_000_000 // 9600 + 1

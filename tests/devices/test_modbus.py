@@ -404,3 +404,20 @@ def test_sample_poll_reads_and_writes_back():
     first = master_of(plc).log[0]
     assert (first["sent"], first["sent_end"]) == (0, 8334)
     assert first["last_char"] == 8334 + 3646 + 5000 + 13 * 10 * 1_000_000 // 9600 + 1
+
+
+def test_a_fork_runs_on_with_its_own_master_and_slave():
+    """A fork in the middle of a request finishes it on its own port and
+    slave; the original is not affected."""
+    plc = load(slave())
+    plc["VW100"] = 99
+    plc["VB210"], plc["VB211"], plc["VD212"], plc["VW216"], plc["VD218"] = \
+        1, 1, 40001, 1, V + 100
+    plc["M2.0"] = 1
+    plc.scan(3)
+    plc["M2.0"] = 0
+    twin = plc.fork()
+    assert master_of(twin).busy() and master_of(twin) is not master_of(plc)
+    twin.run(scans=40)
+    assert (twin["M0.2"], twin["MB3"]) == (1, 0) and twin.ports[0].peer.holding[0] == 99
+    assert plc.ports[0].peer.holding[0] == 42 and plc["M0.2"] == 0

@@ -215,6 +215,9 @@ class _Block:
         if "load" in once:
             return
         once.add("load")
+        # bound into the code, so that a fork (Plc._copy_state) copies the
+        # master with the blocks and the blocks' references land on the twin's
+        g.bind(master_of(plc), "mbmaster")
         msg = ", ".join(f"{k} ({MSG_ERRORS[k]})" for k in PLCRT_CHOICES["MBUS_MSG"])
         g.warn(f"{itf.name}: the Modbus RTU master library (MBUS_CTRL, MBUS_MSG) is emulated; "
                f"its library memory and interrupt routines are not simulated; Error numbers "

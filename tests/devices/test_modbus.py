@@ -260,7 +260,8 @@ def test_bad_responses(reply, error):
 
 
 def test_a_good_scripted_response():
-    """The same scripted device with a right answer: the register arrives (the check above can pass)."""
+    """The same scripted device with a right answer: the register arrives
+    (the checks above can pass)."""
     plc = load(scripted(frame(bytes.fromhex("0103 02 002A")).hex(" ")))
     assert msg(plc, 1, 0, 40001, 1)["error"] == 0 and plc["VW100"] == 42
 
@@ -421,3 +422,14 @@ def test_a_fork_runs_on_with_its_own_master_and_slave():
     twin.run(scans=40)
     assert (twin["M0.2"], twin["MB3"]) == (1, 0) and twin.ports[0].peer.holding[0] == 99
     assert plc.ports[0].peer.holding[0] == 42 and plc["M0.2"] == 0
+
+
+def test_slave_at_another_rate_never_answers():
+    """A slave set to 19200 baud while the master sends at 9600 gets garbled
+    characters: no answer, Error 3; at its own rate it answers."""
+    plc = load(slave(baud=19200), timeout=30)
+    assert msg(plc, 1, 0, 40001, 1)["error"] == 3 and plc.ports[0].peer.ignored == 1
+    plc = load(slave(baud=19200, parity='"even"'), baud=19200, parity=2)
+    assert msg(plc, 1, 0, 40001, 1)["error"] == 0 and plc["VW100"] == 42
+    with pytest.raises(PlcConfigError, match="baud must be one of"):
+        load_plant(slave(baud=1000))

@@ -5,6 +5,8 @@ Plant keys (every problem a PlcConfigError naming the file and key)::
     [port.0.modbus_slave]
     address = 1                   # slave address 1..247
     delay_ms = 5                  # from the request's end (its 3.5-character gap) to the answer
+    baud = 9600                   # optional: the slave's own rate and parity ("none", "even",
+    parity = "even"               # "odd"); without them it follows the port's setting
     coils = [1, 0, 1]             # 00001.. : Modbus address 0..  (0/1 or true/false)
     discrete_inputs = [0, 1]      # 10001..
     input_registers = [100, 200]  # 30001..   0..65535
@@ -26,8 +28,9 @@ diagnostics functions (8, 11, 12, 17), no Modbus ASCII.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Optional
 
+from ...engine.serial import Framing
 from ...errors import PlcConfigError
 from ..keys import checked_table
 from .rtu import check_crc, frame, gap_us, pack_bits, unpack_bits
@@ -35,7 +38,8 @@ from .rtu import check_crc, frame, gap_us, pack_bits, unpack_bits
 __all__ = ["SlaveConfig", "parse_slave", "ModbusSlave"]
 
 _KEYS = {"address", "delay_ms", "coils", "discrete_inputs", "input_registers",
-         "holding_registers"}
+         "holding_registers", "baud", "parity"}
+_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 #: plant key -> (table attribute, largest value)
 _TABLES = {"coils": ("coils", 1), "discrete_inputs": ("inputs", 1),
            "input_registers": ("input_registers", 0xFFFF),
@@ -49,6 +53,8 @@ _READ_FN = {1: ("coils", True, 2000), 2: ("inputs", True, 2000),
 class SlaveConfig:
     address: int = 1
     delay_us: int = 0
+    baud: Optional[int] = None       #: None: the port's setting
+    parity: Optional[str] = None
     tables: dict[str, list[int]] = field(default_factory=dict)
 
 
@@ -64,6 +70,16 @@ def parse_slave(raw: Any, where: str) -> SlaveConfig:
     if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0 <= d <= 60_000:
         raise PlcConfigError(f"{where}.delay_ms must be a number in 0..60000, got {d!r:.40}")
     cfg.delay_us = int(round(d * 1000))
+    if "baud" in raw:
+        if raw["baud"] not in _BAUDS or isinstance(raw["baud"], bool):
+            raise PlcConfigError(f"{where}.baud must be one of {', '.join(map(str, _BAUDS))}, "
+                                 f"got {raw['baud']!r:.40}")
+        cfg.baud = raw["baud"]
+    if "parity" in raw:
+        if raw["parity"] not in ("none", "even", "odd"):
+            raise PlcConfigError(f"{where}.parity must be \"none\", \"even\" or \"odd\", "
+                                 f"got {raw['parity']!r:.40}")
+        cfg.parity = raw["parity"]
     for key, (attr, top) in _TABLES.items():
         v = raw.get(key, [])
         if not isinstance(v, list) or len(v) > 65536 or any(
@@ -80,6 +96,7 @@ class ModbusSlave:
     def __init__(self, cfg: SlaveConfig) -> None:
         self.address = cfg.address
         self.delay_us = cfg.delay_us
+        self.baud, self.parity = cfg.baud, cfg.parity
         self.coils = list(cfg.tables["coils"])
         self.inputs = list(cfg.tables["inputs"])
         self.input_registers = list(cfg.tables["input_registers"])
@@ -97,22 +114,30 @@ class ModbusSlave:
         """A Modbus slave is no PPI station."""
         return None
 
+    def framing(self) -> Framing:
+        """The slave's framing: its own baud and parity, else the port's."""
+        fr = self.port.framing()
+        return Framing(self.baud or fr.baud, 8, self.parity or fr.parity, "freeport")
+
     def transmit(self, port: Any, t: int, fr: Any, data: bytes) -> None:
         """The CPU sends *data* from *t*: one frame, known ended after the gap."""
         if not data:
             return
         t_end = fr.end(t, len(data)) + gap_us(fr.bits, fr.baud)
-        port.push(t_end, self._frame, data)
+        mine = self.framing()
+        garbled = (fr.baud, fr.data_bits, fr.parity) != (mine.baud, 8, mine.parity)
+        port.push(t_end, self._frame, data, garbled)
 
-    def _frame(self, t: int, data: bytes) -> None:
+    def _frame(self, t: int, data: bytes, garbled: bool = False) -> None:
         self.requests.append((t, data))
-        if not check_crc(data) or data[0] not in (0, self.address):
+        # another rate or format garbles every character: no answer
+        if garbled or not check_crc(data) or data[0] not in (0, self.address):
             self.ignored += 1
             return
         body = self.answer(data[1], data[2:-2])
         if data[0] == 0:
             return                       # broadcast: executed, never answered
-        fr = self.port.framing()
+        fr = self.framing()
         out = frame(bytes((self.address,)) + body)
         start = max(t + self.delay_us, self.busy_until)
         self.port.receive(start, fr, out)

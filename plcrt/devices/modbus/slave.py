@@ -19,7 +19,8 @@ the 3.5-character gap (Modbus over Serial Line 2.5.1.1), waits *delay_ms*
 and answers in the port's framing: functions 1, 2, 3, 4, 5, 6, 15, 16;
 exception 1 for any other function, 2 for an address outside its tables,
 3 for a bad count or coil value; a frame with a bad CRC, for another
-slave or with a parity error gets no answer; address 0 (broadcast) runs
+slave or sent at another rate or parity than the slave's own gets no
+answer; address 0 (broadcast) runs
 a write and gets no answer.  Tests read and write its tables (``coils``,
 ``inputs``, ``input_registers``, ``holding``; lists).  What it is not: no
 diagnostics functions (8, 11, 12, 17), no Modbus ASCII.

@@ -38,6 +38,9 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
     itf = interfaces().get(name)
     if itf is None:
         return False
+    smart = interfaces().get(name + "_SMART")
+    if smart is not None and len(insn.operands) - 1 == len(smart.params) != len(itf.params):
+        name, itf = smart.name.upper(), smart     # the SMART variant (an extra input)
     factory = BLOCK_FACTORIES.get(name)
     if factory is None:
         _load_implementations()
@@ -118,3 +121,4 @@ _WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4}
 def _load_implementations() -> None:
     from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)
     from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)
+    from ..devices.modbus import master as _modbus  # noqa: F401  (MBUS_CTRL, MBUS_MSG)

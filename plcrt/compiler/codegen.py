@@ -667,7 +667,7 @@ def _empty_library_blocks(unit: Unit) -> None:
     """Warn about called subroutines that have an interface and no code.
 
     Micro/WIN exports a protected block (a Siemens instruction library such
-    as MBUS_CTRL or USS_INIT, wizard code, a password-protected block) with
+    as MBUS_INIT or USS_INIT, wizard code, a password-protected block) with
     its interface and an empty body: its calls run nothing here.  Blocks
     plcrt emulates by name (a library interface in ``library/``) are left
     to that emulation."""

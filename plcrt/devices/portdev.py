@@ -28,7 +28,8 @@ whenever the bytes since the last answer equal a request, the device sends
 its reply (in the port's framing, *delay_ms* after that request's last stop
 bit, and after anything it is still sending); bytes left over at the end of
 a transmission went unanswered and are reported in ``plc.diagnostics``.
-What it is not: no protocol (Modbus, USS): requests are exact bytes.
+What it is not: no protocol (USS): requests are exact bytes; a Modbus RTU
+slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`).
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from ..errors import PlcConfigError
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
 
-_PORT_KEYS = {"address", "ppi_baud", "reply", "send"}
+_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave"}
 _REPLY_KEYS = {"request", "reply", "delay_ms", "bad_parity"}
 _SEND_KEYS = {"at", "data", "bad_parity"}
 _ETH_KEYS = {"ip", "latency_ms"}
@@ -68,6 +69,7 @@ class PortConfig:
     address: int = 2
     ppi_baud: int = 9600
     device: DeviceConfig | None = None
+    modbus: Any = None   #: a Modbus RTU slave (plcrt.devices.modbus.slave.SlaveConfig)
     where: str = field(default="", compare=False)
 
 
@@ -141,6 +143,12 @@ def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
                                  f"{', '.join(map(str, PPI_BAUDS))}, got {cfg.ppi_baud!r:.40}")
         if "reply" in p or "send" in p:
             cfg.device = _device(p, where)
+        if "modbus_slave" in p:
+            if cfg.device is not None:
+                raise PlcConfigError(f"{where}.modbus_slave: the port already has a scripted "
+                                     f"device (reply/send); one device per port")
+            from .modbus.slave import parse_slave
+            cfg.modbus = parse_slave(p["modbus_slave"], f"{where}.modbus_slave")
         out[int(key)] = cfg
     return out
 

@@ -86,6 +86,9 @@ class Port(Inbox):
         self.address = 2
         self.ppi_baud = 9600
         self.jobs: list[Any] = []          #: NETR/NETW jobs in progress
+        #: a library that took the port (the Modbus master): it gets the
+        #: characters received, and sends with :meth:`send`
+        self.owner: Any = None
         self.sm[4] |= self.idle_bit        # SM4.5 / SM4.6: the transmitter is idle
 
     # ------------------------------------------------------------ set-up
@@ -136,22 +139,35 @@ class Port(Inbox):
         if off + 1 + n > len(buf):
             return self._bad_table("XMT", ptr, f"holds {n} characters past the end of its area")
         data = bytes(fr.mask(b) for b in buf[off + 1:off + 1 + n])
+        self._send(t, fr, data, True)
+        return True
+
+    def send(self, t: int, data: bytes) -> int:
+        """A library's transmission (the Modbus master's XMT): *data* from
+        *t* in the port's framing, without the program's transmit-complete
+        event (the library's own routine takes it); the end µs."""
+        return self._send(t, self.framing(), bytes(self.framing().mask(b) for b in data),
+                          False)
+
+    def _send(self, t: int, fr: Framing, data: bytes, event: bool) -> int:
+        n = len(data)
         # count 0: a break, the line held low for 16 bit times (System Manual, XMT)
         end = fr.end(t, n) if n else fr.end(t, 0, bits=16)
         self.tx_end = end
         self.sent += n
         self.sm[4] &= ~self.idle_bit & 0xFF
-        self.push(end, self._xmt_done)
+        self.push(end, self._xmt_done, event)
         if self.peer is not None:
             self.peer.transmit(self, t, fr, data)
         elif n:
             self.no_answer(fr.end(t, n), data, "no device is at the port")
-        return True
+        return end
 
-    def _xmt_done(self, t: int) -> None:
+    def _xmt_done(self, t: int, event: bool = True) -> None:
         self.tx_end = None
         self.sm[4] |= self.idle_bit
-        self.post(self.ev_xmt, t)
+        if event:
+            self.post(self.ev_xmt, t)
 
     def no_answer(self, t: int, data: bytes, why: str) -> None:
         """Bytes sent at the port that nobody answered (diagnostics)."""
@@ -194,6 +210,9 @@ class Port(Inbox):
         err = err or (bad and mine.parity != "none")
         byte = mine.mask(byte)
         self.received += 1
+        if self.owner is not None:
+            self.owner.char(t, byte, err)     # the library's receive, not the program's
+            return
         sm = self.sm
         # System Manual, "Receive character interrupt": SMB2 and SM3.0
         sm[2] = byte
@@ -376,3 +395,6 @@ def attach_devices(ports: list[Port], plant: Any) -> None:
         if cfg.device is not None:
             from ..devices.portdev import ScriptedDevice
             ScriptedDevice(cfg.device).attach(ports[k])
+        elif cfg.modbus is not None:
+            from ..devices.modbus.slave import ModbusSlave
+            ModbusSlave(cfg.modbus).attach(ports[k])

@@ -1,0 +1,202 @@
+"""A Modbus RTU slave at a CPU port, from the plant file.
+
+Plant keys (every problem a PlcConfigError naming the file and key)::
+
+    [port.0.modbus_slave]
+    address = 1                   # slave address 1..247
+    delay_ms = 5                  # from the request's end (its 3.5-character gap) to the answer
+    baud = 9600                   # optional: the slave's own rate and parity ("none", "even",
+    parity = "even"               # "odd"); without them it follows the port's setting
+    coils = [1, 0, 1]             # 00001.. : Modbus address 0..  (0/1 or true/false)
+    discrete_inputs = [0, 1]      # 10001..
+    input_registers = [100, 200]  # 30001..   0..65535
+    holding_registers = [1, 2, 3] # 40001..   0..65535
+
+A table's length is how many addresses the slave has; an address past it
+is exception 2.  What it is: :class:`ModbusSlave`, the port's peer; each
+transmission of the CPU is one frame; the slave knows it has ended after
+the 3.5-character gap (Modbus over Serial Line 2.5.1.1), waits *delay_ms*
+and answers in the port's framing: functions 1, 2, 3, 4, 5, 6, 15, 16;
+exception 1 for any other function, 2 for an address outside its tables,
+3 for a bad count or coil value; a frame with a bad CRC, for another
+slave or sent at another rate or parity than the slave's own gets no
+answer; address 0 (broadcast) runs
+a write and gets no answer.  Tests read and write its tables (``coils``,
+``inputs``, ``input_registers``, ``holding``; lists).  What it is not: no
+diagnostics functions (8, 11, 12, 17), no Modbus ASCII.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+from ...engine.serial import Framing
+from ...errors import PlcConfigError
+from ..keys import checked_table
+from .rtu import check_crc, frame, gap_us, pack_bits, unpack_bits
+
+__all__ = ["SlaveConfig", "parse_slave", "ModbusSlave"]
+
+_KEYS = {"address", "delay_ms", "coils", "discrete_inputs", "input_registers",
+         "holding_registers", "baud", "parity"}
+_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
+#: plant key -> (table attribute, largest value)
+_TABLES = {"coils": ("coils", 1), "discrete_inputs": ("inputs", 1),
+           "input_registers": ("input_registers", 0xFFFF),
+           "holding_registers": ("holding", 0xFFFF)}
+#: read function -> (table, is bits, largest count) (Modbus Application Protocol 6.1-6.4)
+_READ_FN = {1: ("coils", True, 2000), 2: ("inputs", True, 2000),
+            3: ("holding", False, 125), 4: ("input_registers", False, 125)}
+
+
+@dataclass
+class SlaveConfig:
+    address: int = 1
+    delay_us: int = 0
+    baud: Optional[int] = None       #: None: the port's setting
+    parity: Optional[str] = None
+    tables: dict[str, list[int]] = field(default_factory=dict)
+
+
+def parse_slave(raw: Any, where: str) -> SlaveConfig:
+    """``[port.N.modbus_slave]``."""
+    raw = checked_table(raw, where, _KEYS)
+    cfg = SlaveConfig()
+    a = raw.get("address", 1)
+    if isinstance(a, bool) or not isinstance(a, int) or not 1 <= a <= 247:
+        raise PlcConfigError(f"{where}.address must be a slave address 1..247, got {a!r:.40}")
+    cfg.address = a
+    d = raw.get("delay_ms", 0)
+    if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0 <= d <= 60_000:
+        raise PlcConfigError(f"{where}.delay_ms must be a number in 0..60000, got {d!r:.40}")
+    cfg.delay_us = int(round(d * 1000))
+    if "baud" in raw:
+        if raw["baud"] not in _BAUDS or isinstance(raw["baud"], bool):
+            raise PlcConfigError(f"{where}.baud must be one of {', '.join(map(str, _BAUDS))}, "
+                                 f"got {raw['baud']!r:.40}")
+        cfg.baud = raw["baud"]
+    if "parity" in raw:
+        if raw["parity"] not in ("none", "even", "odd"):
+            raise PlcConfigError(f"{where}.parity must be \"none\", \"even\" or \"odd\", "
+                                 f"got {raw['parity']!r:.40}")
+        cfg.parity = raw["parity"]
+    for key, (attr, top) in _TABLES.items():
+        v = raw.get(key, [])
+        if not isinstance(v, list) or len(v) > 65536 or any(
+                not isinstance(x, int) or not 0 <= int(x) <= top for x in v):
+            raise PlcConfigError(f"{where}.{key} must be a list of at most 65536 values "
+                                 f"0..{top}")
+        cfg.tables[attr] = [int(x) for x in v]
+    return cfg
+
+
+class ModbusSlave:
+    """The slave of one port (see the module docstring)."""
+
+    def __init__(self, cfg: SlaveConfig) -> None:
+        self.address = cfg.address
+        self.delay_us = cfg.delay_us
+        self.baud, self.parity = cfg.baud, cfg.parity
+        self.coils = list(cfg.tables["coils"])
+        self.inputs = list(cfg.tables["inputs"])
+        self.input_registers = list(cfg.tables["input_registers"])
+        self.holding = list(cfg.tables["holding"])
+        self.port: Any = None
+        self.busy_until = 0
+        self.requests: list[tuple[int, bytes]] = []   #: (time the frame ended, frame)
+        self.ignored = 0                              #: frames that got no answer
+
+    def attach(self, port: Any) -> None:
+        self.port = port
+        port.peer = self
+
+    def station(self, address: int) -> None:
+        """A Modbus slave is no PPI station."""
+        return None
+
+    def framing(self) -> Framing:
+        """The slave's framing: its own baud and parity, else the port's."""
+        fr = self.port.framing()
+        return Framing(self.baud or fr.baud, 8, self.parity or fr.parity, "freeport")
+
+    def transmit(self, port: Any, t: int, fr: Any, data: bytes) -> None:
+        """The CPU sends *data* from *t*: one frame, known ended after the gap."""
+        if not data:
+            return
+        t_end = fr.end(t, len(data)) + gap_us(fr.bits, fr.baud)
+        mine = self.framing()
+        garbled = (fr.baud, fr.data_bits, fr.parity) != (mine.baud, 8, mine.parity)
+        port.push(t_end, self._frame, data, garbled)
+
+    def _frame(self, t: int, data: bytes, garbled: bool = False) -> None:
+        self.requests.append((t, data))
+        # another rate or format garbles every character: no answer
+        if garbled or not check_crc(data) or data[0] not in (0, self.address):
+            self.ignored += 1
+            return
+        body = self.answer(data[1], data[2:-2])
+        if data[0] == 0:
+            return                       # broadcast: executed, never answered
+        fr = self.framing()
+        out = frame(bytes((self.address,)) + body)
+        start = max(t + self.delay_us, self.busy_until)
+        self.port.receive(start, fr, out)
+        self.busy_until = fr.end(start, len(out))
+
+    def answer(self, fn: int, pdu: bytes) -> bytes:
+        """The response PDU (function and data, or exception) of a request."""
+        try:
+            return bytes((fn,)) + self._run(fn, pdu)
+        except _Exception as e:
+            return bytes((fn | 0x80, e.code))
+
+    def _span(self, table: list[int], start: int, count: int, top: int) -> None:
+        if not 1 <= count <= top:
+            raise _Exception(3)
+        if start + count > len(table):
+            raise _Exception(2)
+
+    def _run(self, fn: int, pdu: bytes) -> bytes:
+        if fn in _READ_FN:
+            if len(pdu) != 4:
+                raise _Exception(3)
+            name, bits, top = _READ_FN[fn]
+            table = getattr(self, name)
+            start, count = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
+            self._span(table, start, count, top)
+            vals = table[start:start + count]
+            data = pack_bits(vals) if bits else b"".join(v.to_bytes(2, "big") for v in vals)
+            return bytes((len(data),)) + data
+        if fn in (5, 6):
+            if len(pdu) != 4:
+                raise _Exception(3)
+            start, value = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
+            table = self.coils if fn == 5 else self.holding
+            self._span(table, start, 1, 1)
+            if fn == 5 and value not in (0x0000, 0xFF00):
+                raise _Exception(3)
+            table[start] = (value == 0xFF00) if fn == 5 else value
+            table[start] = int(table[start])
+            return pdu
+        if fn in (15, 16):
+            if len(pdu) < 5:
+                raise _Exception(3)
+            start, count, n = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3], pdu[4]
+            bits = fn == 15
+            want = (count + 7) // 8 if bits else 2 * count
+            if n != want or len(pdu) != 5 + n:
+                raise _Exception(3)
+            table = self.coils if bits else self.holding
+            self._span(table, start, count, 1968 if bits else 123)
+            vals = unpack_bits(pdu[5:], count) if bits else \
+                [pdu[5 + 2 * i] << 8 | pdu[6 + 2 * i] for i in range(count)]
+            table[start:start + count] = vals
+            return pdu[:4]
+        raise _Exception(1)
+
+
+class _Exception(Exception):
+    def __init__(self, code: int) -> None:
+        super().__init__(code)
+        self.code = code

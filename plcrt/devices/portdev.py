@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import PlcConfigError
+from .keys import checked_table
 
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
@@ -115,16 +116,6 @@ def _bad(v: Any, where: str, n: int) -> frozenset[int]:
     return frozenset(v)
 
 
-def _table(v: Any, where: str, keys: set[str]) -> dict:
-    if not isinstance(v, dict):
-        raise PlcConfigError(f"{where} must be a table")
-    unknown = set(v) - keys
-    if unknown:
-        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(map(str, unknown)))} "
-                             f"(known: {', '.join(sorted(keys))})")
-    return v
-
-
 def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
     """``[port.N]`` tables."""
     if not isinstance(raw, dict):
@@ -134,7 +125,7 @@ def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
         where = f"{file}: port.{key}"
         if str(key) not in ("0", "1"):
             raise PlcConfigError(f"{where}: the CPU has ports 0 and 1")
-        p = _table(p, where, _PORT_KEYS)
+        p = checked_table(p, where, _PORT_KEYS)
         cfg = PortConfig(int(key), where=where)
         cfg.address = _int(p.get("address", 2), f"{where}.address", 0, 126)
         cfg.ppi_baud = p.get("ppi_baud", 9600)
@@ -162,7 +153,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
                                  f"([[{where.split(': ')[-1]}.{name}]])")
     for i, r in enumerate(replies):
         rw = f"{where}.reply[{i}]"
-        r = _table(r, rw, _REPLY_KEYS)
+        r = checked_table(r, rw, _REPLY_KEYS)
         for k in ("request", "reply"):
             if k not in r:
                 raise PlcConfigError(f"{rw}: {k} is missing")
@@ -175,7 +166,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
                             _bad(r.get("bad_parity", []), f"{rw}.bad_parity", len(rep))))
     for i, s in enumerate(sends):
         sw = f"{where}.send[{i}]"
-        s = _table(s, sw, _SEND_KEYS)
+        s = checked_table(s, sw, _SEND_KEYS)
         for k in ("at", "data"):
             if k not in s:
                 raise PlcConfigError(f"{sw}: {k} is missing")
@@ -189,7 +180,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
 def parse_ethernet(raw: Any, file: str) -> EthernetConfig:
     """``[ethernet]``: ip, latency_ms."""
     where = f"{file}: ethernet"
-    raw = _table(raw, where, _ETH_KEYS)
+    raw = checked_table(raw, where, _ETH_KEYS)
     if "ip" not in raw:
         raise PlcConfigError(f"{where}: ip is missing")
     m = _IP_RE.fullmatch(str(raw["ip"]))

@@ -287,10 +287,7 @@ def _processes(raw: Any, where: str) -> list[dict[str, Any]]:
     inputs: set[int] = set()
     for i, p in enumerate(raw):
         pw = f"{where}.process[{i}]"
-        checked_table(p, pw, _PROCESS_KEYS)
-        for key in ("output", "input", "tau"):
-            if key not in p:
-                raise PlcConfigError(f"{pw}: {key} is missing")
+        checked_table(p, pw, _PROCESS_KEYS, ("output", "input", "tau"))
         cfg = {"output": _analog(p["output"], "AQW", f"{pw}.output"),
                "input": _analog(p["input"], "AIW", f"{pw}.input"),
                "gain": _number(p.get("gain", 1.0), f"{pw}.gain", -1e6, 1e6),

@@ -153,10 +153,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
                                  f"([[{where.split(': ')[-1]}.{name}]])")
     for i, r in enumerate(replies):
         rw = f"{where}.reply[{i}]"
-        r = checked_table(r, rw, _REPLY_KEYS)
-        for k in ("request", "reply"):
-            if k not in r:
-                raise PlcConfigError(f"{rw}: {k} is missing")
+        r = checked_table(r, rw, _REPLY_KEYS, ("request", "reply"))
         req = _hex(r["request"], f"{rw}.request")
         rep = _hex(r["reply"], f"{rw}.reply")
         if any(req == x[0] for x in dev.replies):
@@ -166,10 +163,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
                             _bad(r.get("bad_parity", []), f"{rw}.bad_parity", len(rep))))
     for i, s in enumerate(sends):
         sw = f"{where}.send[{i}]"
-        s = checked_table(s, sw, _SEND_KEYS)
-        for k in ("at", "data"):
-            if k not in s:
-                raise PlcConfigError(f"{sw}: {k} is missing")
+        s = checked_table(s, sw, _SEND_KEYS, ("at", "data"))
         data = _hex(s["data"], f"{sw}.data", empty=True)
         dev.sends.append((_seconds(s["at"], f"{sw}.at", 1e6), data,
                           _bad(s.get("bad_parity", []), f"{sw}.bad_parity", max(len(data), 1))))
@@ -180,9 +174,7 @@ def _device(p: dict, where: str) -> DeviceConfig:
 def parse_ethernet(raw: Any, file: str) -> EthernetConfig:
     """``[ethernet]``: ip, latency_ms."""
     where = f"{file}: ethernet"
-    raw = checked_table(raw, where, _ETH_KEYS)
-    if "ip" not in raw:
-        raise PlcConfigError(f"{where}: ip is missing")
+    raw = checked_table(raw, where, _ETH_KEYS, ("ip",))
     m = _IP_RE.fullmatch(str(raw["ip"]))
     if not isinstance(raw["ip"], str) or m is None or any(int(x) > 255 for x in m.groups()):
         raise PlcConfigError(f"{where}.ip must be an IPv4 address such as \"192.168.2.1\", "

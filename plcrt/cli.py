@@ -483,19 +483,10 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         if drives:
             obj["drives"] = [d.to_dict() | {"flags": d.flags} for d in drives]
     if plc is not None:
-        pulses, counters = pulse_rows(plc), hsc_rows(plc)
-        if pulses:
-            obj["pulse_outputs"] = [dict(zip(PULSE_COLUMNS, r)) | {"pulses": int(r[2])}
-                                    for r in pulses]
-        if counters:
-            obj["counters"] = [dict(zip(HSC_COLUMNS, r)) | {"mode": int(r[1]), "CV": int(r[2]),
-                                                             "PV": int(r[3])}
-                               for r in counters]
-        ports = port_rows(plc)
-        if ports:
-            obj["ports"] = [dict(zip(PORT_COLUMNS, r)) | {k: int(r[i]) for i, k in
-                                                          enumerate(PORT_COLUMNS) if i != 1}
-                            for r in ports]
+        for key, items in (("pulse_outputs", pulse_outputs(plc)),
+                           ("counters", counters_in_use(plc)), ("ports", ports_in_use(plc))):
+            if items:
+                obj[key] = items
     if len(args.programs) > 1:
         obj["files"] = list(args.programs)
     if error is not None:
@@ -588,65 +579,70 @@ PULSE_COLUMNS = ("output", "mode", "pulses", "state")
 HSC_COLUMNS = ("counter", "mode", "CV", "PV", "state")
 
 
-def pulse_rows(plc: Any) -> list[list[str]]:
-    """The pulse outputs Q0.0/Q0.1 that PLS or a wizard block used: mode,
-    pulses sent so far, idle or running."""
-    rows = []
+def pulse_outputs(plc: Any) -> list[dict[str, Any]]:
+    """The pulse outputs Q0.0/Q0.1 that PLS or a wizard block used
+    (columns ``PULSE_COLUMNS``): mode, pulses sent so far, idle or running."""
+    out = []
     now = plc.now_us
     for po in plc.pulse:
         sent = po.pulses_until(now)
         if not po.mode and not sent:
             continue
-        state = "running" if po.running else "idle"
-        rows.append([f"Q0.{po.number}", po.mode or "-", str(sent), state])
-    return rows
+        out.append({"output": f"Q0.{po.number}", "mode": po.mode or "-", "pulses": sent,
+                    "state": "running" if po.running else "idle"})
+    return out
 
 
 #: columns of the communication port table
 PORT_COLUMNS = ("port", "mode", "baud", "sent", "received", "unanswered")
 
 
-def port_rows(plc: Any) -> list[list[str]]:
-    """The ports that sent or received characters (plcrt.engine.ports):
-    mode, baud rate, characters sent and received, transmissions nobody
-    answered."""
-    rows = []
+def ports_in_use(plc: Any) -> list[dict[str, Any]]:
+    """The ports that sent or received characters (plcrt.engine.ports;
+    columns ``PORT_COLUMNS``): mode, baud rate, characters sent and
+    received, transmissions nobody answered."""
+    out = []
     for p in plc.ports:
         st = p.state()
-        if not (st["sent"] or st["received"] or st["unanswered"]):
-            continue
-        rows.append([str(p.number), st["mode"], str(st["baud"]), str(st["sent"]),
-                     str(st["received"]), str(st["unanswered"])])
-    return rows
+        if st["sent"] or st["received"] or st["unanswered"]:
+            out.append({"port": p.number} | {k: st[k] for k in PORT_COLUMNS[1:]})
+    return out
 
 
-def hsc_rows(plc: Any) -> list[list[str]]:
-    """The high-speed counters an HDEF defined: mode, CV, PV, enabled."""
-    rows = []
+def counters_in_use(plc: Any) -> list[dict[str, Any]]:
+    """The high-speed counters an HDEF defined (columns ``HSC_COLUMNS``):
+    mode, CV, PV, enabled."""
+    out = []
     for c in plc.hsc:
         if c.mode is None:
             continue
         c.sync(plc.now_us)
         state = ("counting" if c.enabled else "disabled") + ("" if c.direction > 0 else ", down")
-        rows.append([f"HSC{c.number}", str(c.mode), str(c.cv), str(c.pv), state])
-    return rows
+        out.append({"counter": f"HSC{c.number}", "mode": c.mode, "CV": c.cv, "PV": c.pv,
+                    "state": state})
+    return out
+
+
+def _cells(columns: Sequence[str], items: list[dict[str, Any]]) -> list[list[str]]:
+    """Table cells of *items*, one row each, in *columns* order."""
+    return [[str(item[c]) for c in columns] for item in items]
 
 
 def _print_devices(plc: Any) -> None:
-    """The plant's EM253 axes and bus drives, then the CPU's pulse outputs
-    and high-speed counters in use, after the watch values."""
+    """The plant's EM253 axes and bus drives, then the CPU's pulse outputs,
+    high-speed counters and ports in use, after the watch values."""
     axes, drives = plc.axes(), plc.drives()
     if axes:
         _print_table(_AXIS_COLUMNS, axis_rows(axes))
     if drives:
         _print_table(DRIVE_COLUMNS, drive_rows(drives), left=(2, 3))
-    pulses, counters, ports = pulse_rows(plc), hsc_rows(plc), port_rows(plc)
+    pulses, counters, ports = pulse_outputs(plc), counters_in_use(plc), ports_in_use(plc)
     if pulses:
-        _print_table(PULSE_COLUMNS, pulses, left=(0, 1))
+        _print_table(PULSE_COLUMNS, _cells(PULSE_COLUMNS, pulses), left=(0, 1))
     if counters:
-        _print_table(HSC_COLUMNS, counters, left=(0,))
+        _print_table(HSC_COLUMNS, _cells(HSC_COLUMNS, counters), left=(0,))
     if ports:
-        _print_table(PORT_COLUMNS, ports, left=(1,))
+        _print_table(PORT_COLUMNS, _cells(PORT_COLUMNS, ports), left=(1,))
     # a plant that only wires the CPU's own inputs has no axes to speak of
     if not axes and not drives and not pulses and not counters and not ports and (
             plc.modules or not (plc.wiring or plc.encoders or plc.devices)):

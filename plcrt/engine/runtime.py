@@ -85,16 +85,17 @@ class Plc(AddressAccess):
         if system_symbols is not None and not isinstance(system_symbols, dict):
             raise PlcConfigError(f"system_symbols must be a dict of name -> address, got "
                                  f"{type(system_symbols).__name__}")
+        if system_symbols is None:
+            from ..lang.symbols import SYSTEM_SYMBOLS
+            system_symbols = dict(SYSTEM_SYMBOLS)
         self.program = program
         self.model = cpu_model(cpu)
         auto_diags: list[Diagnostic] = []
         if auto_symbols:
             # unknown symbols get free M/V addresses, each reported (docs/decisions.md)
             from ..compiler.autosym import auto_symbols as assign_symbols
-            from ..lang.symbols import SYSTEM_SYMBOLS
-            symbols, auto_diags = assign_symbols(
-                program, self.model, symbols,
-                system_symbols if system_symbols is not None else SYSTEM_SYMBOLS, data)
+            symbols, auto_diags = assign_symbols(program, self.model, symbols,
+                                                 system_symbols, data)
         self.symbols = symbols
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
@@ -176,9 +177,6 @@ class Plc(AddressAccess):
         #: the diagnostic LED and port station addresses (DLED, GPA, SPA)
         self.station = Station()
         self._acc_sm = (self.mem.areas["AC"], self.mem.areas["SM"])
-        if system_symbols is None:
-            from ..lang.symbols import SYSTEM_SYMBOLS
-            system_symbols = dict(SYSTEM_SYMBOLS)
 
         self._warned: set[str] = set()
         self.diagnostics: list[Any] = []

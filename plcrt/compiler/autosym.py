@@ -34,7 +34,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Iterable
 
-from ..errors import Diagnostic, SourceLoc
+from ..errors import Diagnostic, PlcConfigError, SourceLoc
 from ..isa.registry import Role, lookup
 from ..lang import ir
 from ..lang.symbols import Symbol, SymbolTable
@@ -119,13 +119,10 @@ def _collect(program: ir.Program, model: CpuModel, symbols: SymbolTable | None,
     """Unknown symbols with their uses, and the (area, byte) the program addresses."""
     uses: dict[str, _Use] = {}
     used: set[tuple[str, int]] = set()
-    params = _subroutine_params(program, model)
+    layouts = {pou.ident: _locals(pou, model) for pou in program.pous}
+    params = _subroutine_params(program, layouts)
     for pou in program.pous:
-        try:
-            local_vars = layout_locals(pou, model.l_bytes)
-        except ResolveError:
-            local_vars = {}
-        resolver = Resolver(model, symbols, system_symbols, local_vars)
+        resolver = Resolver(model, symbols, system_symbols, layouts[pou.ident])
         for net in pou.networks:
             for insn in net.insns:
                 for text, width, loc in _operands(insn, params, pou, net):
@@ -173,7 +170,17 @@ def _operands(insn: ir.Insn, params: dict[str, list[str | int]], pou: ir.Pou,
         yield op.text, kind, loc
 
 
-def _subroutine_params(program: ir.Program, model: CpuModel) -> dict[str, list[str | int]]:
+def _locals(pou: ir.Pou, model: CpuModel) -> dict[str, LocalVar]:
+    """The block's locals, or none when they cannot be laid out (the
+    compiler reports why)."""
+    try:
+        return layout_locals(pou, model.l_bytes)
+    except ResolveError:
+        return {}
+
+
+def _subroutine_params(program: ir.Program, layouts: dict[str, dict[str, LocalVar]]
+                       ) -> dict[str, list[str | int]]:
     """Callee name (block id and symbolic name, upper case) -> the kinds of
     its parameters in call order; the library blocks' too."""
     out: dict[str, list[str | int]] = {}
@@ -181,15 +188,12 @@ def _subroutine_params(program: ir.Program, model: CpuModel) -> dict[str, list[s
         from ..blocks.interface import interfaces
         for name, itf in interfaces().items():
             out[name] = [_TYPE_KIND.get(p.type, 4) for p in itf.params]
-    except Exception:  # noqa: BLE001 - a bad library file is reported by the compiler
+    except PlcConfigError:      # a bad library file: the compiler reports it
         pass
     for pou in program.pous:
         if pou.kind != "SBR":
             continue
-        try:
-            local_vars: dict[str, LocalVar] = layout_locals(pou, model.l_bytes)
-        except ResolveError:
-            continue
+        local_vars = layouts[pou.ident]
         kinds: list[str | int] = [lv.addr.width or "bit" for lv in local_vars.values()
                                   if lv.decl.section != "TEMP"]
         out[pou.ident] = kinds

@@ -232,7 +232,7 @@ class Interrupts:
     def live(self) -> bool:
         """Whether a timed interrupt runs, or T32/T96 CT=PT is attached (the
         scheduler asks only live sources)."""
-        return bool(self.timed_next) or 21 in self.attached or 22 in self.attached
+        return bool(self.timed_next) or not self.cacheable   # not cacheable: 21/22 attached
 
     def next_time(self, after: int, until: int) -> Optional[int]:
         """The first timed occurrence in (*after*, *until*], if any."""

@@ -93,6 +93,53 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
     return True
 
 
+#: export block name -> (the interfaces it may stand for, in the order tried;
+#: the family named in warnings), filled by :func:`register_protected`
+PROTECTED: dict[str, tuple[tuple[str, ...], str]] = {}
+
+
+def register_protected(family: str, names: dict[str, tuple[str, ...]]) -> None:
+    """Declare library blocks that an export holds as protected subroutines
+    (an interface and an empty body): a CALL of a program subroutine named
+    like one of *names* runs the built-in block whose interface matches."""
+    for name, variants in names.items():
+        PROTECTED[name.upper()] = (variants, family)
+
+
+def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
+    """CALL of a program subroutine named like a registered library block:
+    emit the built-in block when the body is empty (a protected block of the
+    export) and the interface matches one of the block's (directions and
+    types in order; names may differ); else False, with a warning once that
+    the program's own subroutine runs."""
+    _load_implementations()
+    name = (callee.pou.name or "").strip().upper()
+    entry = PROTECTED.get(name)
+    if entry is None:
+        return False
+    variants, family = entry
+    own = [(v.decl.section, v.decl.type.upper()) for v in callee.local_vars.values()
+           if v.decl.section != "TEMP"]
+    empty = not any(net.insns for net in callee.pou.networks)
+    itfs = [interfaces()[n] for n in variants if n in interfaces()]
+    for itf in itfs:
+        if empty and own == [(p.dir, p.type) for p in itf.params]:
+            return library_call(g, insn, resolver, name=itf.name)
+    once = g.unit.hooks.setdefault("protected-once", set())
+    if callee.pou.ident not in once:
+        once.add(callee.pou.ident)
+        wanted = " or ".join(", ".join(f"{p.dir} {p.type}" for p in itf.params) for itf in itfs)
+        why = [w for w, bad in (
+            ("has instructions", not empty),
+            ("has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
+             + f", not the library's {wanted}",
+             all(own != [(p.dir, p.type) for p in itf.params] for itf in itfs))) if bad]
+        g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the {family} "
+               f"block {name} but {' and '.join(why)}: the program's own subroutine runs, not "
+               f"the library emulation", f"protected-own-{callee.pou.ident}")
+    return False
+
+
 def _check_in(g: Any, itf: Any, p: Any, op: Any, role: Role, text: str) -> tuple[Any, str]:
     """Check an IN argument against its declared type, then against the
     other types the interface allows (``also``); returns the operand and

@@ -185,15 +185,12 @@ class Plc(AddressAccess):
             from ..devices import build_devices
             self.devices = build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
-        from ..blocks.call import library_call
-        from ..devices.modbus.master import modbus_call
-        from ..devices.ptowizard.blocks import wizard_call
+        from ..blocks.call import library_call, protected_call
 
         def setup(unit: Any) -> None:
             unit.hooks["plc"] = self
             unit.hooks["library_call"] = library_call
-            unit.hooks["wizard_call"] = wizard_call
-            unit.hooks["modbus_call"] = modbus_call
+            unit.hooks["protected_call"] = protected_call
             unit.hooks["timers"] = self.timers
             unit.hooks["counters"] = self.counters
 

@@ -267,13 +267,11 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         g.fail(f"no subroutine named '{excerpt(name)}' in the program")
     if callee.pou.kind != "SBR":
         g.fail(f"{callee.pou.ident} is not a subroutine")
-    # a protected wizard subroutine of the export (an empty body): the
-    # built-in PTOx_* / PWMx_RUN block instead (the engine installs the hook)
-    # (and MBUS_CTRL / MBUS_MSG: the Modbus master library)
-    for hook_name in ("wizard_call", "modbus_call"):
-        hook = g.unit.hooks.get(hook_name)
-        if hook is not None and hook(g, insn_ir, resolver, callee):
-            return
+    # a protected library subroutine of the export (an empty body): the
+    # built-in block instead (PTOx_*, MBUS_*, ...; the engine installs the hook)
+    hook = g.unit.hooks.get("protected_call")
+    if hook is not None and hook(g, insn_ir, resolver, callee):
+        return
     params = [v.decl for v in callee.local_vars.values() if v.decl.section != "TEMP"]
     actual = insn_ir.operands[1:]
     if len(actual) != len(params):

@@ -429,7 +429,7 @@ def test_a_wizard_name_with_another_interface_or_a_body_runs_its_own_code():
     plc = plcrt.load(text, plant=load_plant(plant()))
     own = [d.message for d in plc.diagnostics if "own subroutine runs" in d.message]
     assert len(own) == 2
-    assert any("not the wizard's IN BOOL, IN BYTE, IN BOOL" in m for m in own)
+    assert any("not the library's IN BOOL, IN BYTE, IN BOOL" in m for m in own)
     assert any("has instructions" in m for m in own)
     plc.scan(3)
     assert (plc["VW90"], plc["VW92"]) == (6, 3)

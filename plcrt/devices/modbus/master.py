@@ -18,8 +18,8 @@ What it is not: the library's code.  Its V-memory area (the library
 memory Micro/WIN asks for) and its interrupt routines are not simulated;
 the Error numbers are the manual's tables, plcrt's own choice where the
 manual has none (PLCRT_CHOICES; a load-time warning names them).
-Recognising the export's protected empty MBUS_CTRL / MBUS_MSG is
-:func:`modbus_call`.
+A protected, empty SUBROUTINE_BLOCK of the export named like one of these
+blocks runs it (``register_protected``; plcrt.blocks.call.protected_call).
 """
 
 from __future__ import annotations
@@ -28,12 +28,11 @@ import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
-from ...blocks.call import library_call
-from ...blocks.interface import interfaces
+from ...blocks.call import register_protected
 from ...safetext import excerpt
-from .rtu import READS, WRITES, check_crc, frame, gap_us, pack_bits
+from .rtu import READS, WRITES, check_crc, frame, gap_us
 
-__all__ = ["Master", "master_of", "modbus_call", "CTRL_ERRORS", "MSG_ERRORS", "RANGES"]
+__all__ = ["Master", "master_of", "CTRL_ERRORS", "MSG_ERRORS", "RANGES"]
 
 #: MBUS_CTRL Error (S7-200 SMART System Manual V2.3, 9.3.2.4 "Modbus RTU
 #: master execution error codes"; 0..4 as the S7-200 System Manual's table)
@@ -341,31 +340,5 @@ class MbusMsg(_Block):
             self.master.request = None
 
 
-def modbus_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
-    """CALL of a program subroutine named MBUS_CTRL or MBUS_MSG: the built-in
-    block when its body is empty (a protected library block of the export)
-    and its interface matches one of the library's (directions and types in
-    order; names may differ); else False, with a warning once that the
-    program's own code runs."""
-    name = (callee.pou.name or "").strip().upper()
-    variants = {"MBUS_CTRL": ("MBUS_CTRL", "MBUS_CTRL_SMART"), "MBUS_MSG": ("MBUS_MSG",)}
-    if name not in variants:
-        return False
-    own = [(v.decl.section, v.decl.type.upper()) for v in callee.local_vars.values()
-           if v.decl.section != "TEMP"]
-    empty = not any(net.insns for net in callee.pou.networks)
-    itfs = [interfaces()[n] for n in variants[name]]
-    for itf in itfs:
-        if empty and own == [(p.dir, p.type) for p in itf.params]:
-            return library_call(g, insn, resolver, name=itf.name)
-    once = g.unit.hooks.setdefault("modbus-once", set())
-    if callee.pou.ident not in once:
-        once.add(callee.pou.ident)
-        wanted = " or ".join(", ".join(f"{p.dir} {p.type}" for p in itf.params) for itf in itfs)
-        why = "has instructions" if not empty else (
-            "has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
-            + f", not the library's {wanted}")
-        g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the Modbus "
-               f"library block {name} but {why}: the program's own subroutine runs, not the "
-               f"library emulation", f"modbus-own-{callee.pou.ident}")
-    return False
+register_protected("Modbus", {"MBUS_CTRL": ("MBUS_CTRL", "MBUS_CTRL_SMART"),
+                               "MBUS_MSG": ("MBUS_MSG",)})

@@ -13,8 +13,8 @@ terminal, HSC mode 12, event 19/20 at the end of a motion).
 What it is not: the wizard's code.  Its error numbers, ramp algorithm and
 V-memory table are not public; plcrt's choices (the ERRORS table below,
 docs/pto-wizard.md) are announced by a warning when the program loads.
-Recognising a protected, empty SUBROUTINE_BLOCK of the export as one of
-these blocks is :func:`wizard_call`.
+A protected, empty SUBROUTINE_BLOCK of the export named like one of these
+blocks runs it (``register_protected``; plcrt.blocks.call.protected_call).
 """
 
 from __future__ import annotations
@@ -23,9 +23,7 @@ import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
-from ...blocks.call import library_call
-from ...blocks.interface import interfaces
-from ...safetext import excerpt
+from ...blocks.call import register_protected
 from .plan import change_trains, continuous_trains, profile_trains, stop_trains
 
 #: Error output codes (plcrt's own: the wizard's numbers are not public)
@@ -408,34 +406,4 @@ class PwmRun(_Block):
         return (self.error,)
 
 
-def wizard_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
-    """CALL of a program subroutine named like a wizard block: emit the
-    built-in block when its body is empty (a protected block of the export)
-    and its interface matches (directions and types in order; names may
-    differ); else False, and a warning once that the program's own code
-    runs."""
-    name = (callee.pou.name or "").strip().upper()
-    if name not in NAMES:
-        return False
-    itf = interfaces().get(name)
-    if itf is None:
-        return False
-    own = [(v.decl.section, v.decl.type.upper()) for v in callee.local_vars.values()
-           if v.decl.section != "TEMP"]
-    wanted = [(p.dir, p.type) for p in itf.params]
-    empty = not any(net.insns for net in callee.pou.networks)
-    if empty and own == wanted:
-        return library_call(g, insn, resolver, name=name)
-    once = g.unit.hooks.setdefault("ptowizard-once", set())
-    if callee.pou.ident not in once:
-        once.add(callee.pou.ident)
-        why = [w for w, bad in (
-            ("has instructions", not empty),
-            ("has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
-             + ", not the wizard's " + ", ".join(f"{d} {t}" for d, t in wanted),
-             own != wanted)) if bad]
-        why = " and ".join(why)
-        g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the wizard "
-               f"block {itf.name} but {why}: the program's own subroutine runs, not the "
-               f"wizard emulation", f"ptowizard-own-{callee.pou.ident}")
-    return False
+register_protected("PTO/PWM wizard", {n: (n,) for n in NAMES})

@@ -39,8 +39,10 @@ class EventSource(Protocol):
     def next_time(self, after: int, until: int) -> Optional[int]:
         """The time (µs) of the first event in (*after*, *until*], or None."""
 
-    def fire(self, t: int) -> None:
-        """Handle the events due at *t* (the devices are at *t*)."""
+    def fire(self, t: int) -> Optional[int]:
+        """Handle the events due at *t* (the devices are at *t*); it may
+        return its next event's time (after *t*) when it knows it without
+        being asked, else None."""
 
 
 class Scheduler:
@@ -93,42 +95,73 @@ class Scheduler:
         # pulse train started by PLS reaching a counter's PV at once) are
         # asked for from just before it
         after = t_from - 1 if first else t_from
+        quick: Any = None      # a row known to be due alone next (see below)
+        second = _NEVER
         while True:
-            best = _NEVER
-            due: Any = None            # the row due first
-            ties: Optional[list[Any]] = None   # all rows due, when several are
             gen = self.gen
-            for row in rows:           # in priority order: ties fire in this order
-                if row[1] != gen or not row[3]:
-                    src = row[0]
-                    row[2] = src.next_time(after, _NEVER) if src.live() else None
-                    row[1], row[3] = gen, src.cacheable
-                te = row[2]
-                if te is None or te > best:
-                    continue
-                if te < best:
-                    best, due, ties = te, row, None
-                elif ties is None:
-                    ties = [due, row]
-                else:
-                    ties.append(row)
+            if quick is not None:
+                # perf: the row that fired alone knows its next event, nothing
+                # touched the sources and every row is cacheable: the scan
+                # below would find it due alone, before *second*
+                due, best, ties = quick, quick[2], None
+            else:
+                best = second = _NEVER
+                due = None                 # the row due first
+                ties = None                # all rows due, when several are
+                volatile = False           # a row that must be asked each time
+                for row in rows:           # in priority order: ties fire in this order
+                    if row[1] != gen or not row[3]:
+                        src = row[0]
+                        row[2] = src.next_time(after, _NEVER) if src.live() else None
+                        row[1], row[3] = gen, src.cacheable
+                        volatile = volatile or not row[3]
+                    te = row[2]
+                    if te is None:
+                        continue
+                    if te > best:
+                        if te < second:
+                            second = te
+                    elif te < best:
+                        second, best, due, ties = best, te, row, None
+                    elif ties is None:
+                        ties = [due, row]
+                    else:
+                        ties.append(row)
             if best > t_to:
                 break
             if best > t:
                 for dev in devices:
                     dev.step(plc, t, best)
                 t = best
-            # perf: one row due is the common case (no list per instant)
-            for row in (ties or (due,)):
-                row[1] = -1
-                row[0].fire(best)
-                if row[4]:
+            quick = None
+            if ties is None:
+                # perf: one row due is the common case (no list per instant);
+                # a source may answer with its next event (kept like an
+                # asked one); None: asked again at the next instant
+                nxt = due[0].fire(best)
+                if nxt is None:
+                    due[1] = -1
+                else:
+                    due[2] = nxt
+                if due[4]:
                     self.gen += 1      # e.g. a train ended: a counter on it moves too
+            else:
+                for row in ties:
+                    nxt = row[0].fire(best)
+                    if nxt is None:
+                        row[1] = -1
+                    else:
+                        row[2] = nxt
+                    if row[4]:
+                        self.gen += 1
             if on_instant is not None:
                 on_instant(best)
             after = best
             if rows is not self._rows:   # HDEF in a routine added a counter
                 rows = self._rows = self._make_rows()
+            elif (ties is None and nxt is not None and nxt < second and not volatile
+                  and self.gen == gen and due[1] == gen):
+                quick = due
         if t < t_to:
             for dev in devices:
                 dev.step(plc, t, t_to)

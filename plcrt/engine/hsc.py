@@ -246,7 +246,9 @@ class HighSpeedCounter:
             # perf: the start input is read only in the modes that have one
             if not self.reset_held and (self.mode == 12 or self.mode % 3 != 2
                                         or self.counting()):
-                self.cv = _wrap(self.cv + self.direction * (now - self.base))
+                cv = self.cv + self.direction * (now - self.base)
+                # perf: wrapped only when it leaves the DINT range
+                self.cv = cv if -_I32 <= cv < _I32 else _wrap(cv)
             self.base = now
             self._publish()
 

@@ -247,23 +247,29 @@ class Interrupts:
                 best = te
         return best
 
-    def fire(self, t: int) -> None:
+    def fire(self, t: int) -> Optional[int]:
         """The scheduler's call (:class:`plcrt.engine.events.EventSource`):
         post the timed occurrences due at *t* and schedule their next ones
         (the engine runs the routines once every source of the instant has
-        fired)."""
+        fired); returns the next timed occurrence when that is all there
+        is to know (no CT=PT event attached)."""
         timed = self.timed_next
-        # event order: 10 before 11 at one instant (perf: no sort for one)
-        for event in (sorted(timed) if len(timed) > 1 else tuple(timed)):
+        # event order: 10 before 11 at one instant (perf: no sort for one;
+        # only values change, so the dict itself can be iterated)
+        for event in (sorted(timed) if len(timed) > 1 else timed):
             if timed[event] == t:
                 timed[event] = t + self.timed_period[event]
-                self.timed_fired.add(event)
+                if event not in self.timed_fired:
+                    self.timed_fired.add(event)
                 self.post(event, t)
         if not self.cacheable:
             for event, n in ((21, 32), (22, 96)):
                 if event in self.attached and self.timers.ct_pt_time(n) == t:
                     self.timers.refresh_1ms(t)       # CV = PT now: no second event
                     self.post(event, t)
+            return None
+        # perf: the scheduler keeps this instead of asking live/next_time
+        return min(timed.values()) if timed else None
 
     def attach_timer_events(self, timers: Any) -> None:
         """Events 21 / 22: T32 / T96 CT=PT, from the timer bank."""

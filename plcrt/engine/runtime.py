@@ -405,7 +405,9 @@ class Plc(AddressAccess):
     def _instant(self, t: int) -> None:
         """After the events of one instant: 1 ms timers and counters current,
         then the routines."""
-        self.timers.refresh_1ms(t)
+        timers = self.timers
+        if timers._fast:                # perf: no call without a running 1 ms timer
+            timers.refresh_1ms(t)
         for c in self._counted:
             c.sync(t)
         irq = self.interrupts

@@ -106,6 +106,8 @@ class Train:
         """The output's level at *t* (high for the first half of a cycle)."""
         if not self.start <= t < self.end:
             return 0
+        if self.delta == 0:             # perf: a constant cycle inline
+            return 1 if (t - self.start) % self.c0 < self.c0 // 2 else 0
         k = self.pulses_started(t) - 1
         return 1 if t - self.rise(k) < self.cycle(k) // 2 else 0
 
@@ -343,7 +345,11 @@ class PulseOutput:
     def level(self, t: int) -> int:
         """The terminal's level at *t*."""
         if self.trains:
-            return max(tr.level(t) for tr in self.trains)
+            # perf: no generator per scan (levels are 0 or 1)
+            for tr in self.trains:
+                if tr.level(t):
+                    return 1
+            return 0
         if self.mode == "PWM":
             start, cycle, width = self.pwm
             if width <= 0:

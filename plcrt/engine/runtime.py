@@ -359,7 +359,9 @@ class Plc(AddressAccess):
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
-        if self._pulse_running():
+        p0, p1 = self.pulse
+        # perf: the generators' own fields, not their `running` property
+        if p0.trains or p1.trains or p0.mode == "PWM" or p1.mode == "PWM":
             # a running generator drives its terminal, not the image bit
             t_end = now + self.scan_us
             for po in self.pulse:
@@ -429,10 +431,6 @@ class Plc(AddressAccess):
     def _hsc(self, number: int) -> None:
         self.hsc[number].hsc(self._irq_t)
         self.scheduler.touch()
-
-    def _pulse_running(self) -> bool:
-        p0, p1 = self.pulse
-        return p0.running or p1.running
 
     def _pls(self, number: int) -> None:
         self.pulse[number].pls(self._irq_t)

@@ -59,6 +59,9 @@ class Scheduler:
         #: such as PLS, HSC or ATCH; the end of a pulse train)
         self.gen = 0
         self._rows: list[list[Any]] = []
+        #: (row, second, gen): the row due alone next when the last run
+        #: ended, the earliest other row's time, and the gen they hold for
+        self._carry: Optional[tuple[list[Any], int, int]] = None
 
     def _make_rows(self) -> list[list[Any]]:
         return [[src, -1, None, src.cacheable, getattr(src, "moves_others", False)]
@@ -68,11 +71,13 @@ class Scheduler:
         """A new source (an HDEF'd counter on a pulse output), lowest priority."""
         self.sources.append(source)
         self._rows = []
+        self._carry = None
 
     def reset(self, sources: list[EventSource]) -> None:
         """Replace the sources (a forked PLC's own)."""
         self.sources[:] = sources
         self._rows = []
+        self._carry = None
 
     def touch(self) -> None:
         """A source's next event may have moved: ask them all again."""
@@ -97,6 +102,12 @@ class Scheduler:
         after = t_from - 1 if first else t_from
         quick: Any = None      # a row known to be due alone next (see below)
         second = _NEVER
+        carry = self._carry
+        if carry is not None and carry[2] == self.gen and rows is self._rows:
+            # perf: the last run's end already knew the row due next
+            quick, second, _ = carry
+            volatile = False
+        self._carry = None
         while True:
             gen = self.gen
             if quick is not None:
@@ -128,6 +139,8 @@ class Scheduler:
                     else:
                         ties.append(row)
             if best > t_to:
+                if ties is None and due is not None and not volatile:
+                    self._carry = (due, second, gen)
                 break
             if best > t:
                 for dev in devices:

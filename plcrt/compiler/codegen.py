@@ -65,6 +65,8 @@ class PouInfo:
     flow: bool = False
     cost: list[int] = field(default_factory=list)
     depth_after: dict[int, int] = field(default_factory=dict)  #: piece -> stack depth at its end
+    #: variables of a type plcrt cannot hold (reported at the declaration)
+    bad_vars: list[str] = field(default_factory=list)
 
 
 class Unit:
@@ -623,12 +625,17 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
             if p.number != 1:
                 diag.error(f"organization block {ident}: the S7-200 has only OB1",
                            p.loc.within(ident, None))
+        bad: list[ir.VarDecl] = []
         try:
-            local_vars = layout_locals(p, model.l_bytes)
+            local_vars = layout_locals(p, model.l_bytes, bad)
         except ResolveError as e:
             diag.error(str(e), p.loc.within(ident, None))
             local_vars = {}
-        info = PouInfo(p, _pou_fname(p), local_vars)
+        for d in bad:
+            diag.error(f"variable '#{excerpt(d.name)}': type {excerpt(d.type)} is not "
+                       f"supported; the block cannot run and its calls are not checked",
+                       d.loc.within(ident, None))
+        info = PouInfo(p, _pou_fname(p), local_vars, bad_vars=[d.name for d in bad])
         unit.pous[ident] = info
         if p.name and p.name.upper() != ident:
             if p.name.upper() in unit.by_name:

@@ -37,7 +37,8 @@ class LocalVar:
     addr: Addr
 
 
-def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
+def layout_locals(pou: ir.Pou, l_bytes: int,
+                  bad_types: list[ir.VarDecl] | None = None) -> dict[str, LocalVar]:
     """Allocate a POU's variables in L memory in Micro/WIN's order.
 
     IN, then IN_OUT, then OUT, then temporaries, each in declaration order.
@@ -46,6 +47,10 @@ def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
 
     Names are case-sensitive, as in Micro/WIN: a Siemens library block
     declares ``tmp_b`` (BOOL) and ``tmp_B`` (BYTE) side by side.
+
+    *bad_types*: when given, a variable of a type plcrt cannot hold is
+    appended to it and left out (the others keep their places as far as
+    they come before it), instead of raising.
 
     Raises:
         ResolveError: unknown type, duplicate name, or L memory exhausted.
@@ -59,6 +64,9 @@ def layout_locals(pou: ir.Pou, l_bytes: int) -> dict[str, LocalVar]:
                 raise ResolveError(f"variable '#{excerpt(d.name)}' declared twice")
             width = TYPE_WIDTH.get(d.type.upper())
             if width is None:
+                if bad_types is not None:
+                    bad_types.append(d)
+                    continue
                 raise ResolveError(f"variable '#{excerpt(d.name)}': type {excerpt(d.type)} "
                                    f"is not supported")
             if width == 0:

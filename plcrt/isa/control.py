@@ -272,6 +272,10 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
     hook = g.unit.hooks.get("protected_call")
     if hook is not None and hook(g, insn_ir, resolver, callee):
         return
+    if callee.bad_vars:
+        g.fail(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) cannot be called: its "
+               f"variable #{excerpt(callee.bad_vars[0])} has a type plcrt does not support "
+               f"(see its declaration)")
     params = [v.decl for v in callee.local_vars.values() if v.decl.section != "TEMP"]
     actual = insn_ir.operands[1:]
     if len(actual) != len(params):

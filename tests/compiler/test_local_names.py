@@ -63,3 +63,25 @@ def test_a_spelling_that_fits_two_variables_is_a_located_error() -> None:
 def test_the_same_name_twice_is_still_an_error() -> None:
     with pytest.raises(PlcCompileError, match="declared twice"):
         plcrt.load(program().replace("tmp_B:BYTE;", "tmp_b:BYTE;").replace("#tmp_B", "#tmp_b"))
+
+
+def test_a_variable_of_an_unsupported_type_keeps_the_rest_of_the_interface() -> None:
+    """A STRING parameter is reported once at its own declaration line; the
+    other variables keep their places, and a CALL says the block cannot be
+    called instead of miscounting its parameters."""
+    src = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+           "CALL   SBR_0, \"abc\", VB100\nEND_ORGANIZATION_BLOCK\n"
+           "SUBROUTINE_BLOCK SBR_0:SBR0\nVAR_INPUT\nk:BYTE;\ns:STRING;\nEND_VAR\n"
+           "VAR_OUTPUT\nn:BYTE;\nEND_VAR\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+           "MOVB   #k, #n\nEND_SUBROUTINE_BLOCK\n")
+    with pytest.raises(PlcCompileError) as ei:
+        plcrt.load(src)
+    errors = [d for d in ei.value.diagnostics if d.severity == "error"]
+    texts = [d.message for d in errors]
+    assert any("'#s': type STRING is not supported" in m for m in texts), texts
+    decl = next(d for d in errors if "type STRING" in d.message)
+    assert decl.loc.line == 10                     # the line of `s:STRING;`
+    assert any("cannot be called" in m and "#s" in m for m in texts), texts
+    assert not any("takes" in m and "parameter(s)" in m for m in texts), texts
+    # #k and #n were laid out: the body's MOVB resolved
+    assert not any("#k" in m or "#n" in m for m in texts), texts

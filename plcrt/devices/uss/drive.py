@@ -387,6 +387,7 @@ class UssBus:
         self.port: Any = None
         self.busy_until = 0
         self.telegrams: list[tuple[int, bytes]] = []   #: (time the telegram ended, bytes)
+        self.answers: list[tuple[int, bytes]] = []     #: (time the answer starts, bytes)
         self.ignored = 0                               #: telegrams that got no answer
         self.corrupt = 0                               #: next answers sent with a wrong BCC
 
@@ -408,9 +409,11 @@ class UssBus:
             return
         mine = self.framing()
         garbled = (fr.baud, fr.data_bits, fr.parity) != (mine.baud, 8, mine.parity)
-        port.push(fr.end(t, len(data)), self._telegram, bytes(data), garbled)
+        port.push(fr.end(t, len(data)), self.take, bytes(data), garbled)
 
-    def _telegram(self, t: int, data: bytes, garbled: bool = False) -> None:
+    def take(self, t: int, data: bytes, garbled: bool = False) -> None:
+        """A telegram whose last stop bit ended at *t* (*garbled*: sent in
+        another framing): the addressed drive answers, or nobody."""
         self.telegrams.append((t, data))
         tel, _ = decode(data)
         drive = self.drives.get(tel.address) if tel is not None else None
@@ -428,4 +431,5 @@ class UssBus:
         fr = self.framing()
         start = max(t + drive.cfg.delay_us, self.busy_until)
         self.port.receive(start, fr, out)
+        self.answers.append((start, out))
         self.busy_until = fr.end(start, len(out))

@@ -193,7 +193,8 @@ def test_init_change_while_active_is_error_17():
     assert plc["MB5"] == 0
 
 
-SMART = PROGRAM.replace("CALL   USS_INIT, VB200, VD204, VD208", "CALL   USS_INIT, VB200, VD204, VB201, VD208")
+SMART = PROGRAM.replace("CALL   USS_INIT, VB200, VD204, VD208",
+                        "CALL   USS_INIT, VB200, VD204, VB201, VD208")
 
 
 @pytest.mark.parametrize("cpu, port, error", [("CPU226", 1, 0), ("CPU226", 2, 23),

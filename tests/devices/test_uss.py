@@ -489,6 +489,56 @@ def test_bad_bcc_from_the_drive_is_error_2():
     assert [e["error"] for e in master_of(plc).log].count(2) == 1
 
 
+def test_parity_error_in_the_response_is_error_3():
+    """A response character with a parity error: Error 3; the next good one clears it."""
+    plc = load()
+    plc.run(0.1)
+    plc.ports[0].peer.bad_parity = 1
+    plc.run(0.1)
+    assert [e["error"] for e in master_of(plc).log].count(3) == 1 and plc["MB6"] == 0
+
+
+GOOD = encode(Telegram(3, 0, 0, 0, 0xEB31, 0))
+
+
+@pytest.mark.parametrize("data, bad, error, at_timeout", [
+    (GOOD, (), 0, False),
+    (encode(Telegram(1, 0, 0, 0, 0xEB31, 0)), (), 13, False),
+    (GOOD[:1] + bytes((12,)) + GOOD[2:14], (), 12, False),
+    (GOOD[:-1] + bytes((GOOD[-1] ^ 0x10,)), (), 2, False),
+    (GOOD, (4,), 3, False),
+    (b"\x03" + GOOD[1:], (), 11, True),
+    (GOOD[:10], (), 10, True)])
+def test_response_checks(data, bad, error, at_timeout):
+    """Another device answers the telegram to drive 3 (no drive there) 5 ms
+    after it: ADR 1 is Error 13, LGE 12 Error 12, a bad BCC 2, a parity
+    error 3, at the last character; a first character not STX 11 and a
+    short response 10, at the timeout."""
+    from plcrt.engine.serial import Framing
+    plc = load(active=0b1000)
+    plc["VB212"] = 3
+    first_end = 2292 + 18334
+    plc.ports[0].receive(first_end + 5000, Framing(9600, 8, "even", "freeport"), data,
+                         frozenset(bad))
+    plc.run(0.1)
+    entry = master_of(plc).log[0]
+    assert entry["error"] == error
+    assert entry["finished"] == (first_end + 50_000 if at_timeout else entry["last_char"])
+
+
+def test_a_new_uss_init_drops_a_running_parameter_request_with_error_4():
+    """USS_INIT Mode 0 then 1 while a read waits: the read ends with Error 4."""
+    plc = load(active=0b1000)           # drive 3 is absent: the read never ends by itself
+    plc["VB240"], plc["VW242"] = 3, 700
+    plc["M3.0"] = 1
+    plc.scan()
+    plc["M3.0"], plc["VB200"] = 0, 0
+    plc.scan()
+    plc["VB200"] = 1
+    plc.scan()
+    assert (plc["M3.1"], plc["MB7"]) == (1, 4)
+
+
 def test_drive_ignores_a_telegram_with_a_bad_bcc():
     """The drive does not answer a telegram with a bad BCC, nor one for an
     address it does not have; a good one it answers."""

@@ -35,7 +35,8 @@ supported).  The ramp times are parameters 1120, 1121 and 1135 when the
 real table has them (so USS_WPM_R can change them).  r0021 (actual
 frequency, REAL) and r0052 (status word) are there unless the tables
 define them.  Tests read ``frequency``, ``status``, ``fault``; ``trip()``
-puts a drive in fault; ``corrupt`` answers with a wrong BCC.
+puts a drive in fault; ``corrupt`` answers with a wrong BCC, ``bad_parity``
+with a parity error.
 
 What it is not: no motor, no current, no V/f; no PKW of variable length;
 one device per port.
@@ -390,6 +391,7 @@ class UssBus:
         self.answers: list[tuple[int, bytes]] = []     #: (time the answer starts, bytes)
         self.ignored = 0                               #: telegrams that got no answer
         self.corrupt = 0                               #: next answers sent with a wrong BCC
+        self.bad_parity = 0                            #: next answers with a parity error
 
     def attach(self, port: Any) -> None:
         self.port = port
@@ -428,8 +430,12 @@ class UssBus:
         if self.corrupt:
             self.corrupt -= 1
             out = out[:-1] + bytes((out[-1] ^ 0xFF,))
+        bad: frozenset[int] = frozenset()
+        if self.bad_parity:
+            self.bad_parity -= 1
+            bad = frozenset((7,))        # one character of PWE arrives with a parity error
         fr = self.framing()
         start = max(t + drive.cfg.delay_us, self.busy_until)
-        self.port.receive(start, fr, out)
+        self.port.receive(start, fr, out, bad)
         self.answers.append((start, out))
         self.busy_until = fr.end(start, len(out))

@@ -24,10 +24,10 @@ from . import BLOCK_FACTORIES
 from .interface import interfaces
 
 _READ = {"BOOL": Role.BIT_R, "BYTE": Role.B_R, "WORD": Role.W_R, "INT": Role.W_R,
-         "DINT": Role.D_R, "DWORD": Role.D_R}
+         "DINT": Role.D_R, "DWORD": Role.D_R, "REAL": Role.R_R}
 _WRITE = {"BOOL": Role.BIT_W, "BYTE": Role.B_W, "WORD": Role.W_W, "INT": Role.W_W,
-          "DINT": Role.D_W, "DWORD": Role.D_W}
-_KIND = {"BYTE": "B", "WORD": "WU", "INT": "W", "DINT": "D", "DWORD": "DU"}
+          "DINT": Role.D_W, "DWORD": Role.D_W, "REAL": Role.R_W}
+_KIND = {"BYTE": "B", "WORD": "WU", "INT": "W", "DINT": "D", "DWORD": "DU", "REAL": "R"}
 
 
 def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> bool:
@@ -162,10 +162,11 @@ def _check_in(g: Any, itf: Any, p: Any, op: Any, role: Role, text: str) -> tuple
         raise
 
 
-_WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4}
+_WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4, "REAL": 4}
 
 
 def _load_implementations() -> None:
     from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)
     from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)
     from ..devices.modbus import master as _modbus  # noqa: F401  (MBUS_CTRL, MBUS_MSG)
+    from ..devices.uss import library as _uss  # noqa: F401  (USS_INIT, USS_CTRL, USS_xPM_x)

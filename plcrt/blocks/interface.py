@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ..errors import PlcConfigError
 
-TYPES = ("BOOL", "BYTE", "WORD", "INT", "DINT", "DWORD")
+TYPES = ("BOOL", "BYTE", "WORD", "INT", "DINT", "DWORD", "REAL")
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,8 +28,9 @@ whenever the bytes since the last answer equal a request, the device sends
 its reply (in the port's framing, *delay_ms* after that request's last stop
 bit, and after anything it is still sending); bytes left over at the end of
 a transmission went unanswered and are reported in ``plc.diagnostics``.
-What it is not: no protocol (USS): requests are exact bytes; a Modbus RTU
-slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`).
+What it is not: no protocol: requests are exact bytes; a Modbus RTU
+slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`), USS
+drives ``[port.N.uss]`` (:mod:`plcrt.devices.uss.drive`).
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ from .keys import checked_table
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
 
-_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave"}
+_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave", "uss"}
 _REPLY_KEYS = {"request", "reply", "delay_ms", "bad_parity"}
 _SEND_KEYS = {"at", "data", "bad_parity"}
 _ETH_KEYS = {"ip", "latency_ms"}
@@ -71,6 +72,7 @@ class PortConfig:
     ppi_baud: int = 9600
     device: DeviceConfig | None = None
     modbus: Any = None   #: a Modbus RTU slave (plcrt.devices.modbus.slave.SlaveConfig)
+    uss: Any = None      #: USS drives (plcrt.devices.uss.drive.BusConfig)
     where: str = field(default="", compare=False)
 
 
@@ -140,6 +142,12 @@ def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
                                      f"device (reply/send); one device per port")
             from .modbus.slave import parse_slave
             cfg.modbus = parse_slave(p["modbus_slave"], f"{where}.modbus_slave")
+        if "uss" in p:
+            if cfg.device is not None or cfg.modbus is not None:
+                raise PlcConfigError(f"{where}.uss: the port already has a device "
+                                     f"(reply/send or modbus_slave); one device per port")
+            from .uss.drive import parse_uss
+            cfg.uss = parse_uss(p["uss"], f"{where}.uss")
         out[int(key)] = cfg
     return out
 

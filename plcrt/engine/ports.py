@@ -398,3 +398,6 @@ def attach_devices(ports: list[Port], plant: Any) -> None:
         elif cfg.modbus is not None:
             from ..devices.modbus.slave import ModbusSlave
             ModbusSlave(cfg.modbus).attach(ports[k])
+        elif getattr(cfg, "uss", None) is not None:
+            from ..devices.uss.drive import UssBus
+            UssBus(cfg.uss).attach(ports[k])

@@ -169,3 +169,4 @@ def _load_implementations() -> None:
     from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)
     from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)
     from ..devices.modbus import master as _modbus  # noqa: F401  (MBUS_CTRL, MBUS_MSG)
+    from ..devices.modbus import slavelib as _mbslave  # noqa: F401  (MBUS_INIT, MBUS_SLAVE)

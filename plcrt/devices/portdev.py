@@ -29,7 +29,9 @@ its reply (in the port's framing, *delay_ms* after that request's last stop
 bit, and after anything it is still sending); bytes left over at the end of
 a transmission went unanswered and are reported in ``plc.diagnostics``.
 What it is not: no protocol (USS): requests are exact bytes; a Modbus RTU
-slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`).
+slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`), a
+Modbus RTU master ``[port.N.modbus_master]``
+(:mod:`plcrt.devices.modbus.plantmaster`).
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ from .keys import checked_table
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
 
-_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave"}
+_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave", "modbus_master"}
 _REPLY_KEYS = {"request", "reply", "delay_ms", "bad_parity"}
 _SEND_KEYS = {"at", "data", "bad_parity"}
 _ETH_KEYS = {"ip", "latency_ms"}
@@ -71,6 +73,8 @@ class PortConfig:
     ppi_baud: int = 9600
     device: DeviceConfig | None = None
     modbus: Any = None   #: a Modbus RTU slave (plcrt.devices.modbus.slave.SlaveConfig)
+    #: a scripted Modbus RTU master (plcrt.devices.modbus.plantmaster.MasterConfig)
+    modbus_master: Any = None
     where: str = field(default="", compare=False)
 
 
@@ -140,6 +144,13 @@ def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
                                      f"device (reply/send); one device per port")
             from .modbus.slave import parse_slave
             cfg.modbus = parse_slave(p["modbus_slave"], f"{where}.modbus_slave")
+        if "modbus_master" in p:
+            if cfg.device is not None or cfg.modbus is not None:
+                other = "a scripted device (reply/send)" if cfg.device else "a Modbus slave"
+                raise PlcConfigError(f"{where}.modbus_master: the port already has {other}; "
+                                     f"one device per port")
+            from .modbus.plantmaster import parse_master
+            cfg.modbus_master = parse_master(p["modbus_master"], f"{where}.modbus_master")
         out[int(key)] = cfg
     return out
 

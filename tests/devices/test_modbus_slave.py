@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 import plcrt
+from plcrt.devices.modbus.master import master_of
 from plcrt.devices.modbus.rtu import frame
 from plcrt.devices.modbus.slavelib import slave_of
 from plcrt.devices.plant import load_plant
@@ -350,21 +351,24 @@ def test_export_block_with_another_interface_runs_its_own_code():
 
 # ---------------------------------------------------------------- two CPUs
 def test_two_linked_cpus_master_and_slave():
-    """programs/modbus/poll.awl (MBUS_CTRL/MBUS_MSG) on CPU A linked to
-    programs/modbus/slave.awl (MBUS_INIT/MBUS_SLAVE) on CPU B: A reads B's
-    40001..40004 (VW1000..) and writes VW100 + 1 to B's 40005 (VW1008)."""
+    """programs/modbus/poll.awl (MBUS_CTRL/MBUS_MSG, 10 ms scans) on CPU A
+    linked to programs/modbus/slave.awl (MBUS_INIT/MBUS_SLAVE, 7 ms scans)
+    on CPU B: A reads B's 40001..40004 (VW1000..) and writes VW100 + 1 to
+    B's 40005 (VW1008).  The first read: sent at 0, known ended by B at
+    11 980 µs, served by B's scan at 14 000 µs, 13 bytes to 27 542 µs."""
     root = Path(__file__).resolve().parents[2] / "programs" / "modbus"
     a = plcrt.load(root / "poll.awl", scan_ms=10)
     b = plcrt.load(root / "slave.awl", scan_ms=7)
     net = plcrt.link(a, 0, b, 0)
     b["VW1002"], b["VW1004"] = 35, 7
     net.run(1.0)
-    assert a["MB3"] == 0 and a["MB4"] == 0 and a["VW20"] >= 10
-    assert (a["VW102"], a["VW104"]) == (35, 7)
-    assert a["VW100"] == b["VW1000"] or a["VW100"] + 1 == b["VW1000"]
-    assert b["VW1008"] == a["VW100"] + 1 or b["VW1008"] + 1 == a["VW100"] + 1
-    assert b["VW20"] == a["VW20"] * 2 - (a["VB10"] == 1)
-    assert b["MB2"] == 0
+    first = slave_of(b).log[0]
+    assert (first["known"], first["served"], first["answer_end"]) == (11_980, 14_000, 27_542)
+    assert master_of(a).log[0]["first_char"] == 15_042
+    assert (a["MB3"], a["MB4"], b["MB2"]) == (0, 0, 0)
+    assert (a["VW20"], b["VW20"]) == (14, 28)          # 14 reads and 14 writes served
+    assert (a["VW100"], a["VW102"], a["VW104"]) == (b["VW1000"], 35, 7) == (1, 35, 7)
+    assert b["VW1008"] == 2 and b["QB1"] == 2
 
 
 # ---------------------------------------------------------------- the sample

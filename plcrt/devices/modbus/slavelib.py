@@ -56,8 +56,8 @@ ERRORS = {0: "no error", 1: "memory range error", 2: "illegal baud rate or parit
 #: what plcrt decided where the manual has no word (docs/modbus.md)
 PLCRT_CHOICES = {
     "MBUS_INIT": ("Error 4 for Mode not 0 or 1 and for Delay above 32767 ms",),
-    "MBUS_SLAVE": ("Error 9 also for an illegal data value (count or coil value; "
-                   "exception 3)",
+    "MBUS_SLAVE": ("Error 9 also for an illegal data value (a count, coil value or "
+                   "length; exception 3)",
                    "Done 1 with Error 6 / 7 for a frame with a parity / CRC error "
                    "(no answer)",
                    "Done 1 with Error 10 at every call before a successful MBUS_INIT")}

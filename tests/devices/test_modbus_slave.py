@@ -421,3 +421,19 @@ def test_periodic_requests_and_a_fork():
     busy.run(0.1)
     # the second is due at 30 000 µs while the first's answer ends at 29 292 + 3646
     assert [r["sent"] for r in answers(busy)] == [10_000, 32_938]
+
+
+def test_a_request_waits_while_the_last_answer_is_sent():
+    """Half duplex: a second request (from a scripted device, unasked for)
+    known ended at 41 980 µs while the 205-byte answer to the first runs
+    until 235 542 µs is served by the first scan after that answer."""
+    first = frame(bytes.fromhex("010300000064")).hex(" ")
+    second = frame(bytes.fromhex("010300000001")).hex(" ")
+    plant = (f'[[port.0.send]]\nat = 0.01\ndata = "{first}"\n'
+             f'[[port.0.send]]\nat = 0.03\ndata = "{second}"\n')
+    plc = load(plant)
+    plc.run(0.3)
+    one, two = slave_of(plc).log
+    assert (one["served"], one["answer_end"]) == (22_000, 22_000 + 213_542)
+    assert two["known"] == 41_980 and two["served"] == 236_000
+    assert plc["VW300"] == 2

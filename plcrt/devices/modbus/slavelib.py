@@ -144,8 +144,9 @@ class SlaveLib:
     # -- MBUS_SLAVE
     def serve_one(self) -> tuple[int, int]:
         """Serve the oldest waiting request: (Done, Error); (0, 0) when
-        there is none for this slave."""
-        while self.waiting:
+        there is none for this slave, or the port still sends the last
+        answer (half duplex: the request waits for a later call)."""
+        while self.waiting and self.port.tx_end is None:
             known, data, parity, t0, last = self.waiting.popleft()
             rec: dict[str, Any] = {"first_char": t0, "last_char": last, "known": known,
                                    "request": data}

@@ -29,7 +29,8 @@ gap.  ``responses`` records each request's times (µs: ``sent``,
 ``sent_end``, ``first_char``, ``last_char``, ``finished``) and outcome:
 ``values`` (reads), ``exception`` (its code), ``timeout``, or ``error``
 ("crc", "slave", "function", "length", "echo", "garbled"), with the bytes
-received.  What it is not: no retries, no diagnostics functions, no ASCII.
+received; ``unasked`` the bytes the CPU sent while no answer was awaited
+(time of the last stop bit, bytes).  What it is not: no retries, no diagnostics functions, no ASCII.
 """
 
 from __future__ import annotations

@@ -26,6 +26,7 @@ demo: setup
 	$(BIN)/plcrt run programs/events/pto_count.awl --plant programs/events/pto_count_plant.toml --seconds 1.2 --set M0.0=1 --watch VD200 --watch VW204 --watch VD208
 	$(BIN)/plcrt run programs/pid/pid_loop.awl --plant programs/pid/pid_loop_plant.toml --seconds 60 --set I0.0=1 --watch AIW0 --watch AQW0
 	$(BIN)/plcrt run programs/uss/drive.awl --plant programs/uss/drive_plant.toml --seconds 6 --watch VD100:REAL --watch VD110:REAL --watch MB3
+	$(BIN)/plcrt run programs/modbus/slave.awl --plant programs/modbus/master_plant.toml --seconds 1 --watch VW20 --watch QB0 --watch QB1
 	$(BIN)/plcrt run programs/ports/scale.awl --plant programs/ports/scale_plant.toml --seconds 1 --watch VW10 --watch VW12
 	$(BIN)/plcrt run examples/bus_drive/bus_drive.awl library/cia402/drive_lib.awl --plant examples/bus_drive/plant.toml --symbols examples/bus_drive/bus_drive_symbols.txt --data examples/bus_drive/bus_drive.db --seconds 2 --set D1_Enable_SW=1 --set D1_Jog_SW=1 --watch VD1036
 

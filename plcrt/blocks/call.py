@@ -170,3 +170,4 @@ def _load_implementations() -> None:
     from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)
     from ..devices.modbus import master as _modbus  # noqa: F401  (MBUS_CTRL, MBUS_MSG)
     from ..devices.uss import library as _uss  # noqa: F401  (USS_INIT, USS_CTRL, USS_xPM_x)
+    from ..devices.modbus import slavelib as _mbslave  # noqa: F401  (MBUS_INIT, MBUS_SLAVE)

@@ -29,8 +29,10 @@ its reply (in the port's framing, *delay_ms* after that request's last stop
 bit, and after anything it is still sending); bytes left over at the end of
 a transmission went unanswered and are reported in ``plc.diagnostics``.
 What it is not: no protocol: requests are exact bytes; a Modbus RTU
-slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`), USS
-drives ``[port.N.uss]`` (:mod:`plcrt.devices.uss.drive`).
+slave is ``[port.N.modbus_slave]`` (:mod:`plcrt.devices.modbus.slave`), a
+Modbus RTU master ``[port.N.modbus_master]``
+(:mod:`plcrt.devices.modbus.plantmaster`), USS drives ``[port.N.uss]``
+(:mod:`plcrt.devices.uss.drive`).
 """
 
 from __future__ import annotations
@@ -46,7 +48,13 @@ from .keys import checked_table
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
 
-_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave", "uss"}
+_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave", "modbus_master",
+              "uss"}
+#: the devices a port may have at its other end (one), by their plant keys
+_DEVICE_KEYS = {"a scripted device (reply/send)": ("reply", "send"),
+                "a Modbus slave (modbus_slave)": ("modbus_slave",),
+                "a Modbus master (modbus_master)": ("modbus_master",),
+                "USS drives (uss)": ("uss",)}
 _REPLY_KEYS = {"request", "reply", "delay_ms", "bad_parity"}
 _SEND_KEYS = {"at", "data", "bad_parity"}
 _ETH_KEYS = {"ip", "latency_ms"}
@@ -73,6 +81,8 @@ class PortConfig:
     device: DeviceConfig | None = None
     modbus: Any = None   #: a Modbus RTU slave (plcrt.devices.modbus.slave.SlaveConfig)
     uss: Any = None      #: USS drives (plcrt.devices.uss.drive.BusConfig)
+    #: a scripted Modbus RTU master (plcrt.devices.modbus.plantmaster.MasterConfig)
+    modbus_master: Any = None
     where: str = field(default="", compare=False)
 
 
@@ -134,18 +144,20 @@ def parse_ports(raw: Any, file: str) -> dict[int, PortConfig]:
         if cfg.ppi_baud not in PPI_BAUDS or isinstance(cfg.ppi_baud, bool):
             raise PlcConfigError(f"{where}.ppi_baud must be one of "
                                  f"{', '.join(map(str, PPI_BAUDS))}, got {cfg.ppi_baud!r:.40}")
+        # one device per port: what the plant puts at its other end
+        present = [name for name, keys in _DEVICE_KEYS.items() if any(k in p for k in keys)]
+        if len(present) > 1:
+            raise PlcConfigError(f"{where}: the port has {' and '.join(present)}; "
+                                 f"one device per port")
         if "reply" in p or "send" in p:
             cfg.device = _device(p, where)
         if "modbus_slave" in p:
-            if cfg.device is not None:
-                raise PlcConfigError(f"{where}.modbus_slave: the port already has a scripted "
-                                     f"device (reply/send); one device per port")
             from .modbus.slave import parse_slave
             cfg.modbus = parse_slave(p["modbus_slave"], f"{where}.modbus_slave")
+        if "modbus_master" in p:
+            from .modbus.plantmaster import parse_master
+            cfg.modbus_master = parse_master(p["modbus_master"], f"{where}.modbus_master")
         if "uss" in p:
-            if cfg.device is not None or cfg.modbus is not None:
-                raise PlcConfigError(f"{where}.uss: the port already has a device "
-                                     f"(reply/send or modbus_slave); one device per port")
             from .uss.drive import parse_uss
             cfg.uss = parse_uss(p["uss"], f"{where}.uss")
         out[int(key)] = cfg

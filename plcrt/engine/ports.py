@@ -86,8 +86,8 @@ class Port(Inbox):
         self.address = 2
         self.ppi_baud = 9600
         self.jobs: list[Any] = []          #: NETR/NETW jobs in progress
-        #: a library that took the port (the Modbus master): it gets the
-        #: characters received, and sends with :meth:`send`
+        #: a library that took the port (the Modbus master or slave): it
+        #: gets the characters received, and sends with :meth:`send`
         self.owner: Any = None
         self.sm[4] |= self.idle_bit        # SM4.5 / SM4.6: the transmitter is idle
 
@@ -401,3 +401,6 @@ def attach_devices(ports: list[Port], plant: Any) -> None:
         elif getattr(cfg, "uss", None) is not None:
             from ..devices.uss.drive import UssBus
             UssBus(cfg.uss).attach(ports[k])
+        elif getattr(cfg, "modbus_master", None) is not None:
+            from ..devices.modbus.plantmaster import PlantMaster
+            PlantMaster(cfg.modbus_master).attach(ports[k])

@@ -366,14 +366,15 @@ END_ORGANIZATION_BLOCK
 
 def test_export_protected_blocks_run_the_library():
     """An export's MBUS_CTRL / MBUS_MSG (interface, empty body) run the
-    library, with the load warning naming plcrt's error numbers; another
-    empty protected block (MBUS_INIT) keeps the empty-block warning."""
+    library, with the load warning naming plcrt's error numbers; an empty
+    MBUS_INIT with another interface than the slave library's runs as the
+    program's own subroutine, with a warning."""
     text = EXPORT_OB1 + sbr("MBUS_CTRL", 1, CTRL_ITF) + sbr("MBUS_MSG", 2, MSG_ITF) \
         + sbr("MBUS_INIT", 3, [("IN", "BOOL")])
     plc = load(slave(), program=text)
     warns = [d.message for d in plc.diagnostics]
     assert sum("Modbus RTU master library" in w and "107" in w for w in warns) == 1
-    assert any("MBUS_INIT" in w and "no code" in w for w in warns)
+    assert any("MBUS_INIT" in w and "own subroutine runs" in w for w in warns)
     assert not any("MBUS_MSG" in w and "no code" in w for w in warns)
     r = msg(plc, 1, 0, 40001, 2)
     assert r["error"] == 0 and (plc["VW100"], plc["VW102"]) == (42, 7)

@@ -1,4 +1,5 @@
-"""The Modbus RTU master library of Micro/WIN (MBUS_CTRL, MBUS_MSG) as
-built-in blocks (:mod:`.master`), the Modbus RTU slave a plant file puts at
-a port (:mod:`.slave`), and the protocol's frames and CRC (:mod:`.rtu`).
-docs/modbus.md describes all three."""
+"""The Modbus RTU master library of Micro/WIN (MBUS_CTRL, MBUS_MSG) and its
+slave library (MBUS_INIT, MBUS_SLAVE) as built-in blocks (:mod:`.master`,
+:mod:`.slavelib`), the Modbus RTU slave and master a plant file puts at a
+port (:mod:`.slave`, :mod:`.plantmaster`), and the protocol's frames, CRC
+and a slave's answer (:mod:`.rtu`).  docs/modbus.md describes them all."""

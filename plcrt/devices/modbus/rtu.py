@@ -4,14 +4,19 @@ functions the Micro/WIN master library uses (1, 2, 3, 4 reads; 5, 6, 15,
 
 What it is: pure functions over bytes (Modbus over Serial Line
 Specification V1.02, section 2.5.1 "RTU transmission mode" and 6 "CRC";
-Modbus Application Protocol V1.1b3, section 6 "Function codes").  What it
-is not: no timing of characters (:mod:`plcrt.engine.serial`), no memory.
+Modbus Application Protocol V1.1b3, section 6 "Function codes"), and
+:func:`serve`, a slave's answer to one request over tables that its caller
+supplies (the plant's slave: lists; the slave library: the CPU's memory).
+What it is not: no timing of characters (:mod:`plcrt.engine.serial`), no
+memory of its own.
 """
 
 from __future__ import annotations
 
+from typing import Protocol
+
 __all__ = ["crc16", "frame", "check_crc", "pack_bits", "unpack_bits", "gap_us",
-           "READS", "WRITES", "EXCEPTIONS"]
+           "READS", "WRITES", "EXCEPTIONS", "Tables", "ModbusException", "serve"]
 
 #: table kind -> read function (Modbus Application Protocol, section 6)
 READS = {"coils": 1, "inputs": 2, "holding": 3, "input_registers": 4}
@@ -76,3 +81,85 @@ def gap_us(bits: int, baud: int) -> int:
     if baud > 19200:
         return 1750
     return -(-7 * bits * 1_000_000 // (2 * baud))
+
+
+#: read function -> (table, is bits, largest count) (Modbus Application
+#: Protocol 6.1-6.4)
+READ_FN = {1: ("coils", True, 2000), 2: ("inputs", True, 2000),
+           3: ("holding", False, 125), 4: ("input_registers", False, 125)}
+#: largest count of function 15 and 16 (Modbus Application Protocol 6.11, 6.12)
+WRITE_MAX = {15: 1968, 16: 123}
+
+
+class Tables(Protocol):
+    """A slave's four tables by kind ("coils", "inputs", "input_registers",
+    "holding"): how many addresses each has, and reading / writing a span."""
+
+    def size(self, kind: str) -> int: ...
+
+    def get(self, kind: str, start: int, count: int) -> list[int]: ...
+
+    def put(self, kind: str, start: int, values: list[int]) -> None: ...
+
+
+class ModbusException(Exception):
+    """An exception response's code (Modbus Application Protocol, section 7)."""
+
+    def __init__(self, code: int) -> None:
+        super().__init__(code)
+        self.code = code
+
+
+def serve(fn: int, pdu: bytes, tables: Tables) -> bytes:
+    """The response PDU (function and data, or the exception ``fn | 80``
+    and its code) of the request *fn* with data *pdu* over *tables*:
+    exception 1 for a function not in 1..6, 15, 16; 2 for a span past a
+    table; 3 for a bad length, count or coil value.  A request that fails
+    writes nothing."""
+    try:
+        return bytes((fn,)) + _run(fn, pdu, tables)
+    except ModbusException as e:
+        return bytes((fn | 0x80, e.code))
+
+
+def _span(tables: Tables, kind: str, start: int, count: int, top: int) -> None:
+    if not 1 <= count <= top:
+        raise ModbusException(3)
+    if start + count > tables.size(kind):
+        raise ModbusException(2)
+
+
+def _run(fn: int, pdu: bytes, tables: Tables) -> bytes:
+    if fn in READ_FN:
+        if len(pdu) != 4:
+            raise ModbusException(3)
+        kind, bits, top = READ_FN[fn]
+        start, count = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
+        _span(tables, kind, start, count, top)
+        vals = tables.get(kind, start, count)
+        data = pack_bits(vals) if bits else b"".join(v.to_bytes(2, "big") for v in vals)
+        return bytes((len(data),)) + data
+    if fn in (5, 6):
+        if len(pdu) != 4:
+            raise ModbusException(3)
+        start, value = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
+        kind = "coils" if fn == 5 else "holding"
+        _span(tables, kind, start, 1, 1)
+        if fn == 5 and value not in (0x0000, 0xFF00):
+            raise ModbusException(3)
+        tables.put(kind, start, [int(value == 0xFF00) if fn == 5 else value])
+        return pdu
+    if fn in WRITE_MAX:
+        if len(pdu) < 5:
+            raise ModbusException(3)
+        start, count, n = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3], pdu[4]
+        bits = fn == 15
+        if n != ((count + 7) // 8 if bits else 2 * count) or len(pdu) != 5 + n:
+            raise ModbusException(3)
+        kind = "coils" if bits else "holding"
+        _span(tables, kind, start, count, WRITE_MAX[fn])
+        vals = unpack_bits(pdu[5:], count) if bits else \
+            [pdu[5 + 2 * i] << 8 | pdu[6 + 2 * i] for i in range(count)]
+        tables.put(kind, start, vals)
+        return pdu[:4]
+    raise ModbusException(1)

@@ -34,7 +34,7 @@ from typing import Any, Optional
 from ...engine.serial import Framing
 from ...errors import PlcConfigError
 from ..keys import checked_table
-from .rtu import check_crc, frame, gap_us, pack_bits, unpack_bits
+from .rtu import check_crc, frame, gap_us, serve
 
 __all__ = ["SlaveConfig", "parse_slave", "ModbusSlave"]
 
@@ -45,9 +45,6 @@ _BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 _TABLES = {"coils": ("coils", 1), "discrete_inputs": ("inputs", 1),
            "input_registers": ("input_registers", 0xFFFF),
            "holding_registers": ("holding", 0xFFFF)}
-#: read function -> (table, is bits, largest count) (Modbus Application Protocol 6.1-6.4)
-_READ_FN = {1: ("coils", True, 2000), 2: ("inputs", True, 2000),
-            3: ("holding", False, 125), 4: ("input_registers", False, 125)}
 
 
 @dataclass
@@ -146,57 +143,14 @@ class ModbusSlave:
 
     def answer(self, fn: int, pdu: bytes) -> bytes:
         """The response PDU (function and data, or exception) of a request."""
-        try:
-            return bytes((fn,)) + self._run(fn, pdu)
-        except _Exception as e:
-            return bytes((fn | 0x80, e.code))
+        return serve(fn, pdu, self)
 
-    def _span(self, table: list[int], start: int, count: int, top: int) -> None:
-        if not 1 <= count <= top:
-            raise _Exception(3)
-        if start + count > len(table):
-            raise _Exception(2)
+    # -- the tables (rtu.Tables), lists of the plant file's values
+    def size(self, kind: str) -> int:
+        return len(getattr(self, kind))
 
-    def _run(self, fn: int, pdu: bytes) -> bytes:
-        if fn in _READ_FN:
-            if len(pdu) != 4:
-                raise _Exception(3)
-            name, bits, top = _READ_FN[fn]
-            table = getattr(self, name)
-            start, count = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
-            self._span(table, start, count, top)
-            vals = table[start:start + count]
-            data = pack_bits(vals) if bits else b"".join(v.to_bytes(2, "big") for v in vals)
-            return bytes((len(data),)) + data
-        if fn in (5, 6):
-            if len(pdu) != 4:
-                raise _Exception(3)
-            start, value = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3]
-            table = self.coils if fn == 5 else self.holding
-            self._span(table, start, 1, 1)
-            if fn == 5 and value not in (0x0000, 0xFF00):
-                raise _Exception(3)
-            table[start] = (value == 0xFF00) if fn == 5 else value
-            table[start] = int(table[start])
-            return pdu
-        if fn in (15, 16):
-            if len(pdu) < 5:
-                raise _Exception(3)
-            start, count, n = pdu[0] << 8 | pdu[1], pdu[2] << 8 | pdu[3], pdu[4]
-            bits = fn == 15
-            want = (count + 7) // 8 if bits else 2 * count
-            if n != want or len(pdu) != 5 + n:
-                raise _Exception(3)
-            table = self.coils if bits else self.holding
-            self._span(table, start, count, 1968 if bits else 123)
-            vals = unpack_bits(pdu[5:], count) if bits else \
-                [pdu[5 + 2 * i] << 8 | pdu[6 + 2 * i] for i in range(count)]
-            table[start:start + count] = vals
-            return pdu[:4]
-        raise _Exception(1)
+    def get(self, kind: str, start: int, count: int) -> list[int]:
+        return getattr(self, kind)[start:start + count]
 
-
-class _Exception(Exception):
-    def __init__(self, code: int) -> None:
-        super().__init__(code)
-        self.code = code
+    def put(self, kind: str, start: int, values: list[int]) -> None:
+        getattr(self, kind)[start:start + len(values)] = values

@@ -44,6 +44,7 @@ from typing import Any
 
 from ..errors import PlcConfigError
 from .keys import checked_table
+from .peer import PortPeer
 
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
@@ -208,7 +209,7 @@ def parse_ethernet(raw: Any, file: str) -> EthernetConfig:
     return EthernetConfig(ip, latency)
 
 
-class ScriptedDevice:
+class ScriptedDevice(PortPeer):
     """The device of one port (see the module docstring)."""
 
     def __init__(self, cfg: DeviceConfig) -> None:
@@ -219,8 +220,7 @@ class ScriptedDevice:
 
     def attach(self, port: Any) -> None:
         """Become *port*'s peer; schedule what is sent unasked."""
-        self.port = port
-        port.peer = self
+        super().attach(port)
         for k, (at, _, _) in enumerate(self.cfg.sends):
             port.push(at, self._send, k)
 
@@ -253,7 +253,3 @@ class ScriptedDevice:
         if pending:
             port.no_answer(fr.end(t, len(data)), pending,
                            "the plant's device has no reply for them")
-
-    def station(self, address: int) -> None:
-        """A scripted device is no PPI station."""
-        return None

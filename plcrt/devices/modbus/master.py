@@ -29,6 +29,7 @@ from typing import Any, Optional
 
 from ...blocks import register_block
 from ...blocks.call import register_protected
+from ...blocks.library import LibraryBlock
 from ...safetext import excerpt
 from .rtu import READS, WRITES, check_crc, frame, gap_us
 
@@ -198,30 +199,21 @@ def master_of(plc: Any) -> Master:
     return m
 
 
-class _Block:
+class _Block(LibraryBlock):
+    family, bind_as = "modbus", "mbmaster"
+    shared = staticmethod(master_of)
+
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        self.plc, self.loc, self.name = plc, loc, itf.name
+        super().__init__(plc, loc, itf)
         self.master = master_of(plc)
 
-    def warn(self, msg: str, code: str) -> None:
-        self.plc.warn(f"{self.name}: {msg}", self.loc, f"{self.name}:{code}:{id(self)}")
-
     @classmethod
-    def at_load(cls, g: Any, itf: Any, plc: Any) -> None:
-        """Once per program: the library is emulated; the Error numbers
-        plcrt decided."""
-        once = g.unit.hooks.setdefault("modbus-once", set())
-        if "load" in once:
-            return
-        once.add("load")
-        # bound into the code, so that a fork (Plc._copy_state) copies the
-        # master with the blocks and the blocks' references land on the twin's
-        g.bind(master_of(plc), "mbmaster")
+    def notice(cls, itf: Any) -> str:
         msg = ", ".join(f"{k} ({MSG_ERRORS[k]})" for k in PLCRT_CHOICES["MBUS_MSG"])
-        g.warn(f"{itf.name}: the Modbus RTU master library (MBUS_CTRL, MBUS_MSG) is emulated; "
-               f"its library memory and interrupt routines are not simulated; Error numbers "
-               f"not confirmed from the manual are plcrt's choice: MBUS_MSG {msg} "
-               f"(docs/modbus.md)", "modbus-library")
+        return (f"{itf.name}: the Modbus RTU master library (MBUS_CTRL, MBUS_MSG) is "
+                f"emulated; its library memory and interrupt routines are not simulated; "
+                f"Error numbers not confirmed from the manual are plcrt's choice: MBUS_MSG "
+                f"{msg} (docs/modbus.md)")
 
 
 @register_block("MBUS_CTRL")

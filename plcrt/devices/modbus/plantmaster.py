@@ -41,6 +41,7 @@ from typing import Any, Optional
 from ...engine.serial import Framing
 from ...errors import PlcConfigError
 from ..keys import checked_table
+from ..peer import PortPeer, baud_key, parity_key
 from .rtu import check_crc, frame, gap_us, pack_bits, unpack_bits
 
 __all__ = ["MasterConfig", "MasterRequest", "parse_master", "PlantMaster"]
@@ -48,7 +49,6 @@ __all__ = ["MasterConfig", "MasterRequest", "parse_master", "PlantMaster"]
 _KEYS = {"timeout_ms", "baud", "parity", "request"}
 _REQ_KEYS = {"at_ms", "slave", "function", "address", "count", "values", "period_ms", "repeat",
              "raw"}
-_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 #: function -> (values: how many (None: a list 1..n), largest value)
 _WRITE = {5: (1, 1), 6: (1, 0xFFFF), 15: (1968, 1), 16: (123, 0xFFFF)}
 
@@ -90,16 +90,7 @@ def parse_master(raw: Any, where: str) -> MasterConfig:
     raw = checked_table(raw, where, _KEYS, ("request",))
     cfg = MasterConfig()
     cfg.timeout_us = _ms(raw.get("timeout_ms", 1000), f"{where}.timeout_ms", 1)
-    if "baud" in raw:
-        if raw["baud"] not in _BAUDS or isinstance(raw["baud"], bool):
-            raise PlcConfigError(f"{where}.baud must be one of {', '.join(map(str, _BAUDS))}, "
-                                 f"got {raw['baud']!r:.40}")
-        cfg.baud = raw["baud"]
-    if "parity" in raw:
-        if raw["parity"] not in ("none", "even", "odd"):
-            raise PlcConfigError(f"{where}.parity must be \"none\", \"even\" or \"odd\", "
-                                 f"got {raw['parity']!r:.40}")
-        cfg.parity = raw["parity"]
+    cfg.baud, cfg.parity = baud_key(raw, where), parity_key(raw, where)
     rows = raw["request"]
     if not isinstance(rows, list) or not rows:
         raise PlcConfigError(f"{where}.request must be an array of tables "
@@ -169,7 +160,7 @@ def _request(r: Any, rw: str) -> MasterRequest:
     return MasterRequest(at, frame(body), slave, fn, addr, count, period, repeat)
 
 
-class PlantMaster:
+class PlantMaster(PortPeer):
     """The master of one port (see the module docstring)."""
 
     def __init__(self, cfg: MasterConfig) -> None:
@@ -184,14 +175,9 @@ class PlantMaster:
         self.unasked: list[tuple[int, bytes]] = []   #: (time, bytes) with no request out
 
     def attach(self, port: Any) -> None:
-        self.port = port
-        port.peer = self
+        super().attach(port)
         for k, req in enumerate(self.cfg.requests):
             port.push(req.at_us, self._due, k, 1)
-
-    def station(self, address: int) -> None:
-        """A Modbus master is no PPI station."""
-        return None
 
     def framing(self) -> Framing:
         fr = self.port.framing()

@@ -34,13 +34,13 @@ from typing import Any, Optional
 from ...engine.serial import Framing
 from ...errors import PlcConfigError
 from ..keys import checked_table
+from ..peer import PortPeer, baud_key, parity_key
 from .rtu import check_crc, frame, gap_us, serve
 
 __all__ = ["SlaveConfig", "parse_slave", "ModbusSlave"]
 
 _KEYS = {"address", "delay_ms", "coils", "discrete_inputs", "input_registers",
          "holding_registers", "baud", "parity"}
-_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 #: plant key -> (table attribute, largest value)
 _TABLES = {"coils": ("coils", 1), "discrete_inputs": ("inputs", 1),
            "input_registers": ("input_registers", 0xFFFF),
@@ -68,16 +68,7 @@ def parse_slave(raw: Any, where: str) -> SlaveConfig:
     if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0 <= d <= 60_000:
         raise PlcConfigError(f"{where}.delay_ms must be a number in 0..60000, got {d!r:.40}")
     cfg.delay_us = int(round(d * 1000))
-    if "baud" in raw:
-        if raw["baud"] not in _BAUDS or isinstance(raw["baud"], bool):
-            raise PlcConfigError(f"{where}.baud must be one of {', '.join(map(str, _BAUDS))}, "
-                                 f"got {raw['baud']!r:.40}")
-        cfg.baud = raw["baud"]
-    if "parity" in raw:
-        if raw["parity"] not in ("none", "even", "odd"):
-            raise PlcConfigError(f"{where}.parity must be \"none\", \"even\" or \"odd\", "
-                                 f"got {raw['parity']!r:.40}")
-        cfg.parity = raw["parity"]
+    cfg.baud, cfg.parity = baud_key(raw, where), parity_key(raw, where)
     for key, (attr, top) in _TABLES.items():
         v = raw.get(key, [])
         if not isinstance(v, list) or len(v) > 65536 or any(
@@ -88,7 +79,7 @@ def parse_slave(raw: Any, where: str) -> SlaveConfig:
     return cfg
 
 
-class ModbusSlave:
+class ModbusSlave(PortPeer):
     """The slave of one port (see the module docstring)."""
 
     def __init__(self, cfg: SlaveConfig) -> None:
@@ -103,14 +94,6 @@ class ModbusSlave:
         self.busy_until = 0
         self.requests: list[tuple[int, bytes]] = []   #: (time the frame ended, frame)
         self.ignored = 0                              #: frames that got no answer
-
-    def attach(self, port: Any) -> None:
-        self.port = port
-        port.peer = self
-
-    def station(self, address: int) -> None:
-        """A Modbus slave is no PPI station."""
-        return None
 
     def framing(self) -> Framing:
         """The slave's framing: its own baud and parity, else the port's."""

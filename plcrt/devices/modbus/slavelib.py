@@ -38,6 +38,7 @@ from typing import Any, Optional
 
 from ...blocks import register_block
 from ...blocks.call import register_protected
+from ...blocks.library import LibraryBlock
 from ...safetext import excerpt
 from .master import BAUD_CODE, PARITY_BITS
 from .rtu import check_crc, frame, gap_us, serve
@@ -211,28 +212,20 @@ def slave_of(plc: Any) -> SlaveLib:
     return s
 
 
-class _Block:
+class _Block(LibraryBlock):
+    family, bind_as = "modbus-slave", "mbslave"
+    shared = staticmethod(slave_of)
+
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        self.plc, self.loc, self.name = plc, loc, itf.name
+        super().__init__(plc, loc, itf)
         self.lib = slave_of(plc)
 
-    def warn(self, msg: str, code: str) -> None:
-        self.plc.warn(f"{self.name}: {msg}", self.loc, f"{self.name}:{code}:{id(self)}")
-
     @classmethod
-    def at_load(cls, g: Any, itf: Any, plc: Any) -> None:
-        """Once per program: the library is emulated; what plcrt decided."""
-        once = g.unit.hooks.setdefault("modbus-once", set())
-        if "slave-load" in once:
-            return
-        once.add("slave-load")
-        # bound into the code, so that a fork (Plc._copy_state) copies it
-        g.bind(slave_of(plc), "mbslave")
+    def notice(cls, itf: Any) -> str:
         choices = "; ".join(f"{k}: {c}" for k, cs in PLCRT_CHOICES.items() for c in cs)
-        g.warn(f"{itf.name}: the Modbus RTU slave library (MBUS_INIT, MBUS_SLAVE) is emulated; "
-               f"its library memory and interrupt routines are not simulated; plcrt's choices "
-               f"where the manual has no word: {choices} (docs/modbus.md)",
-               "modbus-slave-library")
+        return (f"{itf.name}: the Modbus RTU slave library (MBUS_INIT, MBUS_SLAVE) is "
+                f"emulated; its library memory and interrupt routines are not simulated; "
+                f"plcrt's choices where the manual has no word: {choices} (docs/modbus.md)")
 
 
 @register_block("MBUS_INIT")

@@ -52,6 +52,7 @@ from typing import Any, Optional
 from ...engine.serial import Framing
 from ...errors import PlcConfigError
 from ..keys import checked_table
+from ..peer import PortPeer, baud_key
 from .telegram import (FULL_SCALE, RESPONSE, STW, TASK, ZSW, Telegram, bits_real, decode,
                        encode, real_bits)
 
@@ -60,7 +61,6 @@ __all__ = ["DriveConfig", "BusConfig", "parse_uss", "UssBus", "Drive"]
 _BUS_KEYS = {"baud", "drive"}
 _DRIVE_KEYS = {"address", "model", "base_hz", "max_hz", "ramp_up_s", "ramp_down_s", "off3_ramp_s",
                "response_delay_ms", "word", "dword", "real", "read_only"}
-_BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 #: parameter type -> largest value (None: a REAL)
 _TYPES = {"word": 0xFFFF, "dword": 0xFFFFFFFF, "real": None}
 #: write task -> (value type, indexed, EEPROM)
@@ -146,11 +146,7 @@ def parse_uss(raw: Any, where: str) -> BusConfig:
     """``[port.N.uss]`` with its ``[[port.N.uss.drive]]`` entries."""
     raw = checked_table(raw, where, _BUS_KEYS, ("drive",))
     bus = BusConfig()
-    if "baud" in raw:
-        if raw["baud"] not in _BAUDS or isinstance(raw["baud"], bool):
-            raise PlcConfigError(f"{where}.baud must be one of {', '.join(map(str, _BAUDS))}, "
-                                 f"got {raw['baud']!r:.40}")
-        bus.baud = raw["baud"]
+    bus.baud = baud_key(raw, where)
     drives = raw["drive"]
     if not isinstance(drives, list) or not drives:
         raise PlcConfigError(f"{where}.drive must be an array of tables ([[...uss.drive]])")
@@ -379,7 +375,7 @@ class Drive:
         return RESPONSE[resp], bits & (0xFFFF if word else 0xFFFFFFFF)
 
 
-class UssBus:
+class UssBus(PortPeer):
     """The drives of one port (see the module docstring)."""
 
     def __init__(self, cfg: BusConfig) -> None:
@@ -392,14 +388,6 @@ class UssBus:
         self.ignored = 0                               #: telegrams that got no answer
         self.corrupt = 0                               #: next answers sent with a wrong BCC
         self.bad_parity = 0                            #: next answers with a parity error
-
-    def attach(self, port: Any) -> None:
-        self.port = port
-        port.peer = self
-
-    def station(self, address: int) -> None:
-        """A USS drive is no PPI station."""
-        return None
 
     def framing(self) -> Framing:
         """The drives' framing: 8 data bits, even parity, at their rate."""

@@ -37,7 +37,8 @@ from typing import Any, Optional
 
 from ...blocks import register_block
 from ...blocks.call import register_protected
-from .telegram import (SIZE, STW, STX, TASK, ZSW, Telegram, bits_real, decode, encode,
+from ...blocks.library import LibraryBlock
+from .telegram import (STW, STX, TASK, ZSW, Telegram, bits_real, decode, encode,
                        param_code, real_bits, speed_word, word_speed)
 
 __all__ = ["Master", "master_of", "ERRORS", "PLCRT_CHOICES", "POLL_MS"]
@@ -262,13 +263,21 @@ def master_of(plc: Any) -> Master:
     return m
 
 
-class _Block:
+class _Block(LibraryBlock):
+    family, bind_as = "uss", "ussmaster"
+    shared = staticmethod(master_of)
+
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        self.plc, self.loc, self.name = plc, loc, itf.name
+        super().__init__(plc, loc, itf)
         self.master = master_of(plc)
 
-    def warn(self, msg: str, code: str) -> None:
-        self.plc.warn(f"{self.name}: {msg}", self.loc, f"{self.name}:{code}:{id(self)}")
+    @classmethod
+    def notice(cls, itf: Any) -> str:
+        msg = ", ".join(f"{k} ({ERRORS[k]})" for k in PLCRT_CHOICES["USS_INIT"])
+        return (f"{itf.name}: the USS protocol library (USS_INIT, USS_CTRL, USS_RPM_x, "
+                f"USS_WPM_x) is emulated; its library memory and interrupt routines are not "
+                f"simulated; Error numbers not confirmed from the manual are plcrt's choice: "
+                f"USS_INIT {msg} (docs/uss.md)")
 
     def refuse(self, code: int, why: str = "") -> int:
         self.warn(f"Error {code}: {ERRORS[code]}{why}", f"err{code}")
@@ -284,23 +293,6 @@ class _Block:
         if drive not in m.slots:
             return self.refuse(19, f" (Drive {drive} is not in USS_INIT's Active mask)")
         return 0
-
-    @classmethod
-    def at_load(cls, g: Any, itf: Any, plc: Any) -> None:
-        """Once per program: the library is emulated; the Error numbers
-        plcrt decided."""
-        once = g.unit.hooks.setdefault("uss-once", set())
-        if "load" in once:
-            return
-        once.add("load")
-        # bound into the code, so that a fork (Plc._copy_state) copies the
-        # master with the blocks
-        g.bind(master_of(plc), "ussmaster")
-        msg = ", ".join(f"{k} ({ERRORS[k]})" for k in PLCRT_CHOICES["USS_INIT"])
-        g.warn(f"{itf.name}: the USS protocol library (USS_INIT, USS_CTRL, USS_RPM_x, "
-               f"USS_WPM_x) is emulated; its library memory and interrupt routines are not "
-               f"simulated; Error numbers not confirmed from the manual are plcrt's choice: "
-               f"USS_INIT {msg} (docs/uss.md)", "uss-library")
 
 
 @register_block("USS_INIT")

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+from ..engine.serial import BAUDS as _CODES
 from ..errors import PlcConfigError
 
 __all__ = ["PortPeer", "BAUDS", "PARITIES", "baud_key", "parity_key"]
 
 #: the rates a plant device may run at (those of SMB30 / SMB130's freeport)
-BAUDS = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
+BAUDS = tuple(sorted(_CODES))
 PARITIES = ("none", "even", "odd")
 
 

@@ -24,13 +24,15 @@ import heapq
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
-__all__ = ["Framing", "Inbox", "BAUDS", "PROTOCOLS", "framing_of", "MIN_CHAR_US",
-           "table_at"]
+__all__ = ["Framing", "Inbox", "BAUDS", "BAUD_CODE", "PROTOCOLS", "framing_of",
+           "MIN_CHAR_US", "table_at"]
 
 #: baud code (bits 4..2 of SMB30/SMB130) -> bits per second (System Manual,
 #: "SMB30 and SMB130": 000 = 38400 ... 101 = 1200; 110 = 115200 and
 #: 111 = 57600 on CPUs from version 1.2)
 BAUDS: tuple[int, ...] = (38400, 19200, 9600, 4800, 2400, 1200, 115200, 57600)
+#: bits per second -> baud code (what a library writes into SMB30 / SMB130)
+BAUD_CODE: dict[int, int] = {baud: code for code, baud in enumerate(BAUDS)}
 #: protocol code (bits 1..0) -> name; 11 is reserved and means PPI slave
 PROTOCOLS: tuple[str, ...] = ("PPI slave", "freeport", "PPI master", "PPI slave")
 #: the shortest character any port can send (7 data bits, no parity, 115200

@@ -30,6 +30,7 @@ from typing import Any, Optional
 from ...blocks import register_block
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
+from ...engine.serial import BAUD_CODE
 from ...safetext import excerpt
 from .rtu import READS, WRITES, check_crc, frame, gap_us
 
@@ -66,8 +67,6 @@ RANGES = ((1, 9999, "coils", True, True), (10001, 19999, "inputs", True, False),
           (40001, 49999, "holding", False, True))
 #: Count limits (System Manual, MBUS_MSG: at most 1920 bits or 120 words)
 MAX_BITS, MAX_WORDS = 1920, 120
-#: Baud rates MBUS_CTRL accepts -> SMB30 baud code (System Manual, SMB30)
-BAUD_CODE = {38400: 0, 19200: 1, 9600: 2, 4800: 3, 2400: 4, 1200: 5, 115200: 6, 57600: 7}
 #: Parity 0 none, 1 odd, 2 even -> SMB30 bits pp (00 none, 11 odd, 01 even)
 PARITY_BITS = {0: 0x00, 1: 0xC0, 2: 0x40}
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)

@@ -38,6 +38,7 @@ from typing import Any, Optional
 from ...blocks import register_block
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
+from ...engine.serial import BAUD_CODE
 from .telegram import (STW, STX, TASK, ZSW, Telegram, bits_real, decode, encode,
                        param_code, real_bits, speed_word, word_speed)
 
@@ -68,8 +69,6 @@ PLCRT_CHOICES = {"USS_INIT": (23,)}
 #: "Communications times"); here the response timeout from a request's end
 POLL_MS = {1200: 240, 2400: 130, 4800: 75, 9600: 50, 19200: 35, 38400: 30, 57600: 25,
            115200: 25}
-#: baud -> SMB30 baud code (System Manual, SMB30)
-BAUD_CODE = {38400: 0, 19200: 1, 9600: 2, 4800: 3, 2400: 4, 1200: 5, 115200: 6, 57600: 7}
 EVEN = 0x40     #: SMB30 parity bits pp = 01: even
 _V = 0x08       #: pointer area code of V
 DB_SIZE = 16    #: bytes at DB_Ptr (System Manual, USS_RPM_x: a 16-byte buffer)

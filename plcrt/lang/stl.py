@@ -109,7 +109,23 @@ def parse_program(text: str, file: str = "<string>") -> Program:
     :class:`PlcSyntaxError` with every syntax problem found (see
     :func:`_parse_collecting`); its ``partial`` is the program of the blocks
     that parsed without an error, for tools that show what they can.
+
+    A well-formed text is read by the line-based fast path of
+    :mod:`plcrt.lang.fastparse`, which gives the same program; anything it
+    is not sure of goes to lark (:func:`parse_program_lark`).
     """
+    # imported here: fastparse builds on this module's tables
+    from .fastparse import fast_parse
+
+    program = fast_parse(text, file)
+    if program is not None:
+        return program
+    return parse_program_lark(text, file)
+
+
+def parse_program_lark(text: str, file: str = "<string>") -> Program:
+    """:func:`parse_program` through lark only: the reference the fast path
+    is tested against, and the path that reports syntax errors."""
     prepared = _prepare(text)
     sink = DiagnosticSink()
     tree, broken = _parse_collecting(prepared, file, sink)

@@ -14,6 +14,11 @@ read (a missing ``END_SUBROUTINE_BLOCK``, a stray line between blocks, an
 unterminated string, a block id that is not ``OBn``/``SBRn``/``INTn``).
 Every such problem is raised as :class:`~plcrt.errors.PlcSyntaxError`; no
 lark exception ever leaves this module.
+
+:func:`parse_program` first tries the line-based fast path of
+:mod:`plcrt.lang.fastparse`, which builds the same program for the
+well-formed texts it accepts; lark reads everything else and is the only
+source of syntax errors.
 """
 
 from __future__ import annotations

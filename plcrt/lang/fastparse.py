@@ -16,8 +16,9 @@ What it is not:
 * not an error reporter.  Whenever a text is not plainly well formed (a
   syntax error, a block id that does not fit, a number with too many digits,
   a structural keyword where lark would re-type or reject it, unusual
-  whitespace or one of the few letters that case-insensitive matching folds
-  onto ASCII) it returns ``None`` and the caller runs the lark path, which
+  whitespace-only line holding whitespace lark does not ignore, or one of the
+  few letters that case-insensitive matching folds onto ASCII in a line
+  that lark's keyword patterns could read as a keyword) it returns ``None`` and the caller runs the lark path, which
   reports the problem exactly as before.  Declining is always allowed;
   accepting with a different result never is, and the differential tests in
   ``tests/lang/test_fastparse.py`` hold it to that.
@@ -38,15 +39,23 @@ from .stl import _BLOCK_ID, _KEYWORD_TYPES, _SECTION_OF, _prepare
 __all__ = ["fast_parse"]
 
 # The grammar's WS terminal (what lark ignores between tokens and what a
-# blank line may hold).
+# blank line may hold).  Other whitespace (NEL, U+2028, U+2000...) is an
+# ordinary character to lark: text in comments, titles and strings, a
+# lexing error elsewhere, and the regexes below treat it the same way.
+_WS_CHARS = " \t\f\v\u3000\xa0"
 _WS = r"[ \t\f\v\u3000\xa0]"
 
-# Any whitespace lark does *not* ignore (it would be a lexing error or end an
-# operand where the regexes below might disagree), and the four non-ASCII
-# letters that Python's case-insensitive matching folds onto ASCII ones (İ ı
-# ſ K): lark's /i keywords would match them, plain ASCII checks would not.
-# Real exports contain none of these, so a text with one goes to lark.
-_UNSURE = re.compile(r"[^\S \t\f\v\u3000\xa0\n]|[\u0130\u0131\u017f\u212a]")
+# The four non-ASCII letters that Python's case-insensitive matching folds
+# onto ASCII ones (İ ı ſ K).  The line-level patterns below use lark's own
+# /i keyword patterns, so they agree; only the ASCII MNEMONIC pattern, which
+# decides whether an instruction line might be a keyword line, could not
+# see "TıTLE=" as lark does.  A line of a block body is declined if one of
+# lark's keywords of a block body matches at its first token with such a
+# letter in it.
+_FOLDED = re.compile("[\u0130\u0131\u017f\u212a]")
+_BODY_KEYWORD = re.compile(
+    r"NETWORK(?![A-Za-z_])|TITLE[ \t]*=|END_(?:ORGANIZATION|SUBROUTINE|INTERRUPT)_BLOCK(?!\w)",
+    re.I)
 
 # ---- the terminals of grammar/stl.lark, as whole-line patterns -------------
 
@@ -112,10 +121,22 @@ def fast_parse(text: str, file: str = "<string>") -> Program | None:
             gc.enable()
 
 
+def _folded_lines(text: str) -> set[int]:
+    """The numbers of the lines holding a folded letter."""
+    lines: set[int] = set()
+    line, last = 1, 0
+    for match in _FOLDED.finditer(text):
+        pos = match.start()
+        line += text.count("\n", last, pos)
+        last = pos
+        lines.add(line)
+    return lines
+
+
 def _parse(text: str, file: str) -> Program | None:
     prepared = _prepare(text)
-    if _UNSURE.search(prepared):
-        return None
+    # perf: one scan in C; almost every text has no folded letter at all
+    folded = _folded_lines(prepared) if _FOLDED.search(prepared) else set()
     lines = prepared.split("\n")
     count = len(lines)
     pous: list[Pou] = []
@@ -123,16 +144,17 @@ def _parse(text: str, file: str) -> Program | None:
     while index < count:
         line = lines[index]
         index += 1
-        # perf: blank lines are common; with unusual whitespace declined
-        # above, isspace() is exactly the grammar's blank line
+        # perf: isspace() first; a blank line of the grammar holds WS only
         if not line or line.isspace():
+            if line.strip(_WS_CHARS):
+                return None
             continue
         header = _HEADER_LINE.match(line)
         if header is None:
             if _COMMENT_LINE.match(line):
                 continue            # file-level comments are dropped
             return None
-        block = _block(lines, index, header, file)
+        block = _block(lines, index, header, file, folded)
         if block is None:
             return None
         pou, index = block
@@ -140,8 +162,8 @@ def _parse(text: str, file: str) -> Program | None:
     return Program(pous=tuple(pous), file=file, source=text)
 
 
-def _block(lines: list[str], index: int, header: re.Match[str],
-           file: str) -> tuple[Pou, int] | None:
+def _block(lines: list[str], index: int, header: re.Match[str], file: str,
+           folded: set[int]) -> tuple[Pou, int] | None:
     """Read one block whose header line is ``lines[index - 1]``; return the
     :class:`Pou` and the index of the line after its END line."""
     kind_group = 1 if header.group(1) else 2 if header.group(2) else 3
@@ -171,6 +193,8 @@ def _block(lines: list[str], index: int, header: re.Match[str],
         line = lines[index]
         index += 1
         if not line or line.isspace():
+            if line.strip(_WS_CHARS):
+                return None
             continue
         if m := _COMMENT_LINE.match(line):
             comments.append(m.group(1).strip())
@@ -181,13 +205,17 @@ def _block(lines: list[str], index: int, header: re.Match[str],
             else:
                 comments.append(m.group(1).strip())
         elif m := _VAR_LINE.match(line):
-            section = _SECTION_OF[m.group(1).upper()]
+            section = _SECTION_OF.get(m.group(1).upper())
+            if section is None:
+                return None         # "VAR_İNPUT": matched by /i, no such section
             while True:
                 if index >= count:
                     return None
                 line = lines[index]
                 index += 1
                 if not line or line.isspace():
+                    if line.strip(_WS_CHARS):
+                        return None
                     continue
                 if _END_VAR_LINE.match(line):
                     break
@@ -230,6 +258,8 @@ def _block(lines: list[str], index: int, header: re.Match[str],
         line = lines[index]
         index += 1
         if not line or line.isspace():
+            if line.strip(_WS_CHARS):
+                return None
             continue
         m = mnemonic_match(line)
         if m is None:
@@ -242,6 +272,10 @@ def _block(lines: list[str], index: int, header: re.Match[str],
                 net_comments.append(c.group(1).strip())  # network comment
             # comments between instructions are dropped, as by lark's path
             continue
+        if (folded and index in folded
+                and (k := _BODY_KEYWORD.match(line, m.start(1)))
+                and _FOLDED.search(line, k.start(), k.end())):
+            return None             # "TıTLE=": a keyword to lark, not to MNEMONIC
         mnemonic = m.group(1).upper()
         if mnemonic.startswith(_STRUCTURAL):
             if net_number >= 0 and (t := _TITLE_LINE.match(line)):

@@ -506,7 +506,13 @@ class _Builder:
     def var_section(self, tree: Tree, block: str) -> list[VarDecl]:
         head = tree.children[0]
         assert isinstance(head, Token)
-        section = _SECTION_OF[str(head).upper()]
+        section = _SECTION_OF.get(str(head).upper())
+        if section is None:
+            # VAR_KW is matched case-insensitively, and Python folds "İ" onto
+            # "I" there: "VAR_İNPUT" is a VAR_KW token that names no section
+            self.sink.error(f"unknown variable section {excerpt(str(head))!r}",
+                            self.loc(head, block), code="syntax")
+            return []
         decls: list[VarDecl] = []
         for child in tree.children[1:]:
             if isinstance(child, Tree):

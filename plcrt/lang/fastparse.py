@@ -14,12 +14,12 @@ What it is not:
   language; every regular expression here mirrors one terminal of it and is
   used in the same order of priority as lark's contextual lexer uses them.
 * not an error reporter.  Whenever a text is not plainly well formed (a
-  syntax error, a block id that does not fit, a number with too many digits,
-  a structural keyword where lark would re-type or reject it, unusual
-  whitespace-only line holding whitespace lark does not ignore, or one of the
-  few letters that case-insensitive matching folds onto ASCII in a line
-  that lark's keyword patterns could read as a keyword) it returns ``None`` and the caller runs the lark path, which
-  reports the problem exactly as before.  Declining is always allowed;
+  syntax error, a block id that does not fit, a number with too many
+  digits, a name or mnemonic spelled like a structural keyword, a blank
+  line holding whitespace lark does not ignore, a keyword of a block body
+  spelled with a letter that case-insensitive matching folds onto ASCII)
+  it returns ``None`` and the caller runs the lark path, which reports the
+  problem exactly as before.  Declining is always allowed;
   accepting with a different result never is, and the differential tests in
   ``tests/lang/test_fastparse.py`` hold it to that.
 

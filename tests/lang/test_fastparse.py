@@ -225,12 +225,61 @@ def _case(word: str, data: st.DataObject) -> str:
 
 @st.composite
 def programs(draw: st.DrawFn) -> str:
+    """A well-formed export: 1-3 blocks with titles, comments, VAR sections
+    and networks, in random case, blanks and line ends."""
     data = draw(st.data())
-    blank = lambda: draw(_BLANK)                    # noqa: E731
-    sep = lambda: draw(_SEP)                        # noqa: E731
+
+    def blank() -> str:
+        return draw(_BLANK)
+
+    def sep() -> str:
+        return draw(_SEP)
 
     def comment() -> str:
         return blank() + "//" + draw(_COMMENT_TEXT)
+
+    def title() -> str:
+        between = draw(st.sampled_from(["", " ", "\t"]))
+        return f"{blank()}{_case('TITLE', data)}{between}={draw(_COMMENT_TEXT)}"
+
+    def var_section() -> list[str]:
+        keyword = draw(st.sampled_from(
+            ["VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR_TEMP"]))
+        lines = [blank() + _case(keyword, data) + blank()]
+        for _ in range(draw(st.integers(0, 3))):
+            if draw(st.booleans()):
+                name = draw(st.sampled_from(["Start", "x", "计数", "END_VAR1", "v_2"]))
+                type_ = _case(draw(st.sampled_from(["BOOL", "INT", "DWORD", "REAL"])), data)
+                semi = draw(st.sampled_from(["", ";"]))
+                tail = draw(st.sampled_from(["", comment()]))
+                lines.append(f"{blank()}{name}{blank()}:{blank()}{type_}{blank()}{semi}{tail}")
+            else:
+                lines.append(draw(st.sampled_from(["", comment()])))
+        lines.append(blank() + _case("END_VAR", data) + blank())
+        return lines
+
+    def instruction() -> str:
+        operands = draw(st.lists(st.sampled_from(_OPERANDS), max_size=4))
+        text = sep() + f"{blank()},{blank()}".join(operands) if operands else ""
+        semi = draw(st.sampled_from(["", ";", " ;"]))
+        tail = draw(st.sampled_from(["", comment()]))
+        return f"{blank()}{draw(st.sampled_from(_MNEMONICS))}{text}{blank()}{semi}{tail}"
+
+    def network(number: int) -> list[str]:
+        spacing = draw(st.sampled_from([" ", "", "\t"]))
+        net_title = draw(st.sampled_from(["", comment()]))
+        lines = [f"{blank()}{_case('Network', data)}{spacing}{number}{blank()}{net_title}"]
+        for _ in range(draw(st.integers(0, 5))):
+            choice = draw(st.integers(0, 9))
+            if choice == 0:
+                lines.append(comment())
+            elif choice == 1:
+                lines.append(draw(st.sampled_from(["", "\t", "  "])))
+            elif choice == 2:
+                lines.append(title())
+            else:
+                lines.append(instruction())
+        return lines
 
     lines: list[str] = []
     for _ in range(draw(st.integers(0, 2))):
@@ -244,49 +293,13 @@ def programs(draw: st.DrawFn) -> str:
         ref = f"{name}{blank()}:{blank()}{ident}" if name else ident
         lines.append(f"{blank()}{_case(keyword, data)}{sep()}{ref}{blank()}")
         for _ in range(draw(st.integers(0, 3))):
-            choice = draw(st.integers(0, 2))
-            if choice == 0:
-                lines.append(f"{blank()}{_case('TITLE', data)}{draw(st.sampled_from(['', ' ', chr(9)]))}"
-                             f"={draw(_COMMENT_TEXT)}")
-            elif choice == 1:
-                lines.append(comment())
-            else:
-                lines.append(blank() + _case(draw(st.sampled_from(
-                    ["VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR_TEMP"])), data) + blank())
-                for _ in range(draw(st.integers(0, 3))):
-                    if draw(st.booleans()):
-                        vname = draw(st.sampled_from(["Start", "x", "计数", "END_VAR1", "v_2"]))
-                        vtype = _case(draw(st.sampled_from(["BOOL", "INT", "DWORD", "REAL"])), data)
-                        semi = draw(st.sampled_from(["", ";"]))
-                        tail = draw(st.sampled_from(["", comment()]))
-                        lines.append(f"{blank()}{vname}{blank()}:{blank()}{vtype}{blank()}{semi}{tail}")
-                    else:
-                        lines.append(draw(st.sampled_from(["", comment()])))
-                lines.append(blank() + _case("END_VAR", data) + blank())
+            lines.extend(draw(st.sampled_from([
+                lambda: [title()], lambda: [comment()], var_section]))())
         lines.append(blank() + _case("BEGIN", data) + blank())
         for _ in range(draw(st.integers(0, 2))):
             lines.append(comment())
         for number in range(draw(st.integers(0, 3))):
-            title = draw(st.sampled_from(["", comment()]))
-            spacing = draw(st.sampled_from([" ", "", "\t"]))
-            lines.append(f"{blank()}{_case('Network', data)}{spacing}{number + 1}{blank()}{title}")
-            for _ in range(draw(st.integers(0, 5))):
-                choice = draw(st.integers(0, 9))
-                if choice == 0:
-                    lines.append(comment())
-                elif choice == 1:
-                    lines.append(draw(st.sampled_from(["", "\t", "  "])))
-                elif choice == 2:
-                    lines.append(f"{blank()}TITLE={draw(_COMMENT_TEXT)}")
-                else:
-                    ops = draw(st.lists(st.sampled_from(_OPERANDS), max_size=4))
-                    text = ""
-                    if ops:
-                        text = sep() + f"{blank()},{blank()}".join(ops)
-                    semi = draw(st.sampled_from(["", ";", " ;"]))
-                    tail = draw(st.sampled_from(["", comment()]))
-                    lines.append(f"{blank()}{draw(st.sampled_from(_MNEMONICS))}{text}"
-                                 f"{blank()}{semi}{tail}")
+            lines.extend(network(number + 1))
         lines.append(blank() + "END_" + _case(keyword, data) + blank())
         if draw(st.booleans()):
             lines.append("")

@@ -112,11 +112,13 @@ INLINE = _inline_programs()
 
 
 def test_inline_programs_decline_or_agree() -> None:
-    """No inline program of the suite is read differently by the fast path;
-    most of the well-formed ones are accepted."""
+    """No inline program of the suite is read differently by the fast path,
+    and nearly all that lark reads without error are accepted (today all;
+    a few odd spellings may rightly be declined)."""
     accepted = sum(assert_declines_or_agrees(text) is not None for text in INLINE)
-    assert len(INLINE) >= 50
-    assert accepted >= len(INLINE) // 2
+    valid = sum(not isinstance(lark_or_error(text), PlcSyntaxError) for text in INLINE)
+    assert len(INLINE) >= 50 and valid >= 30
+    assert accepted >= 0.9 * valid
 
 
 # --------------------------------------------------------------------------

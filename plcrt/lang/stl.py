@@ -14,6 +14,11 @@ read (a missing ``END_SUBROUTINE_BLOCK``, a stray line between blocks, an
 unterminated string, a block id that is not ``OBn``/``SBRn``/``INTn``).
 Every such problem is raised as :class:`~plcrt.errors.PlcSyntaxError`; no
 lark exception ever leaves this module.
+
+:func:`parse_program` first tries the line-based fast path of
+:mod:`plcrt.lang.fastparse`, which builds the same program for the
+well-formed texts it accepts; lark reads everything else and is the only
+source of syntax errors.
 """
 
 from __future__ import annotations
@@ -109,7 +114,23 @@ def parse_program(text: str, file: str = "<string>") -> Program:
     :class:`PlcSyntaxError` with every syntax problem found (see
     :func:`_parse_collecting`); its ``partial`` is the program of the blocks
     that parsed without an error, for tools that show what they can.
+
+    A well-formed text is read by the line-based fast path of
+    :mod:`plcrt.lang.fastparse`, which gives the same program; anything it
+    is not sure of goes to lark (:func:`parse_program_lark`).
     """
+    # imported here: fastparse builds on this module's tables
+    from .fastparse import fast_parse
+
+    program = fast_parse(text, file)
+    if program is not None:
+        return program
+    return parse_program_lark(text, file)
+
+
+def parse_program_lark(text: str, file: str = "<string>") -> Program:
+    """:func:`parse_program` through lark only: the reference the fast path
+    is tested against, and the path that reports syntax errors."""
     prepared = _prepare(text)
     sink = DiagnosticSink()
     tree, broken = _parse_collecting(prepared, file, sink)
@@ -485,7 +506,13 @@ class _Builder:
     def var_section(self, tree: Tree, block: str) -> list[VarDecl]:
         head = tree.children[0]
         assert isinstance(head, Token)
-        section = _SECTION_OF[str(head).upper()]
+        section = _SECTION_OF.get(str(head).upper())
+        if section is None:
+            # VAR_KW is matched case-insensitively, and Python folds "İ" onto
+            # "I" there: "VAR_İNPUT" is a VAR_KW token that names no section
+            self.sink.error(f"unknown variable section {excerpt(str(head))!r}",
+                            self.loc(head, block), code="syntax")
+            return []
         decls: list[VarDecl] = []
         for child in tree.children[1:]:
             if isinstance(child, Tree):

@@ -415,6 +415,15 @@ def test_missing_end_var() -> None:
     assert "END_VAR" in err.message
 
 
+def test_var_section_keyword_with_a_case_folded_letter() -> None:
+    """"VAR_İNPUT" (dotted capital I, which case-insensitive matching takes
+    for "I") is a syntax error at its line, not an internal KeyError."""
+    err = syntax_error("SUBROUTINE_BLOCK S:SBR0\nVAR_\u0130NPUT\nA:BOOL;\nEND_VAR\n"
+                       "BEGIN\nEND_SUBROUTINE_BLOCK\n")
+    assert (err.loc.line, err.loc.column, err.loc.block) == (2, 1, "SBR0")
+    assert "unknown variable section" in err.message
+
+
 def test_bad_block_ids() -> None:
     """Block ids must be OBn/SBRn/INTn and fit the header keyword."""
     err = syntax_error("ORGANIZATION_BLOCK MAIN:SBR1\nBEGIN\nEND_ORGANIZATION_BLOCK\n"

@@ -121,6 +121,10 @@ _ATOMIC = (int, float, complex, str, bytes, bool, type(None), range, type,
            types.BuiltinFunctionType, types.ModuleType)
 
 
+#: longest list or dict whose items :func:`pair_objects` pairs
+_MAX_ITEMS = 32
+
+
 def pair_objects(src: Any, dst: Any, memo: dict[int, Any], depth: int = 4) -> None:
     """Record in ``memo`` which object of ``dst`` plays the part of each
     object of ``src``: ``src`` and ``dst`` are built by the same
@@ -134,10 +138,14 @@ def pair_objects(src: Any, dst: Any, memo: dict[int, Any], depth: int = 4) -> No
     if src is dst or depth == 0:
         return
     if isinstance(src, (list, tuple)):
-        if len(src) == len(dst):
+        # perf: the items of long lists (the 256 timers of a bank) are not
+        # what run-time bindings refer to; their bank is
+        if len(src) == len(dst) <= _MAX_ITEMS:
             for a, b in zip(src, dst):
                 pair_objects(a, b, memo, depth - 1)
     elif isinstance(src, dict):
+        if len(src) > _MAX_ITEMS:
+            return
         for k, a in src.items():
             if k in dst:
                 pair_objects(a, dst[k], memo, depth - 1)
@@ -210,6 +218,29 @@ def _rebind_cell(cell: types.CellType, memo: dict[int, Any]) -> types.CellType:
         return new
     new.cell_contents = rebind(value, memo)
     return new
+
+
+#: mappings CPU -> state that library families keep outside the PLC
+#: (:func:`per_cpu`)
+_PER_CPU: list[Any] = []
+
+
+def per_cpu(mapping: Any) -> Any:
+    """Register ``mapping`` (a ``WeakKeyDictionary`` PLC -> the family's
+    state of that CPU, such as its Modbus master) and return it: a PLC
+    built from a template gets the copy of the template's state, the same
+    object its library blocks were rebound to."""
+    _PER_CPU.append(mapping)
+    return mapping
+
+
+def rebind_per_cpu(template: Any, plc: Any, memo: dict[int, Any]) -> None:
+    """Give ``plc`` its copy of the template's entries of every
+    :func:`per_cpu` mapping."""
+    for mapping in _PER_CPU:
+        state = mapping.get(template)
+        if state is not None:
+            mapping[plc] = rebind(state, memo)
 
 
 # ---------------------------------------------------------------------------
@@ -286,7 +317,7 @@ class ProgramCache:
 
     def get(self, key: tuple[Any, ...], program: Any) -> Entry | None:
         with self._lock:
-            entry = self._entries.get(key)
+            entry = self._entries.get(key) if self.max_entries > 0 else None
             if entry is None or not (entry.program is program or entry.program == program):
                 self.misses += 1
                 return None
@@ -318,4 +349,4 @@ programs = ProgramCache()
 
 
 __all__ = ["CHUNK_LINES", "Entry", "ProgramCache", "compile_chunks", "gc_paused",
-           "pair_objects", "program_key", "programs", "rebind"]
+           "pair_objects", "per_cpu", "program_key", "programs", "rebind", "rebind_per_cpu"]

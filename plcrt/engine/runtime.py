@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
 from ..compiler.cache import Entry, compile_chunks, gc_paused, pair_objects, program_key, programs,\
-    rebind
+    rebind, rebind_per_cpu
 from ..compiler.rt import CODECS, make_indirect
 from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
@@ -238,6 +238,9 @@ class Plc(AddressAccess):
                 raise PlcConfigError(f"internal error: generated code does not compile "
                                      f"({e.msg}, generated line {e.lineno}); please report "
                                      f"it with the program") from None
+        # the emitters' compile-time tables (they refer to this template) are
+        # not needed any more; the bindings hold what the code uses
+        self.unit.hooks.clear()
         self._bindings = self.unit.bindings
         self._entry = Entry(program, self.unit, self.source, self.line_locs, codes, self,
                             self.diagnostics[before:], self._warned - warned)
@@ -273,6 +276,7 @@ class Plc(AddressAccess):
             self.coverage = copy.deepcopy(template.coverage, memo)
         pair_objects(template, self, memo)
         self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
+        rebind_per_cpu(template, self, memo)
         self._entry = entry
         self.unit, self.source, self.line_locs = entry.unit, entry.source, entry.line_locs
         self.diagnostics = (auto_diags + list(self.unit.diag.items) + self.diagnostics

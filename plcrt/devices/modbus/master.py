@@ -28,6 +28,7 @@ import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
+from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
 from ...safetext import excerpt
@@ -72,7 +73,8 @@ BAUD_CODE = {38400: 0, 19200: 1, 9600: 2, 4800: 3, 2400: 4, 1200: 5, 115200: 6, 
 PARITY_BITS = {0: 0x00, 1: 0xC0, 2: 0x40}
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)
 
-_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = weakref.WeakKeyDictionary()
+_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = per_cpu(
+    weakref.WeakKeyDictionary())
 
 
 class Request:

@@ -14,9 +14,10 @@ Run ``python bench/load.py`` (``--json`` for one JSON document).  It
 3. measures the same load with the garbage collector left on during it
    (``gc on``), so its effect is visible (this needs a plcrt with
    ``plcrt.compiler.cache``);
-4. measures the pytest fixture ``plc``: a generated test file with many
-   tests on a 1 000-statement program, against the same tests without the
-   fixture; the difference per test is the fixture's overhead.
+4. measures the pytest fixture ``plc`` on a 1 000-statement program: the
+   plugin's work per test timed in one process (``in_process``), and whole
+   pytest runs of N and 2N tests with and without the fixture, whose
+   difference per added test is the fixture's overhead with pytest's own.
 
 ``--plcrt DIR`` measures the plcrt package found in DIR instead (another
 checkout: the figures before a change, side by side in the same run with
@@ -38,10 +39,16 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from run import bool_program, mixed_program  # noqa: E402  (the benchmark's generators)
 
-SHAPES = {"bool": bool_program, "mixed": mixed_program}
+
+def _generators() -> dict[str, Any]:
+    """The benchmark's program generators (bench/run.py).  Imported only in
+    the parent process: run.py puts this checkout first on sys.path, and a
+    child measuring another checkout (``--plcrt``) must not import it."""
+    sys.path.insert(0, str(HERE))
+    from run import bool_program, mixed_program
+    return {"bool": bool_program, "mixed": mixed_program}
+
 TINY = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0\n=      Q0.0\nEND_ORGANIZATION_BLOCK\n"
 
 
@@ -101,12 +108,36 @@ def child(path: str, mode: str) -> dict[str, Any]:
     return out
 
 
+def child_fixture(path: str, tests: int = 200) -> dict[str, Any]:
+    """The ``plc`` fixture's own work per test, in this process: what the
+    plugin does for a test's marker (then one scan), after a first test has
+    loaded the program."""
+    from plcrt.testing import plugin
+    root = Path(path).parent
+    sess = plugin._Session(rootpath=root, scan_ms=10.0, history=20, max_time=None,
+                           coverage=False, coverage_report=None)
+
+    def one_test() -> None:
+        spec = plugin._make_spec((Path(path).name,), {}, [root], root)
+        plugin._build(sess, spec).run(scans=1)
+
+    t0 = time.perf_counter()
+    one_test()
+    t1 = time.perf_counter()
+    for _ in range(tests):
+        one_test()
+    t2 = time.perf_counter()
+    return {"mode": "fixture", "first_test_s": t1 - t0,
+            "per_test_ms": (t2 - t1) / tests * 1000}
+
+
 def _run_child(path: Path, mode: str, plcrt_dir: str | None) -> dict[str, Any]:
     env = dict(os.environ)
     if plcrt_dir:
         env["PYTHONPATH"] = plcrt_dir + os.pathsep + env.get("PYTHONPATH", "")
     r = subprocess.run([sys.executable, __file__, "--child", str(path), mode],
-                       capture_output=True, text=True, env=env, check=False)
+                       capture_output=True, text=True, env=env, check=False,
+                       cwd=tempfile.gettempdir())
     if r.returncode != 0:
         return {"mode": mode, "error": r.stderr.strip().splitlines()[-1:]}
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -132,30 +163,39 @@ def test_plain(i):
 
 
 def fixture_overhead(text: str, tests: int, plcrt_dir: str | None) -> dict[str, Any]:
-    """Seconds per test that the ``plc`` fixture adds (one scan included)."""
+    """Milliseconds per test that the ``plc`` fixture adds (one scan of the
+    program included): pytest runs of ``tests`` and ``2 * tests`` tests with
+    and without the fixture, so the one-off costs (start-up, the first load)
+    cancel out; best of two runs each."""
     env = dict(os.environ)
     if plcrt_dir:
         env["PYTHONPATH"] = plcrt_dir + os.pathsep + env.get("PYTHONPATH", "")
-    times = {}
+    times: dict[tuple[str, int], float] = {}
     with tempfile.TemporaryDirectory() as d:
         Path(d, "prog.awl").write_text(text)
-        Path(d, "test_fx.py").write_text(FIXTURE_TEST.format(n=tests))
-        Path(d, "test_plain.py").write_text(PLAIN_TEST.format(n=tests))
         Path(d, "pytest.ini").write_text("[pytest]\n")
-        for name in ("test_plain.py", "test_fx.py"):
-            best = float("inf")
-            for _ in range(2):
-                t0 = time.perf_counter()
-                r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-                                    "-p", "no:xdist", name], cwd=d, env=env,
-                                   capture_output=True, text=True, check=False)
-                best = min(best, time.perf_counter() - t0)
-                if r.returncode != 0:
-                    return {"error": r.stdout.strip().splitlines()[-3:]}
-            times[name] = best
-    per_test = (times["test_fx.py"] - times["test_plain.py"]) / tests
-    return {"tests": tests, "with_fixture_s": times["test_fx.py"],
-            "without_s": times["test_plain.py"], "overhead_ms_per_test": per_test * 1000}
+        for n in (tests, 2 * tests):
+            Path(d, f"test_fx{n}.py").write_text(FIXTURE_TEST.format(n=n))
+            Path(d, f"test_plain{n}.py").write_text(PLAIN_TEST.format(n=n))
+            for kind in ("plain", "fx"):
+                best = float("inf")
+                for _ in range(2):
+                    t0 = time.perf_counter()
+                    r = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p",
+                                        "no:cacheprovider", "-p", "no:xdist", "-p",
+                                        "no:hypothesispytest", f"test_{kind}{n}.py"],
+                                       cwd=d, env=env, capture_output=True, text=True,
+                                       check=False)
+                    best = min(best, time.perf_counter() - t0)
+                    if r.returncode != 0:
+                        return {"error": r.stdout.strip().splitlines()[-3:]}
+                times[kind, n] = best
+    marginal = ((times["fx", 2 * tests] - times["fx", tests])
+                - (times["plain", 2 * tests] - times["plain", tests])) / tests
+    first = (times["fx", tests] - times["plain", tests]) - marginal * tests
+    return {"tests": [tests, 2 * tests],
+            "seconds": {f"{k}{n}": round(v, 3) for (k, n), v in times.items()},
+            "overhead_ms_per_test": marginal * 1000, "first_load_s": first}
 
 
 # ---------------------------------------------------------------------------
@@ -170,13 +210,16 @@ def measure(plcrt_dir: str | None, sizes: list[int], seeds: list[int], shapes: l
             for seed in seeds:
                 path = workdir / f"{shape}_{size}_{seed}.awl"
                 if not path.exists():
-                    path.write_text(SHAPES[shape](size, seed))
+                    path.write_text(_generators()[shape](size, seed))
                 row: dict[str, Any] = {"size": size, "shape": shape, "seed": seed}
                 for mode in ("plain", "gc-on", "trace"):
                     row[mode] = _run_child(path, mode, plcrt_dir)
                 rows.append(row)
                 print(_line(row), file=sys.stderr)
-    fixture = fixture_overhead(bool_program(1000, 1), fixture_tests, plcrt_dir)
+    text = _generators()["bool"](1000, 1)
+    fixture = fixture_overhead(text, fixture_tests, plcrt_dir)
+    (workdir / "fixture_1000.awl").write_text(text)
+    fixture["in_process"] = _run_child(workdir / "fixture_1000.awl", "fixture", plcrt_dir)
     print(f"fixture: {fixture}", file=sys.stderr)
     return {"plcrt": plcrt_dir or "this checkout", "loads": rows, "fixture": fixture}
 
@@ -206,7 +249,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
-        print(json.dumps(child(*args.child)))
+        path, mode = args.child
+        print(json.dumps(child_fixture(path) if mode == "fixture" else child(path, mode)))
         return 0
     sizes = [int(x) for x in args.sizes.split(",")]
     seeds = [int(x) for x in args.seeds.split(",")]

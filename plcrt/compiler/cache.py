@@ -121,41 +121,114 @@ _ATOMIC = (int, float, complex, str, bytes, bool, type(None), range, type,
            types.BuiltinFunctionType, types.ModuleType)
 
 
-#: longest list or dict whose items :func:`pair_objects` pairs
+#: longest list or dict whose items :func:`object_paths` follows
 _MAX_ITEMS = 32
 
+Path = tuple[tuple[str, Any], ...]
 
-def pair_objects(src: Any, dst: Any, memo: dict[int, Any], depth: int = 4) -> None:
-    """Record in ``memo`` which object of ``dst`` plays the part of each
-    object of ``src``: ``src`` and ``dst`` are built by the same
-    constructor, so their attributes (and the items of their lists, tuples
-    and dicts) correspond by name and position.  Used to map a template
-    PLC's engine objects (memory areas, timer bank, ports, devices ...) to
-    a new PLC's."""
-    if isinstance(src, _ATOMIC) or id(src) in memo or type(src) is not type(dst):
-        return
-    memo[id(src)] = dst
-    if src is dst or depth == 0:
-        return
-    if isinstance(src, (list, tuple)):
-        # perf: the items of long lists (the 256 timers of a bank) are not
-        # what run-time bindings refer to; their bank is
-        if len(src) == len(dst) <= _MAX_ITEMS:
-            for a, b in zip(src, dst):
-                pair_objects(a, b, memo, depth - 1)
-    elif isinstance(src, dict):
-        if len(src) > _MAX_ITEMS:
-            return
-        for k, a in src.items():
-            if k in dst:
-                pair_objects(a, dst[k], memo, depth - 1)
-    else:
-        attrs = getattr(src, "__dict__", None)
-        other = getattr(dst, "__dict__", None)
-        if attrs is not None and other is not None:
-            for k, a in attrs.items():
-                if k in other:
-                    pair_objects(a, other[k], memo, depth - 1)
+
+#: attributes of a PLC that are not its engine: the compiled program it
+#: shares with the others of its entry, and its own copy of the probes
+SHARED_ATTRS = frozenset({"_entry", "unit", "_bindings", "_ns", "program", "source",
+                          "line_locs", "coverage"})
+
+
+def object_paths(root: Any, depth: int = 4) -> dict[int, tuple[Any, Path]]:
+    """The engine objects of a PLC, each with its path from the PLC
+    (attribute names, list indexes and dict keys): two PLCs built by the
+    same constructor have corresponding objects at the same paths, so a
+    template's memory areas, timer bank, ports, devices ... are found in a
+    new PLC by following the path there (:func:`pair_objects`)."""
+    found: dict[int, tuple[Any, Path]] = {}
+    todo: list[tuple[Any, Path, int]] = [(root, (), depth)]
+    while todo:
+        obj, path, left = todo.pop()
+        if isinstance(obj, _ATOMIC) or id(obj) in found:
+            continue
+        found[id(obj)] = (obj, path)
+        if left == 0:
+            continue
+        if isinstance(obj, (list, tuple)):
+            # perf: the items of long lists (the 256 timers of a bank) are
+            # not what run-time bindings refer to; their bank is
+            if len(obj) <= _MAX_ITEMS:
+                todo += [(x, path + (("i", i),), left - 1) for i, x in enumerate(obj)]
+        elif isinstance(obj, dict):
+            if len(obj) <= _MAX_ITEMS:
+                todo += [(x, path + (("k", k),), left - 1) for k, x in obj.items()]
+        else:
+            attrs = getattr(obj, "__dict__", None)
+            if attrs is not None:
+                todo += [(x, path + (("a", k),), left - 1) for k, x in attrs.items()
+                         if obj is not root or k not in SHARED_ATTRS]
+    return found
+
+
+def needed_paths(template: Any, roots: list[Any]) -> list[tuple[int, Path]]:
+    """The paths of the template's engine objects that its run-time
+    bindings (``roots``) refer to, which is all a new PLC's memo needs.
+
+    The walk follows what :func:`rebind` and ``copy.deepcopy`` follow
+    (``gc.get_referents``: attributes, slots, items, closure cells, bound
+    objects), and stops at an engine object (it is mapped whole), at
+    functions without a closure, classes and modules (they are shared)."""
+    import gc as _gc
+    engine = object_paths(template)
+    needed: dict[int, Path] = {}
+    seen: set[int] = set()
+    todo = list(roots)
+    while todo:
+        obj = todo.pop()
+        key = id(obj)
+        if key in seen:
+            continue
+        seen.add(key)
+        if key in engine:
+            needed[key] = engine[key][1]
+            continue
+        if isinstance(obj, _ATOMIC) or isinstance(obj, types.CodeType):
+            continue
+        if isinstance(obj, types.FunctionType):
+            todo += [c for c in obj.__closure__ or ()]
+            continue
+        if isinstance(obj, types.CellType):
+            try:
+                todo.append(obj.cell_contents)
+            except ValueError:
+                pass
+            continue
+        todo += [x for x in _gc.get_referents(obj) if not isinstance(x, type)]
+    return sorted(needed.items(), key=lambda kv: len(kv[1]))
+
+
+def follow(root: Any, path: Path) -> Any:
+    """The object at ``path`` from ``root`` (:func:`object_paths`), or
+    None where the path does not exist."""
+    obj = root
+    for kind, step in path:
+        try:
+            if kind == "a":
+                obj = obj.__dict__[step]
+            elif kind == "i":
+                obj = obj[step]
+            else:
+                obj = obj[step]
+        except (AttributeError, KeyError, IndexError, TypeError):
+            return None
+    return obj
+
+
+def pair_objects(template: Any, plc: Any, paths: list[tuple[int, Path]],
+                 memo: dict[int, Any]) -> None:
+    """Record in ``memo`` which object of ``plc`` plays the part of each
+    template object in ``paths`` (:func:`needed_paths`); entries already
+    in ``memo`` stay."""
+    for key, path in paths:
+        if key in memo:
+            continue
+        obj = follow(plc, path)
+        if obj is not None:
+            memo[key] = obj
 
 
 def rebind(obj: Any, memo: dict[int, Any]) -> Any:
@@ -234,6 +307,11 @@ def per_cpu(mapping: Any) -> Any:
     return mapping
 
 
+def per_cpu_states(template: Any) -> list[Any]:
+    """The template's entries of the :func:`per_cpu` mappings."""
+    return [m[template] for m in _PER_CPU if template in m]
+
+
 def rebind_per_cpu(template: Any, plc: Any, memo: dict[int, Any]) -> None:
     """Give ``plc`` its copy of the template's entries of every
     :func:`per_cpu` mapping."""
@@ -301,6 +379,9 @@ class Entry:
     #: (library blocks' load notices), and the keys of its warn-once set
     diagnostics: list[Any] = field(default_factory=list)
     warned: set[str] = field(default_factory=set)
+    #: paths of the template's engine objects its bindings refer to
+    #: (:func:`needed_paths`), found when the first PLC is bound
+    paths: list[tuple[int, Path]] | None = None
 
 
 class ProgramCache:
@@ -348,5 +429,5 @@ class ProgramCache:
 programs = ProgramCache()
 
 
-__all__ = ["CHUNK_LINES", "Entry", "ProgramCache", "compile_chunks", "gc_paused",
-           "pair_objects", "per_cpu", "program_key", "programs", "rebind", "rebind_per_cpu"]
+__all__ = ["CHUNK_LINES", "Entry", "ProgramCache", "compile_chunks", "follow", "gc_paused",
+           "needed_paths", "object_paths", "pair_objects", "per_cpu", "per_cpu_states", "program_key", "programs", "rebind", "rebind_per_cpu"]

@@ -26,8 +26,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
-from ..compiler.cache import Entry, compile_chunks, gc_paused, pair_objects, program_key, programs,\
-    rebind, rebind_per_cpu
+from ..compiler.cache import (Entry, compile_chunks, gc_paused, needed_paths, pair_objects,
+                              per_cpu_states, program_key, programs, rebind, rebind_per_cpu)
 from ..compiler.rt import CODECS, make_indirect
 from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
@@ -274,7 +274,10 @@ class Plc(AddressAccess):
         if template.coverage is not None:
             # the probes' tables were filled while compiling: copy them
             self.coverage = copy.deepcopy(template.coverage, memo)
-        pair_objects(template, self, memo)
+        if entry.paths is None:
+            entry.paths = needed_paths(template, [*entry.unit.bindings.values(),
+                                                  *per_cpu_states(template)])
+        pair_objects(template, self, entry.paths, memo)
         self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
         rebind_per_cpu(template, self, memo)
         self._entry = entry
@@ -682,6 +685,18 @@ class Plc(AddressAccess):
         # the same compiled program (never compiled again, cached or not)
         twin = Plc(self.program, **self._config, _entry=self._entry)
         self._copy_state(twin)
+        return twin
+
+    def _twin_at_power_up(self) -> Plc:
+        """:meth:`fork` of a PLC that has not been touched since its load
+        (the pytest plugin's power-up PLCs, which no test sees): a new PLC
+        of the same compiled program with this one's memory (the data
+        block).  Everything else already is as the load left it, so nothing
+        needs deep-copying (perf: a fraction of a fork's time)."""
+        twin = Plc(self.program, **self._config, _entry=self._entry)
+        dareas = twin.mem.areas
+        for k, buf in self.mem.areas.items():
+            dareas[k][:] = buf
         return twin
 
     def snapshot(self) -> Plc:

@@ -374,8 +374,9 @@ def _build(sess: _Session, spec: _Spec) -> Harness:
     from ..errors import PlcError
     from .harness import Harness
     scan_ms = spec.scan_ms if spec.scan_ms is not None else sess.scan_ms
-    # perf: a fork of the session's power-up PLC, not a new load per test
-    h = Harness(_pristine(sess, spec, scan_ms).fork(),
+    # perf: a twin of the session's power-up PLC (which no test touches),
+    # not a new load per test
+    h = Harness(_pristine(sess, spec, scan_ms)._twin_at_power_up(),
                 history=spec.history if spec.history is not None else sess.history,
                 max_time=spec.max_time if spec.max_time is not None else sess.max_time)
     for address in spec.watch:

@@ -37,7 +37,7 @@ import hashlib
 import pickle
 import threading
 import types
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Iterator
@@ -140,9 +140,11 @@ def object_paths(root: Any, depth: int = 4) -> dict[int, tuple[Any, Path]]:
     template's memory areas, timer bank, ports, devices ... are found in a
     new PLC by following the path there (:func:`pair_objects`)."""
     found: dict[int, tuple[Any, Path]] = {}
-    todo: list[tuple[Any, Path, int]] = [(root, (), depth)]
+    # breadth first: an object reached two ways gets its shortest path, and
+    # is expanded as deep as the depth limit allows
+    todo: deque[tuple[Any, Path, int]] = deque([(root, (), depth)])
     while todo:
-        obj, path, left = todo.pop()
+        obj, path, left = todo.popleft()
         if isinstance(obj, _ATOMIC) or id(obj) in found:
             continue
         found[id(obj)] = (obj, path)
@@ -172,7 +174,6 @@ def needed_paths(template: Any, roots: list[Any]) -> list[tuple[int, Path]]:
     (``gc.get_referents``: attributes, slots, items, closure cells, bound
     objects), and stops at an engine object (it is mapped whole), at
     functions without a closure, classes and modules (they are shared)."""
-    import gc as _gc
     engine = object_paths(template)
     needed: dict[int, Path] = {}
     seen: set[int] = set()
@@ -197,7 +198,7 @@ def needed_paths(template: Any, roots: list[Any]) -> list[tuple[int, Path]]:
             except ValueError:
                 pass
             continue
-        todo += [x for x in _gc.get_referents(obj) if not isinstance(x, type)]
+        todo += [x for x in gc.get_referents(obj) if not isinstance(x, type)]
     return sorted(needed.items(), key=lambda kv: len(kv[1]))
 
 
@@ -207,12 +208,7 @@ def follow(root: Any, path: Path) -> Any:
     obj = root
     for kind, step in path:
         try:
-            if kind == "a":
-                obj = obj.__dict__[step]
-            elif kind == "i":
-                obj = obj[step]
-            else:
-                obj = obj[step]
+            obj = obj.__dict__[step] if kind == "a" else obj[step]
         except (AttributeError, KeyError, IndexError, TypeError):
             return None
     return obj

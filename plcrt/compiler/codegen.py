@@ -100,6 +100,10 @@ class Unit:
         self.nest_check = False
         #: (caller, callee) pairs inside a call cycle
         self.recursive_sites: set[tuple[str, str]] = set()
+        #: (first line, character offset) of each piece of the generated
+        #: module that is compiled on its own (cut between top-level
+        #: statements every :data:`~plcrt.compiler.cache.CHUNK_LINES` lines)
+        self.chunks: list[tuple[int, int]] = [(1, 0)]
 
     def fresh(self, hint: str) -> str:
         self._counter += 1
@@ -376,6 +380,19 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
             "note", f"the program is Unicode text and its string constants do not fit "
                     f"CP1252: they are stored in {codepage.upper()}, the first ANSI code page "
                     f"that holds them (docs/strings.md)", first, "codepage"))
+    from .cache import CHUNK_LINES
+    cut_line, cut_char = 0, 0   # where the last chunk starts (line index, offset)
+
+    def maybe_cut() -> None:
+        """Start a new chunk here when the current one is long enough (a
+        top-level statement starts here)."""
+        nonlocal cut_line, cut_char
+        if len(out) - cut_line >= CHUNK_LINES:
+            cut_char += sum(len(ln) for ln in out[cut_line:]) + len(out) - cut_line
+            cut_line = len(out)
+            unit.chunks.append((cut_line + 1, cut_char))
+
+    unit.chunks = [(1, 0)]
     for info in unit.pous.values():
         p = info.pou
         unit.current = info
@@ -401,6 +418,7 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
             info.depth_after[piece.index] = gen.depth
             args = ["L"] + [f"{n}={n}" for n in sorted(gen.used - {"L"})]
             header = f"def {fname}({', '.join(args)}):"
+            maybe_cut()
             base = len(out)
             out.append(header)
             body = gen.lines
@@ -413,6 +431,7 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
                 line_locs[base + 2 + rel] = unit.locs[insn_id]
             out.append("")
             fnames.append(fname)
+        maybe_cut()
         out.extend(_runner(unit, info, fnames))
         out.append("")
     return "\n".join(out) + "\n", line_locs

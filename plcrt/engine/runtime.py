@@ -26,6 +26,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from ..compiler import compile_program
+from ..compiler.cache import (Entry, compile_chunks, gc_paused, needed_paths, pair_objects,
+                              per_cpu_states, program_key, programs, rebind, rebind_per_cpu)
 from ..compiler.rt import CODECS, make_indirect
 from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError, PlcError,
                       PlcRuntimeError, SourceLoc)
@@ -68,7 +70,8 @@ class Plc(AddressAccess):
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False, library: bool = False,
-                 auto_symbols: bool = False, clock: Any = None) -> None:
+                 auto_symbols: bool = False, clock: Any = None, _entry: Any = None,
+                 _template: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
@@ -185,40 +188,17 @@ class Plc(AddressAccess):
             from ..devices import build_devices
             self.devices = build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
-        from ..blocks.call import library_call, protected_call
-
-        def setup(unit: Any) -> None:
-            unit.hooks["plc"] = self
-            unit.hooks["library_call"] = library_call
-            unit.hooks["protected_call"] = protected_call
-            unit.hooks["timers"] = self.timers
-            unit.hooks["counters"] = self.counters
-
-        try:
-            self.unit, self.source, self.line_locs = compile_program(
-                program, self.model, symbols=symbols, system_symbols=system_symbols,
-                setup=setup, probes=self.coverage, library=library)
-        except PlcCompileError as e:
-            e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
-            raise
-        self.diagnostics = auto_diags + list(self.unit.diag.items) + self.diagnostics
-        self._filename = f"<plcrt {program.file}>"
-        ns: dict[str, Any] = dict(CODECS)
-        ns.update(self.mem.areas)
-        ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
-        ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
-                  _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
-        ns.update(self.unit.bindings)
-        try:
-            code = compile(self.source, self._filename, "exec")
-        except SyntaxError as e:  # a plcrt bug, never the user's: say so clearly
-            raise PlcConfigError(f"internal error: generated code does not compile "
-                                 f"({e.msg}, generated line {e.lineno}); please report it "
-                                 f"with the program") from None
-        exec(code, ns)  # noqa: S102 - source built only from validated numbers
-        self._ns = ns
+        if _entry is None and _template:
+            # a template of the program cache: compiled here, never run
+            self._compile_template(program, symbols, system_symbols, library)
+            return
+        with gc_paused():
+            if _entry is None:
+                _entry = self._cached_entry(program, auto_diags)
+            self._adopt(_entry, auto_diags)
         a = self.mem.areas
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
+        ns = self._ns
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
         self._int_fns = {p.number: ns[f"pou_INT{p.number}"] for p in program.pous
                          if p.kind == "INT" and f"pou_INT{p.number}" in ns}
@@ -229,6 +209,92 @@ class Plc(AddressAccess):
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
         self.mem.areas["SM"][22:28] = ms * 3
         attach_devices(self.ports, plant)   # a plant device sends at given times
+
+    # -- compiling and binding ------------------------------------------------
+    def _compile_template(self, program: ir.Program, symbols: Any,
+                          system_symbols: dict[str, str], library: bool) -> None:
+        """Compile ``program`` for this PLC, which becomes the template of a
+        cache entry (:mod:`plcrt.compiler.cache`): it never runs, so its
+        run-time objects stay as they are at power-up for every PLC built
+        from it."""
+        from ..blocks.call import library_call, protected_call
+
+        def setup(unit: Any) -> None:
+            unit.hooks["plc"] = self
+            unit.hooks["library_call"] = library_call
+            unit.hooks["protected_call"] = protected_call
+            unit.hooks["timers"] = self.timers
+            unit.hooks["counters"] = self.counters
+
+        before, warned = len(self.diagnostics), set(self._warned)
+        with gc_paused():
+            self.unit, self.source, self.line_locs = compile_program(
+                program, self.model, symbols=symbols, system_symbols=system_symbols,
+                setup=setup, probes=self.coverage, library=library)
+            try:
+                codes = compile_chunks(self.source, self.unit.chunks,
+                                       f"<plcrt {program.file}>")
+            except SyntaxError as e:  # a plcrt bug, never the user's: say so clearly
+                raise PlcConfigError(f"internal error: generated code does not compile "
+                                     f"({e.msg}, generated line {e.lineno}); please report "
+                                     f"it with the program") from None
+        # the emitters' compile-time tables (they refer to this template) are
+        # not needed any more; the bindings hold what the code uses
+        self.unit.hooks.clear()
+        self._bindings = self.unit.bindings
+        self._entry = Entry(program, self.unit, self.source, self.line_locs, codes, self,
+                            self.diagnostics[before:], self._warned - warned)
+
+    def _cached_entry(self, program: ir.Program, auto_diags: list[Diagnostic]) -> Entry:
+        """The compiled program for this PLC's options, from the program
+        cache or compiled now (and kept there)."""
+        cfg = self._config
+        key = program_key(program, cpu=self.model.name, symbols=cfg["symbols"],
+                          system_symbols=cfg["system_symbols"], plant=cfg["plant"],
+                          instrument=cfg["instrument"], library=cfg["library"])
+        entry = programs.get(key, program)
+        if entry is None:
+            try:
+                template = Plc(program, **cfg, _template=True)
+            except PlcCompileError as e:
+                e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
+                raise
+            entry = template._entry
+            programs.put(key, entry)
+        return entry
+
+    def _adopt(self, entry: Entry, auto_diags: list[Diagnostic]) -> None:
+        """Bind the compiled program of ``entry`` to this PLC: the template's
+        run-time objects are copied onto this PLC's own (timer bank, ports,
+        devices, library blocks, closures over the CPU), and the shared code
+        objects are executed in this PLC's namespace, so its functions'
+        default arguments are its own objects."""
+        template = entry.template
+        memo: dict[int, Any] = {}
+        if template.coverage is not None:
+            # the probes' tables were filled while compiling: copy them
+            self.coverage = copy.deepcopy(template.coverage, memo)
+        if entry.paths is None:
+            entry.paths = needed_paths(template, [*entry.unit.bindings.values(),
+                                                  *per_cpu_states(template)])
+        pair_objects(template, self, entry.paths, memo)
+        self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
+        rebind_per_cpu(template, self, memo)
+        self._entry = entry
+        self.unit, self.source, self.line_locs = entry.unit, entry.source, entry.line_locs
+        self.diagnostics = (auto_diags + list(self.unit.diag.items) + self.diagnostics
+                            + list(entry.diagnostics))
+        self._warned |= entry.warned
+        self._filename = f"<plcrt {self.program.file}>"
+        ns: dict[str, Any] = dict(CODECS)
+        ns.update(self.mem.areas)
+        ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
+        ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
+                  _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
+        ns.update(self._bindings)
+        for code in entry.codes:
+            exec(code, ns)  # noqa: S102 - source built only from validated numbers
+        self._ns = ns
 
     # -- time -----------------------------------------------------------
     @property
@@ -616,8 +682,21 @@ class Plc(AddressAccess):
         """An independent twin in exactly this state (memory, timers,
         counters, edges, library blocks, devices, time, forces); running one
         never affects the other."""
-        twin = Plc(self.program, **self._config)
+        # the same compiled program (never compiled again, cached or not)
+        twin = Plc(self.program, **self._config, _entry=self._entry)
         self._copy_state(twin)
+        return twin
+
+    def _twin_at_power_up(self) -> Plc:
+        """:meth:`fork` of a PLC that has not been touched since its load
+        (the pytest plugin's power-up PLCs, which no test sees): a new PLC
+        of the same compiled program with this one's memory (the data
+        block).  Everything else already is as the load left it, so nothing
+        needs deep-copying (perf: a fraction of a fork's time)."""
+        twin = Plc(self.program, **self._config, _entry=self._entry)
+        dareas = twin.mem.areas
+        for k, buf in self.mem.areas.items():
+            dareas[k][:] = buf
         return twin
 
     def snapshot(self) -> Plc:
@@ -677,8 +756,8 @@ class Plc(AddressAccess):
                                         *zip(self.ports, dst.ports),
                                         (self.ethernet, dst.ethernet)]
         pairs += list(zip(self.devices, dst.devices))
-        for name, obj in self.unit.bindings.items():
-            other = dst.unit.bindings.get(name)
+        for name, obj in self._bindings.items():
+            other = dst._bindings.get(name)
             if other is None or type(other) is not type(obj):
                 raise PlcConfigError("internal error: the twin was compiled differently")
             if isinstance(obj, bytearray):
@@ -821,10 +900,14 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
     from ..lang.sources import read_program
     # the CPU's V size, so that data block entries past its end are
     # reported in the same run as the syntax errors
-    program, symbols, data = read_program(source_items(source), symbols, data,
-                                          encoding=encoding, max_bytes=limit,
-                                          v_bytes=cpu_model(cpu).v_bytes)
-    return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant, **kw)
+    # perf: parsing and compiling allocate millions of objects that all
+    # stay alive; automatic collections would only walk them (gc_paused)
+    with gc_paused():
+        program, symbols, data = read_program(source_items(source), symbols, data,
+                                              encoding=encoding, max_bytes=limit,
+                                              v_bytes=cpu_model(cpu).v_bytes)
+        return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
+                   **kw)
 
 
 __all__ = ["Plc", "load", "parse_sources"]

@@ -29,6 +29,7 @@ from __future__ import annotations
 import difflib
 import hashlib
 import os
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterator
@@ -36,6 +37,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator
 import pytest
 
 if TYPE_CHECKING:
+    from ..engine.runtime import Plc
     from .harness import Harness
 
 #: keyword arguments of the marker and of ``plc_factory``
@@ -43,6 +45,8 @@ OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "ma
            "encoding", "clock")
 DEFAULT_SCAN_MS = 10.0
 DEFAULT_HISTORY = 20
+#: power-up PLCs the plugin keeps per session (one per program and options)
+PRISTINE_PLCS = 32
 #: name of the JUnit XML property that carries the trace of a failing test
 JUNIT_PROPERTY = "plc_trace"
 #: key of the coverage data in an xdist worker's ``workeroutput``
@@ -74,9 +78,11 @@ class _Session:
     #: parsed programs with their tables: (((path, mtime_ns, size), ...),
     #: which tables, encoding) -> (ir.Program, symbols, data).  The IR is
     #: frozen and the tables are only read, so one parse can serve every
-    #: test; each test still gets its own compiled Plc (and so its own memory
-    #: and power-up state).
+    #: test; each test gets its own fork of one power-up PLC (:attr:`plcs`).
     programs: dict[Any, tuple[Any, Any, Any]] = field(default_factory=dict)
+    #: power-up PLCs by program and options (:func:`_pristine`), least
+    #: recently used first; each test gets a fork
+    plcs: OrderedDict[Any, Plc] = field(default_factory=OrderedDict)
     #: merged coverage: program key -> coverage_report entry
     store: dict[str, Any] = field(default_factory=dict)
 
@@ -323,23 +329,56 @@ def _parsed(sess: _Session, spec: _Spec) -> tuple[Any, Any, Any]:
             data if tables[1] else spec.data)
 
 
+def _option_key(value: Any) -> Any:
+    """A hashable stand-in for a marker option: a file by its name and
+    version, anything else (text, a plant dict, a number) by its repr."""
+    if isinstance(value, Path):
+        st = value.stat()
+        return ("file", str(value), st.st_mtime_ns, st.st_size)
+    return ("value", repr(value))
+
+
+def _pristine(sess: _Session, spec: _Spec, scan_ms: float) -> Plc:
+    """The power-up PLC of ``spec``, loaded once per session and version of
+    its files; every test gets a fork of it (its own memory, timers,
+    devices and time, nothing shared)."""
+    from .harness import Harness
+    if isinstance(spec.program, str):
+        program_key: Any = ("text", spec.program)
+    else:
+        program_key = tuple(_option_key(p) for p in spec.program)
+    key = (program_key, _option_key(spec.symbols), _option_key(spec.data),
+           _option_key(spec.plant), scan_ms, spec.cpu, sess.coverage, spec.encoding,
+           _option_key(spec.clock))
+    plc = sess.plcs.get(key)
+    if plc is not None:
+        sess.plcs.move_to_end(key)
+        return plc
+    if isinstance(spec.program, str):
+        program, symbols, data = spec.program, spec.symbols, spec.data
+    else:
+        program, symbols, data = _parsed(sess, spec)
+    plc = Harness.load(program, symbols=symbols, data=data, plant=spec.plant,
+                       scan_ms=scan_ms, cpu=spec.cpu, instrument=sess.coverage,
+                       encoding=spec.encoding, clock=spec.clock).plc
+    sess.plcs[key] = plc
+    while len(sess.plcs) > PRISTINE_PLCS:
+        sess.plcs.popitem(last=False)
+    return plc
+
+
 def _build(sess: _Session, spec: _Spec) -> Harness:
     """A harness for ``spec``; plcrt's own errors propagate (PlcError: a
     program without OB1 is a compile error), a bad ``watch`` address is a
     PlcUsageError."""
     from ..errors import PlcError
     from .harness import Harness
-    if isinstance(spec.program, str):
-        program, symbols, data = spec.program, spec.symbols, spec.data
-    else:
-        program, symbols, data = _parsed(sess, spec)
-    h = Harness.load(program, symbols=symbols, data=data, plant=spec.plant,
-                     scan_ms=spec.scan_ms if spec.scan_ms is not None else sess.scan_ms,
-                     cpu=spec.cpu,
-                     history=spec.history if spec.history is not None else sess.history,
-                     instrument=sess.coverage,
-                     max_time=spec.max_time if spec.max_time is not None else sess.max_time,
-                     encoding=spec.encoding, clock=spec.clock)
+    scan_ms = spec.scan_ms if spec.scan_ms is not None else sess.scan_ms
+    # perf: a twin of the session's power-up PLC (which no test touches),
+    # not a new load per test
+    h = Harness(_pristine(sess, spec, scan_ms)._twin_at_power_up(),
+                history=spec.history if spec.history is not None else sess.history,
+                max_time=spec.max_time if spec.max_time is not None else sess.max_time)
     for address in spec.watch:
         try:
             h.watch(address)

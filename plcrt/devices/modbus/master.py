@@ -28,6 +28,7 @@ import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
+from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
 from ...engine.serial import BAUD_CODE
@@ -71,7 +72,8 @@ MAX_BITS, MAX_WORDS = 1920, 120
 PARITY_BITS = {0: 0x00, 1: 0xC0, 2: 0x40}
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)
 
-_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = weakref.WeakKeyDictionary()
+_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = per_cpu(
+    weakref.WeakKeyDictionary())
 
 
 class Request:

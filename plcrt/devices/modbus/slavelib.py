@@ -37,6 +37,7 @@ from collections import deque
 from typing import Any, Optional
 
 from ...blocks import register_block
+from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
 from ...safetext import excerpt
@@ -71,7 +72,8 @@ _EXC_ERROR = {1: 8, 2: 9, 3: 9}
 _WRITE_FN = (5, 6, 15, 16)
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)
 
-_SLAVES: "weakref.WeakKeyDictionary[Any, SlaveLib]" = weakref.WeakKeyDictionary()
+_SLAVES: "weakref.WeakKeyDictionary[Any, SlaveLib]" = per_cpu(
+    weakref.WeakKeyDictionary())
 
 
 class SlaveLib:

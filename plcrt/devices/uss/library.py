@@ -36,6 +36,7 @@ import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
+from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
 from ...blocks.library import LibraryBlock
 from ...engine.serial import BAUD_CODE
@@ -82,7 +83,8 @@ _WRITE_TASK = {"W": (TASK["write_word"], TASK["write_word_index"], TASK["write_w
                "D": (TASK["write_dword"], TASK["write_dword_index"],
                      TASK["write_dword_eeprom"], TASK["write_dword_index_eeprom"])}
 
-_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = weakref.WeakKeyDictionary()
+_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = per_cpu(
+    weakref.WeakKeyDictionary())
 
 
 class Slot:

@@ -121,9 +121,6 @@ _ATOMIC = (int, float, complex, str, bytes, bool, type(None), range, type,
            types.BuiltinFunctionType, types.ModuleType)
 
 
-#: longest list or dict whose items :func:`object_paths` follows
-_MAX_ITEMS = 32
-
 Path = tuple[tuple[str, Any], ...]
 
 
@@ -133,36 +130,35 @@ SHARED_ATTRS = frozenset({"_entry", "unit", "_bindings", "_ns", "program", "sour
                           "line_locs", "coverage"})
 
 
-def object_paths(root: Any, depth: int = 4) -> dict[int, tuple[Any, Path]]:
+def object_paths(root: Any) -> dict[int, tuple[Any, Path]]:
     """The engine objects of a PLC, each with its path from the PLC
     (attribute names, list indexes and dict keys): two PLCs built by the
     same constructor have corresponding objects at the same paths, so a
     template's memory areas, timer bank, ports, devices ... are found in a
     new PLC by following the path there (:func:`pair_objects`)."""
     found: dict[int, tuple[Any, Path]] = {}
-    # breadth first: an object reached two ways gets its shortest path, and
-    # is expanded as deep as the depth limit allows
-    todo: deque[tuple[Any, Path, int]] = deque([(root, (), depth)])
+    # breadth first: an object reached two ways gets its shortest path.  The
+    # whole graph is walked (a few ms: the areas are bytearrays and the
+    # banks' long lists hold numbers), so a binding that refers to an
+    # engine object however deep never gets a private copy of it
+    todo: deque[tuple[Any, Path]] = deque([(root, ())])
     while todo:
-        obj, path, left = todo.popleft()
+        obj, path = todo.popleft()
         if isinstance(obj, _ATOMIC) or id(obj) in found:
             continue
         found[id(obj)] = (obj, path)
-        if left == 0:
-            continue
         if isinstance(obj, (list, tuple)):
-            # perf: the items of long lists (the 256 timers of a bank) are
-            # not what run-time bindings refer to; their bank is
-            if len(obj) <= _MAX_ITEMS:
-                todo += [(x, path + (("i", i),), left - 1) for i, x in enumerate(obj)]
+            todo += [(x, path + (("i", i),)) for i, x in enumerate(obj)
+                     if not isinstance(x, _ATOMIC)]
         elif isinstance(obj, dict):
-            if len(obj) <= _MAX_ITEMS:
-                todo += [(x, path + (("k", k),), left - 1) for k, x in obj.items()]
+            todo += [(x, path + (("k", k),)) for k, x in obj.items()
+                     if not isinstance(x, _ATOMIC)]
         else:
             attrs = getattr(obj, "__dict__", None)
             if attrs is not None:
-                todo += [(x, path + (("a", k),), left - 1) for k, x in attrs.items()
-                         if obj is not root or k not in SHARED_ATTRS]
+                todo += [(x, path + (("a", k),)) for k, x in attrs.items()
+                         if (obj is not root or k not in SHARED_ATTRS)
+                         and not isinstance(x, _ATOMIC)]
     return found
 
 
@@ -215,16 +211,22 @@ def follow(root: Any, path: Path) -> Any:
 
 
 def pair_objects(template: Any, plc: Any, paths: list[tuple[int, Path]],
-                 memo: dict[int, Any]) -> None:
+                 memo: dict[int, Any]) -> list[Path]:
     """Record in ``memo`` which object of ``plc`` plays the part of each
     template object in ``paths`` (:func:`needed_paths`); entries already
-    in ``memo`` stay."""
+    in ``memo`` stay.  Returns the paths that ``plc`` lacks (none when the
+    two were built alike): a binding would otherwise get a private copy of
+    an engine object instead of the new PLC's own."""
+    missing = []
     for key, path in paths:
         if key in memo:
             continue
         obj = follow(plc, path)
-        if obj is not None:
+        if obj is None:
+            missing.append(path)
+        else:
             memo[key] = obj
+    return missing
 
 
 def rebind(obj: Any, memo: dict[int, Any]) -> Any:

@@ -277,7 +277,11 @@ class Plc(AddressAccess):
         if entry.paths is None:
             entry.paths = needed_paths(template, [*entry.unit.bindings.values(),
                                                   *per_cpu_states(template)])
-        pair_objects(template, self, entry.paths, memo)
+        missing = pair_objects(template, self, entry.paths, memo)
+        if missing:
+            where = ".".join(str(step) for _, step in missing[0])
+            raise PlcRuntimeError(f"internal error: the compiled program refers to "
+                                  f"plc.{where}, which this PLC does not have")
         self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
         rebind_per_cpu(template, self, memo)
         self._entry = entry

@@ -246,3 +246,32 @@ def test_nested_pauses_restore_once() -> None:
             pass
         assert not gc.isenabled()
     assert gc.isenabled()
+
+
+class _Node:
+    def __init__(self, **kw: object) -> None:
+        self.__dict__.update(kw)
+
+
+def test_engine_objects_are_paired_however_deep_and_a_missing_one_is_reported() -> None:
+    """An engine object six attributes down (or an item of a long list) is
+    found by its path in the new PLC, so a binding refers to the new PLC's
+    own object; a path the new PLC lacks comes back as missing instead of
+    leaving the binding a private copy."""
+    def build() -> _Node:
+        deep = _Node(value=bytearray(4))
+        chain = _Node(a=_Node(b=_Node(c=_Node(d=_Node(e=deep)))))
+        return _Node(chain=chain, items=[_Node(k=i) for i in range(100)])
+
+    template, twin = build(), build()
+    deep = template.chain.a.b.c.d.e
+    binding = {"blk": _Node(target=deep, item=template.items[77])}
+    paths = cache.needed_paths(template, [binding])
+    memo: dict[int, object] = {}
+    assert cache.pair_objects(template, twin, paths, memo) == []
+    copy_ = cache.rebind(binding, memo)
+    assert copy_["blk"].target is twin.chain.a.b.c.d.e
+    assert copy_["blk"].item is twin.items[77]
+    del twin.chain.a.b.c.d.e
+    missing = cache.pair_objects(template, twin, paths, {})
+    assert any(step == "e" for path in missing for _, step in path)

@@ -24,13 +24,11 @@ blocks runs it (``register_protected``; plcrt.blocks.call.protected_call).
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
-from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
-from ...blocks.library import LibraryBlock
+from ...blocks.library import LibraryBlock, per_cpu_state
 from ...engine.serial import BAUD_CODE
 from ...safetext import excerpt
 from .rtu import READS, WRITES, check_crc, frame, gap_us
@@ -72,8 +70,6 @@ MAX_BITS, MAX_WORDS = 1920, 120
 PARITY_BITS = {0: 0x00, 1: 0xC0, 2: 0x40}
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)
 
-_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = per_cpu(
-    weakref.WeakKeyDictionary())
 
 
 class Request:
@@ -192,21 +188,13 @@ class Master:
         return 0 if r[2:6] == req.frame[2:6] and len(r) == 8 else 7
 
 
-def master_of(plc: Any) -> Master:
-    """*plc*'s Modbus master (one per CPU)."""
-    m = _MASTERS.get(plc)
-    if m is None:
-        m = _MASTERS[plc] = Master(plc)
-    return m
+#: *plc*'s Modbus master (one per CPU).
+master_of = per_cpu_state(Master)
 
 
 class _Block(LibraryBlock):
     family, bind_as = "modbus", "mbmaster"
-    shared = staticmethod(master_of)
-
-    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        super().__init__(plc, loc, itf)
-        self.master = master_of(plc)
+    state_of, state_attr = staticmethod(master_of), "master"
 
     @classmethod
     def notice(cls, itf: Any) -> str:

@@ -32,14 +32,12 @@ export named MBUS_INIT / MBUS_SLAVE runs these (``register_protected``).
 
 from __future__ import annotations
 
-import weakref
 from collections import deque
 from typing import Any, Optional
 
 from ...blocks import register_block
-from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
-from ...blocks.library import LibraryBlock
+from ...blocks.library import LibraryBlock, per_cpu_state
 from ...safetext import excerpt
 from .master import BAUD_CODE, PARITY_BITS
 from .rtu import check_crc, frame, gap_us, serve
@@ -72,8 +70,6 @@ _EXC_ERROR = {1: 8, 2: 9, 3: 9}
 _WRITE_FN = (5, 6, 15, 16)
 _V = 0x08     #: pointer area code of V (plcrt.compiler.operands.POINTER_AREAS)
 
-_SLAVES: "weakref.WeakKeyDictionary[Any, SlaveLib]" = per_cpu(
-    weakref.WeakKeyDictionary())
 
 
 class SlaveLib:
@@ -206,21 +202,13 @@ class SlaveLib:
             v_mem[off + 2 * i:off + 2 * i + 2] = w.to_bytes(2, "big")
 
 
-def slave_of(plc: Any) -> SlaveLib:
-    """*plc*'s Modbus slave library (one per CPU)."""
-    s = _SLAVES.get(plc)
-    if s is None:
-        s = _SLAVES[plc] = SlaveLib(plc)
-    return s
+#: *plc*'s Modbus slave library (one per CPU).
+slave_of = per_cpu_state(SlaveLib)
 
 
 class _Block(LibraryBlock):
     family, bind_as = "modbus-slave", "mbslave"
-    shared = staticmethod(slave_of)
-
-    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        super().__init__(plc, loc, itf)
-        self.lib = slave_of(plc)
+    state_of, state_attr = staticmethod(slave_of), "lib"
 
     @classmethod
     def notice(cls, itf: Any) -> str:

@@ -32,13 +32,11 @@ blocks runs it (``register_protected``).
 from __future__ import annotations
 
 import math
-import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block
-from ...compiler.cache import per_cpu
 from ...blocks.call import register_protected
-from ...blocks.library import LibraryBlock
+from ...blocks.library import LibraryBlock, per_cpu_state
 from ...engine.serial import BAUD_CODE
 from .telegram import (STW, STX, TASK, ZSW, Telegram, bits_real, decode, encode,
                        param_code, real_bits, speed_word, word_speed)
@@ -83,8 +81,6 @@ _WRITE_TASK = {"W": (TASK["write_word"], TASK["write_word_index"], TASK["write_w
                "D": (TASK["write_dword"], TASK["write_dword_index"],
                      TASK["write_dword_eeprom"], TASK["write_dword_index_eeprom"])}
 
-_MASTERS: "weakref.WeakKeyDictionary[Any, Master]" = per_cpu(
-    weakref.WeakKeyDictionary())
 
 
 class Slot:
@@ -256,21 +252,13 @@ class Master:
         self.plc._sources_on = True
 
 
-def master_of(plc: Any) -> Master:
-    """*plc*'s USS master (one per CPU)."""
-    m = _MASTERS.get(plc)
-    if m is None:
-        m = _MASTERS[plc] = Master(plc)
-    return m
+#: *plc*'s USS master (one per CPU).
+master_of = per_cpu_state(Master)
 
 
 class _Block(LibraryBlock):
     family, bind_as = "uss", "ussmaster"
-    shared = staticmethod(master_of)
-
-    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
-        super().__init__(plc, loc, itf)
-        self.master = master_of(plc)
+    state_of, state_attr = staticmethod(master_of), "master"
 
     @classmethod
     def notice(cls, itf: Any) -> str:

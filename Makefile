@@ -31,7 +31,7 @@ demo: setup
 	$(BIN)/plcrt run examples/bus_drive/bus_drive.awl library/cia402/drive_lib.awl --plant examples/bus_drive/plant.toml --symbols examples/bus_drive/bus_drive_symbols.txt --data examples/bus_drive/bus_drive.db --seconds 2 --set D1_Enable_SW=1 --set D1_Jog_SW=1 --watch VD1036
 
 test: setup
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto
 
 bench: setup
 	$(BIN)/python bench/run.py

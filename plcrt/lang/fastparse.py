@@ -163,6 +163,22 @@ def _parse(text: str, file: str) -> Program | None:
     return Program(pous=tuple(pous), file=file, source=text)
 
 
+def _next_line(lines: list[str], index: int) -> tuple[str, int] | None:
+    """The first line from ``lines[index]`` on that is not blank, and the
+    index after it; None at the end of the text, or at a blank-looking line
+    holding whitespace that lark does not ignore (the caller declines)."""
+    count = len(lines)
+    while index < count:
+        line = lines[index]
+        index += 1
+        # perf: isspace() first; a blank line of the grammar holds WS only
+        if line and not line.isspace():
+            return line, index
+        if line.strip(_WS_CHARS):
+            return None
+    return None
+
+
 def _block(lines: list[str], index: int, header: re.Match[str], file: str,
            folded: set[int]) -> tuple[Pou, int] | None:
     """Read one block whose header line is ``lines[index - 1]``; return the
@@ -189,14 +205,10 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
     variables: list[VarDecl] = []
     # ---- between the header and BEGIN
     while True:
-        if index >= count:
+        got = _next_line(lines, index)
+        if got is None:
             return None
-        line = lines[index]
-        index += 1
-        if not line or line.isspace():
-            if line.strip(_WS_CHARS):
-                return None
-            continue
+        line, index = got
         if m := _COMMENT_LINE.match(line):
             comments.append(m.group(1).strip())
         elif m := _TITLE_LINE.match(line):
@@ -210,14 +222,10 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
             if section is None:
                 return None         # "VAR_İNPUT": matched by /i, no such section
             while True:
-                if index >= count:
+                got = _next_line(lines, index)
+                if got is None:
                     return None
-                line = lines[index]
-                index += 1
-                if not line or line.isspace():
-                    if line.strip(_WS_CHARS):
-                        return None
-                    continue
+                line, index = got
                 if _END_VAR_LINE.match(line):
                     break
                 if _COMMENT_LINE.match(line):
@@ -254,6 +262,7 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
     tail_match = _TAIL.match
     append_insn = insns.append
     while True:
+        # perf: _next_line inline here, the loop that runs once per statement
         if index >= count:
             return None             # missing END_...
         line = lines[index]

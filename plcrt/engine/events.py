@@ -147,26 +147,17 @@ class Scheduler:
                     dev.step(plc, t, best)
                 t = best
             quick = None
-            if ties is None:
-                # perf: one row due is the common case (no list per instant);
+            # perf: one row due is the common case (a one-item tuple, no list)
+            for row in (ties or (due,)):
                 # a source may answer with its next event (kept like an
                 # asked one); None: asked again at the next instant
-                nxt = due[0].fire(best)
+                nxt = row[0].fire(best)
                 if nxt is None:
-                    due[1] = -1
+                    row[1] = -1
                 else:
-                    due[2] = nxt
-                if due[4]:
+                    row[2] = nxt
+                if row[4]:
                     self.gen += 1      # e.g. a train ended: a counter on it moves too
-            else:
-                for row in ties:
-                    nxt = row[0].fire(best)
-                    if nxt is None:
-                        row[1] = -1
-                    else:
-                        row[2] = nxt
-                    if row[4]:
-                        self.gen += 1
             if on_instant is not None:
                 on_instant(best)
             after = best

@@ -315,6 +315,16 @@ class ReferencePlc:
     def top(self, value: int) -> None:
         self.stack[-1] = value
 
+    def contact(self, how: str, value: int) -> None:
+        """A contact's or compare's value: loaded (LD), and-ed (A) or
+        or-ed (O) onto the top of the stack."""
+        if how == "LD":
+            self.push(value)
+        elif how == "A":
+            self.top = self.top & value
+        else:
+            self.top = self.top | value
+
     # -- instructions ---------------------------------------------------------
     def execute(self, insn: ir.Insn, key: tuple[int, int, int]) -> None:
         """Execute one instruction; ``key`` identifies it (for EU/ED memory)."""
@@ -324,12 +334,7 @@ class ReferencePlc:
             bit = self.read_bit(ops[0])
             if m.endswith("N"):
                 bit ^= 1
-            if m.startswith("LD"):
-                self.push(bit)
-            elif m.startswith("A"):
-                self.top = self.top & bit
-            else:
-                self.top = self.top | bit
+            self.contact(m.rstrip("N"), bit)
         elif COMPARE_RE.fullmatch(m):
             self._compare(m, ops)
         elif STRING_COMPARE_RE.fullmatch(m):
@@ -406,13 +411,7 @@ class ReferencePlc:
         nbytes, signed = WIDTHS[width]
         a = self.read_value(ops[0], nbytes, signed)
         b = self.read_value(ops[1], nbytes, signed)
-        result = int(RELATIONS[relation](a, b))
-        if how == "LD":
-            self.push(result)
-        elif how == "A":
-            self.top = self.top & result
-        else:
-            self.top = self.top | result
+        self.contact(how, int(RELATIONS[relation](a, b)))
 
     def _edge(self, rising: bool, key: tuple[int, int, int]) -> None:
         # Each EU/ED has its own memory.  Its first execution reports no edge.
@@ -519,13 +518,7 @@ class ReferencePlc:
         a, b = self.read_string(ops[0]), self.read_string(ops[1])
         if a is None or b is None:
             raise Unsupported("compare of an invalid string (a fatal error)")
-        result = int((a == b) == (relation == "="))
-        if how == "LD":
-            self.push(result)
-        elif how == "A":
-            self.top = self.top & result
-        else:
-            self.top = self.top | result
+        self.contact(how, int((a == b) == (relation == "=")))
 
     def _slen(self, ops: list[str]) -> None:
         s = self.read_string(ops[0])

@@ -94,7 +94,7 @@ def measure(peers: Path, cache: Path, seeds: list[int], sizes: list[tuple[int, i
                 subprocess.run([sys.executable, str(peers / "gen.py"), str(progdir),
                                 "--bool", str(n_bool), "--mixed", str(n_mixed),
                                 "--seed", str(seed)], check=True, capture_output=True)
-                best: dict[str, dict[str, float]] = {}
+                best: dict[str, float] = {}     # engine:program -> best µs per scan
                 checks: dict[str, dict[str, Any]] = {}
                 errors: dict[str, str] = {}
                 for _ in range(rounds):
@@ -106,12 +106,11 @@ def measure(peers: Path, cache: Path, seeds: list[int], sizes: list[tuple[int, i
                         for prog, r in res["programs"].items():
                             label = f"{engine}:{prog}"
                             us = r["best_s"] * 1e6
-                            best.setdefault(label, {"us": us})
-                            best[label]["us"] = min(best[label]["us"], us)
+                            best[label] = min(best.get(label, us), us)
                             if "check" in r:
                                 checks[label] = r["check"]
                 row: dict[str, Any] = {"seed": seed, "bool": n_bool, "mixed": n_mixed,
-                                       "us_per_scan": {k: round(v["us"], 2)
+                                       "us_per_scan": {k: round(v, 2)
                                                        for k, v in sorted(best.items())},
                                        "checks": checks, "errors": errors, "ratios": {}}
                 for prog in ("bool", "mixed"):
@@ -119,7 +118,7 @@ def measure(peers: Path, cache: Path, seeds: list[int], sizes: list[tuple[int, i
                     for peer in ("awlsim-cy", "awlsim-py"):
                         theirs = best.get(f"{peer}:{prog}")
                         if mine and theirs:
-                            row["ratios"][f"{peer}/plcrt {prog}"] = round(theirs["us"] / mine["us"], 3)
+                            row["ratios"][f"{peer}/plcrt {prog}"] = round(theirs / mine, 3)
                 cases.append(row)
     return {"engines": engines, "missing": missing, "cache": str(cache),
             "rounds": rounds, "cases": cases}

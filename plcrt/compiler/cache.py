@@ -428,4 +428,5 @@ programs = ProgramCache()
 
 
 __all__ = ["CHUNK_LINES", "Entry", "ProgramCache", "compile_chunks", "follow", "gc_paused",
-           "needed_paths", "object_paths", "pair_objects", "per_cpu", "per_cpu_states", "program_key", "programs", "rebind", "rebind_per_cpu"]
+           "needed_paths", "object_paths", "pair_objects", "per_cpu", "per_cpu_states",
+           "program_key", "programs", "rebind", "rebind_per_cpu"]

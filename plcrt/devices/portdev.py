@@ -49,13 +49,12 @@ from .peer import PortPeer
 __all__ = ["PortConfig", "DeviceConfig", "EthernetConfig", "parse_ports", "parse_ethernet",
            "ScriptedDevice"]
 
-_PORT_KEYS = {"address", "ppi_baud", "reply", "send", "modbus_slave", "modbus_master",
-              "uss"}
 #: the devices a port may have at its other end (one), by their plant keys
 _DEVICE_KEYS = {"a scripted device (reply/send)": ("reply", "send"),
                 "a Modbus slave (modbus_slave)": ("modbus_slave",),
                 "a Modbus master (modbus_master)": ("modbus_master",),
                 "USS drives (uss)": ("uss",)}
+_PORT_KEYS = {"address", "ppi_baud"} | {k for keys in _DEVICE_KEYS.values() for k in keys}
 _REPLY_KEYS = {"request", "reply", "delay_ms", "bad_parity"}
 _SEND_KEYS = {"at", "data", "bad_parity"}
 _ETH_KEYS = {"ip", "latency_ms"}

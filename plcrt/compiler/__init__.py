@@ -20,7 +20,8 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
                     system_symbols: dict[str, str] | None = None,
                     bindings: dict[str, Any] | None = None,
                     setup: Any = None, probes: Any = None,
-                    library: bool = False) -> tuple[Unit, str, dict]:
+                    library: bool = False, native: bool = False
+                    ) -> tuple[Unit, str, dict]:
     """Check and generate code; returns the unit, module source and line map.
 
     Args:
@@ -31,6 +32,9 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
             the code for (network and output coverage, breakpoints).
         library: accept a program without OB1 (a subroutine library, for
             checking only); otherwise that is an error.
+        native: also plan the native backend's segments
+            (:mod:`plcrt.compiler.native`; ``unit.native`` holds the plan).
+            An instrumented program (``probes``) stays Python.
 
     Raises:
         PlcCompileError: with every error found (warnings ride along).
@@ -39,6 +43,9 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
     diag = DiagnosticSink()
     unit = build_unit(program, model, symbols, system_symbols or {}, diag, library=library)
     unit.probes = probes
+    if native and probes is None:
+        from .native import NativePlan
+        unit.native = NativePlan()
     if setup is not None:
         setup(unit)
     source, line_locs = generate(unit)

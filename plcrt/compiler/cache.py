@@ -380,6 +380,8 @@ class Entry:
     #: paths of the template's engine objects its bindings refer to
     #: (:func:`needed_paths`), found when the first PLC is bound
     paths: list[tuple[int, Path]] | None = None
+    #: the machine code of the native backend's segments, or None
+    native: Any = None
 
 
 class ProgramCache:

@@ -47,6 +47,9 @@ class Piece:
     start_depth: int = 0
     index: int = 0
     suffix: str = ""
+    #: (mnemonic, resolved operands) of each instruction, for the native
+    #: backend (recorded only when it is asked for)
+    resolved: list[tuple[str, list[Any]]] | None = None
 
 
 @dataclass
@@ -104,6 +107,9 @@ class Unit:
         #: module that is compiled on its own (cut between top-level
         #: statements every :data:`~plcrt.compiler.cache.CHUNK_LINES` lines)
         self.chunks: list[tuple[int, int]] = [(1, 0)]
+        #: the native backend's plan (:mod:`plcrt.compiler.native`), or None
+        #: for Python only
+        self.native: Any = None
 
     def fresh(self, hint: str) -> str:
         self._counter += 1
@@ -401,6 +407,8 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
         fnames: list[str] = []
         for piece in info.pieces:
             unit.current_piece = piece
+            if unit.native is not None:
+                piece.resolved = []
             fname = f"n_{p.ident}_{piece.network.number}{piece.suffix}_{piece.index}"
             gen = Gen(unit, piece.network.loc, 0)
             if unit.probes is not None:
@@ -431,8 +439,15 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
                 line_locs[base + 2 + rel] = unit.locs[insn_id]
             out.append("")
             fnames.append(fname)
+        segs = None
+        if unit.native is not None:
+            from .native import plan_pou
+            segs = plan_pou(unit.native, p.ident, info.flow,
+                            [(pc.network.number, pc.resolved) for pc in info.pieces])
+            for pc in info.pieces:
+                pc.resolved = None
         maybe_cut()
-        out.extend(_runner(unit, info, fnames))
+        out.extend(_runner(unit, info, fnames, segs))
         out.append("")
     return "\n".join(out) + "\n", line_locs
 
@@ -503,7 +518,20 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     return True
 
 
-def _runner(unit: Unit, info: PouInfo, fnames: list[str]) -> list[str]:
+def _runner(unit: Unit, info: PouInfo, fnames: list[str],
+            segs: list[int | None] | None = None) -> list[str]:
+    if segs is not None and any(s is not None for s in segs):
+        # native segments (plcrt.compiler.native): one call per run of
+        # lowered pieces, the Python piece functions for the others
+        lines = [f"def {info.fname}(L):"]
+        prev: int | None = None
+        for fname, seg in zip(fnames, segs):
+            if seg is None:
+                lines.append(f"    {fname}(L)")
+            elif seg != prev:
+                lines.append(f"    _nseg{seg}()")
+            prev = seg
+        return lines
     if not info.flow and len(fnames) == 1:
         # perf: a block of one piece is that piece (one call less per run)
         return [f"{info.fname} = {fnames[0]}"]
@@ -577,6 +605,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 spec.emit(gen, insn, resolver, *ops)
             else:
                 spec.emit(gen, *ops)
+            if piece.resolved is not None:
+                piece.resolved.append((insn.mnemonic, ops))
         except (CodegenError, ResolveError) as e:
             gen.lines, gen.depth, gen.indent, gen.pending = saved
             if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):

@@ -46,7 +46,7 @@ from .pid import make_loops
 from .pulse import make_outputs
 from .ports import attach_devices, make_ports
 from .netjobs import make_ethernet, netr_netw
-from .values import (Duration, check_load_options, check_parsed_inputs, scan_number,
+from .values import (BACKENDS, Duration, check_load_options, check_parsed_inputs, scan_number,
                      scan_total, source_items)
 
 if TYPE_CHECKING:
@@ -70,8 +70,8 @@ class Plc(AddressAccess):
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False, library: bool = False,
-                 auto_symbols: bool = False, clock: Any = None, _entry: Any = None,
-                 _template: bool = False) -> None:
+                 auto_symbols: bool = False, clock: Any = None, backend: str = "python",
+                 _entry: Any = None, _template: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
             raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
@@ -81,6 +81,14 @@ class Plc(AddressAccess):
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
                                  f"got {watchdog_ms!r:.40}")
+        if backend not in BACKENDS:
+            raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
+                                 f"got {backend!r:.40}")
+        if backend == "native":
+            from ..compiler.native.jit import available
+            if not available():
+                raise PlcConfigError("backend 'native' needs llvmlite: pip install "
+                                     "'plcrt[native]' (or pip install llvmlite)")
         if not isinstance(program, ir.Program):
             raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
                                  f"plcrt.load(), got {type(program).__name__}")
@@ -104,7 +112,9 @@ class Plc(AddressAccess):
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
                             pace=pace, plant=plant, instrument=instrument, library=library,
-                            clock=clock)
+                            clock=clock, backend=backend)
+        #: the native segments' context over this PLC's buffers, or None
+        self._native: Any = None
         #: network/output coverage and breakpoints (``instrument=True`` only)
         self.coverage: CoverageMap | None = CoverageMap() if instrument else None
         #: callables ``fn(plc)`` run after every scan (traces, test harness)
@@ -230,7 +240,8 @@ class Plc(AddressAccess):
         with gc_paused():
             self.unit, self.source, self.line_locs = compile_program(
                 program, self.model, symbols=symbols, system_symbols=system_symbols,
-                setup=setup, probes=self.coverage, library=library)
+                setup=setup, probes=self.coverage, library=library,
+                native=self._config["backend"] == "native")
             try:
                 codes = compile_chunks(self.source, self.unit.chunks,
                                        f"<plcrt {program.file}>")
@@ -244,6 +255,11 @@ class Plc(AddressAccess):
         self._bindings = self.unit.bindings
         self._entry = Entry(program, self.unit, self.source, self.line_locs, codes, self,
                             self.diagnostics[before:], self._warned - warned)
+        plan = self.unit.native
+        if plan is not None and plan.names:
+            from ..compiler.native.jit import NativeCode
+            self._entry.native = NativeCode(plan.ir, plan.names)
+            plan.functions = []      # the IR text is compiled (and cached on disk)
 
     def _cached_entry(self, program: ir.Program, auto_diags: list[Diagnostic]) -> Entry:
         """The compiled program for this PLC's options, from the program
@@ -251,7 +267,8 @@ class Plc(AddressAccess):
         cfg = self._config
         key = program_key(program, cpu=self.model.name, symbols=cfg["symbols"],
                           system_symbols=cfg["system_symbols"], plant=cfg["plant"],
-                          instrument=cfg["instrument"], library=cfg["library"])
+                          instrument=cfg["instrument"], library=cfg["library"],
+                          backend=cfg["backend"])
         entry = programs.get(key, program)
         if entry is None:
             try:
@@ -296,9 +313,35 @@ class Plc(AddressAccess):
         ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
                   _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
         ns.update(self._bindings)
+        if entry.native is not None:
+            self._native = entry.native.bind(self._native_buffers())
+            ns.update({f"_nseg{k}": call for k, call in enumerate(self._native.calls)})
         for code in entry.codes:
             exec(code, ns)  # noqa: S102 - source built only from validated numbers
         self._ns = ns
+
+    def _native_buffers(self) -> dict[str, Any]:
+        """The buffers the native segments reach (plcrt.compiler.native.lower.SLOTS)."""
+        bufs: dict[str, Any] = dict(self.mem.areas)
+        t = self.timers
+        bufs.update(T_RUN=t.running, T_PRE=t.preset, T_D100=t.d100_buf)
+        return bufs
+
+    @property
+    def backend(self) -> dict[str, Any]:
+        """How the program runs: ``name`` (``"python"`` or ``"native"``) and,
+        for native, ``pieces`` run as machine code, ``python`` (block,
+        network, reason) of the pieces left in Python, ``segments``,
+        ``compile_s`` and ``cached`` (machine code from the disk cache)."""
+        name = self._config["backend"]
+        plan = self.unit.native
+        if name != "native" or plan is None:
+            return {"name": name}
+        code = self._entry.native
+        return {"name": name, "pieces": plan.pieces, "python": list(plan.python),
+                "segments": len(plan.names),
+                "compile_s": code.compile_s if code is not None else 0.0,
+                "cached": bool(code is not None and code.cached)}
 
     # -- time -----------------------------------------------------------
     @property
@@ -792,6 +835,10 @@ class Plc(AddressAccess):
             b.__dict__.clear()
             b.__dict__.update(state)
         dst.modules = {d.slot: d for d in dst.devices if d.slot is not None}
+        if dst._native is not None:
+            # the timer bank's arrays were replaced by copies: point the
+            # native segments at them
+            dst._native.point(dst._native_buffers())
         dst._int_l[:] = self._int_l
         dst._counted[:] = [dst.hsc[c.number] for c in self._counted]   # HDEF order
         dst._defined[:] = [dst.hsc[c.number] for c in self._defined]

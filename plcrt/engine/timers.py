@@ -38,6 +38,7 @@ keeps only the hidden state (running, preset, previous IN).
 
 from __future__ import annotations
 
+from array import array
 from struct import Struct
 
 _H = Struct(">h")
@@ -68,12 +69,15 @@ class TimerBank:
     def __init__(self, tv: bytearray, tb: bytearray, count: int = 256) -> None:
         self.tv = tv
         self.tb = tb
-        self.running = [False] * count
-        self.preset = [0] * count
+        # running and preset are arrays, not lists: the native backend's
+        # TON (plcrt.compiler.native.lower) reads and writes them in place
+        self.running = bytearray(count)
+        self.preset = array("h", bytes(2 * count))
         self.prev_in = [0] * count
         self.kind = [""] * count
         self.res = [resolution_ms(n) for n in range(count)]
         self.d1 = self.d10 = self.d100 = 0  #: ticks since previous scan start
+        self.d100_buf = array("i", [0])     #: d100 for the native backend
         self._fast: set[int] = set()        #: running 1 ms / 10 ms timers
         self.ms1: int | None = None         #: the ms the 1 ms timers are advanced to
 
@@ -82,11 +86,13 @@ class TimerBank:
         """Compute tick deltas and advance running 1 ms / 10 ms timers."""
         if prev_us is None or now_us == prev_us:
             self.d1 = self.d10 = self.d100 = 0
+            self.d100_buf[0] = 0
         else:
             # the 1 ms timers may have been advanced inside the interval already
             self.d1 = now_us // 1000 - (prev_us // 1000 if self.ms1 is None else self.ms1)
             self.d10 = now_us // 10000 - prev_us // 10000
             self.d100 = now_us // 100000 - prev_us // 100000
+        self.d100_buf[0] = self.d100
         self.ms1 = now_us // 1000
         if self._fast:
             for n in list(self._fast):

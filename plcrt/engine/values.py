@@ -367,7 +367,10 @@ def scan_total(scan_us: int, seconds: Any = None, scans: Any = None) -> int:
 
 #: the keyword options of load() besides symbols, data, scan_ms and cpu
 LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols", "library",
-                "max_file_mb", "auto_symbols", "clock")
+                "max_file_mb", "auto_symbols", "clock", "backend")
+
+#: the code generators a program can be loaded with (plcrt.compiler.native)
+BACKENDS = ("python", "native")
 
 _SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
 

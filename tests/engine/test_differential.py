@@ -371,9 +371,10 @@ def _describe_difference(area: str, got: bytes, want: bytes) -> str:
     return shown + (" ..." if len(offsets) > 6 else "")
 
 
-def run_side_by_side(case: Case, instrument: bool = False) -> None:
+def run_side_by_side(case: Case, instrument: bool = False, backend: str = "python") -> None:
     """Run both sides over the case; assert identical memory after each scan."""
-    engine = plcrt.load(case.program, scan_ms=case.scan_ms, instrument=instrument)
+    engine = plcrt.load(case.program, scan_ms=case.scan_ms, instrument=instrument,
+                        backend=backend)
     reference = ReferencePlc(case.program, scan_ms=case.scan_ms)
     for mem in (engine.mem.areas, reference.mem):
         mem["V"][:V_BYTES] = case.initial_v
@@ -530,6 +531,23 @@ def test_probed_engine_matches_reference(case: Case) -> None:
     """The coverage probes (contacts split into load + ALD/OLD, output and
     network marks) never change what a program does, stack overflows included."""
     run_side_by_side(case, instrument=True)
+
+
+@settings(max_examples=300, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(case=cases())
+@example(Case(STACK_OVERFLOW, ((0, 0, 2),)))
+@example(Case(MATH_EDGES, ((0, 0, 3),), initial_v=bytes([0x80, 0, 0, 0x80, 0, 0, 0, 0,
+                                                           0x80, 0, 0, 0])))
+@example(Case(TIMER_COUNTER, ((1, 0, 3), (0, 0, 2), (1, 0, 4), (3, 0, 1), (1, 0, 12)),
+              scan_ms=50))
+@example(Case(_prog("LD I0.0\nTON T37, 32767\nLDW= T37, 32767\n= Q0.0"), ((1, 0, 57),),
+              scan_ms=60000))
+def test_native_engine_matches_reference(case: Case) -> None:
+    """The native backend (machine code for the pieces it lowers, Python for
+    the others, in one scan) computes what the reference does, scan by scan."""
+    pytest.importorskip("llvmlite")
+    run_side_by_side(case, backend="native")
 
 
 # Regression: an early version of the contact-run folding (Gen.combine) turned

@@ -1,0 +1,474 @@
+"""Lower checked network pieces to LLVM IR text for the native backend.
+
+One table maps a mnemonic to its lowering (:data:`LOWER`), as
+:mod:`plcrt.isa.registry` maps it to its Python emitter; each lowering
+mirrors the semantics of that emitter byte for byte (the differential tests
+run every program on both backends and compare the memory image after every
+scan).  A piece with anything outside the table (an instruction, an operand
+area, a stack depth) is not lowered: :class:`NotLowered` says why, and the
+piece runs as Python.
+
+What the generated IR may contain: only integers computed here from resolved
+operands (offsets, masks, constants) and names built from counters.  No text
+from the program ever reaches it.
+
+Memory is the PLC's own image: every segment function takes one argument, a
+pointer to a table of buffer addresses (:data:`SLOTS`), and reads and writes
+the bytes in program order, as the Python code does.  Boxes (moves, math)
+run only with power flow: their stores are written as ``select`` between the
+new and the old byte, which keeps each piece one basic block (cheap to
+compile, and the same bytes as a conditional store).
+
+This module is pure Python (no llvmlite): :mod:`.jit` compiles its output.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from ..emit import VALUE_WIDTH, const_expr
+from ..operands import Addr, Const, Pointer
+from ...engine.timers import MAX_CV, resolution_ms
+
+#: the buffers a segment can reach, in the order of the context table
+SLOTS = ("I", "Q", "M", "V", "SM", "S", "TV", "TB", "CV", "CB", "AC", "AI", "AQ",
+         "T_RUN", "T_PRE", "T_D100")
+SLOT = {name: i for i, name in enumerate(SLOTS)}
+
+#: operand areas a native piece may read and write directly (L is per call,
+#: HC is brought up to date by the engine, the immediate forms reach terminals)
+AREAS = {"I", "Q", "M", "V", "SM", "S", "T", "C", "AC", "AI", "AQ"}
+
+MAX_STACK = 9
+
+
+class NotLowered(Exception):
+    """The piece cannot run natively (the reason is reported by ``plcrt dump``)."""
+
+
+class Fn:
+    """One LLVM function under construction: SSA names, the logic stack as a
+    list of ``i1`` values, and the buffer pointers it loads at its entry."""
+
+    def __init__(self) -> None:
+        self.body: list[str] = []
+        self.stack: list[str] = []
+        self.slots: set[str] = set()
+        self._n = 0
+
+    # -- SSA -------------------------------------------------------------
+    def t(self) -> str:
+        self._n += 1
+        return f"%v{self._n}"
+
+    def op(self, text: str) -> str:
+        """Append ``%new = text`` and return the new name."""
+        name = self.t()
+        self.body.append(f"  {name} = {text}")
+        return name
+
+    def stmt(self, text: str) -> None:
+        self.body.append(f"  {text}")
+
+    # -- stack -------------------------------------------------------------
+    def push(self, v: str) -> None:
+        if len(self.stack) >= MAX_STACK:
+            raise NotLowered("the logic stack overflows (the bottom level is lost)")
+        self.stack.append(v)
+
+    @property
+    def top(self) -> str:
+        if not self.stack:
+            raise NotLowered("the logic stack is empty")
+        return self.stack[-1]
+
+    def level(self, n: int) -> str:
+        if len(self.stack) <= n:
+            raise NotLowered("the logic stack holds too few levels")
+        return self.stack[-1 - n]
+
+    # -- memory ------------------------------------------------------------
+    def base(self, slot: str) -> str:
+        self.slots.add(slot)
+        return f"%b{SLOT[slot]}"
+
+    def at(self, slot: str, off: int) -> str:
+        return self.op(f"getelementptr i8, ptr {self.base(slot)}, i64 {int(off)}")
+
+    def load8(self, slot: str, off: int) -> str:
+        return self.op(f"load i8, ptr {self.at(slot, off)}, align 1")
+
+    def store8(self, slot: str, off: int, v: str) -> None:
+        self.stmt(f"store i8 {v}, ptr {self.at(slot, off)}, align 1")
+
+    def emit(self, name: str) -> str:
+        """The function's text."""
+        head = [f"define void @{name}(ptr %ctx) {{", "entry:"]
+        for slot in sorted(self.slots, key=SLOT.__getitem__):
+            k = SLOT[slot]
+            head.append(f"  %c{k} = getelementptr ptr, ptr %ctx, i64 {k}")
+            head.append(f"  %b{k} = load ptr, ptr %c{k}, align 8")
+        return "\n".join(head + self.body + ["  ret void", "}", ""])
+
+
+# -- operands ------------------------------------------------------------------
+
+def _area(op: Any) -> str:
+    if not isinstance(op, Addr) or op.area not in AREAS:
+        what = getattr(op, "area", type(op).__name__)
+        raise NotLowered(f"operand area {what} is not reached natively")
+    return op.area
+
+
+def rbit(f: Fn, op: Any) -> str:
+    """``i1`` value of a bit operand."""
+    area = _area(op)
+    if area in ("T", "C"):
+        slot, byte, bit = ("TB" if area == "T" else "CB"), op.offset >> 3, op.offset & 7
+    else:
+        slot, byte, bit = area, op.offset, op.bit
+    v = f.load8(slot, byte)
+    if bit:
+        v = f.op(f"lshr i8 {v}, {int(bit)}")
+    return f.op(f"trunc i8 {v} to i1")
+
+
+def wbit(f: Fn, op: Any, v: str) -> None:
+    """Write ``i1`` ``v`` to a bit operand (T/C bits are not written by ``=``)."""
+    area = _area(op)
+    if area in ("T", "C"):
+        raise NotLowered("timer and counter bits are written by their boxes")
+    old = f.load8(area, op.offset)
+    kept = f.op(f"and i8 {old}, {~(1 << op.bit) & 0xFF}")
+    b = f.op(f"zext i1 {v} to i8")
+    if op.bit:
+        b = f.op(f"shl i8 {b}, {int(op.bit)}")
+    f.store8(area, op.offset, f.op(f"or i8 {kept}, {b}"))
+
+
+def place(op: Any, width: int) -> tuple[str, int]:
+    """Buffer slot and byte offset of a value operand (as Gen._place)."""
+    area = _area(op)
+    if area == "T":
+        return "TV", op.offset * 2
+    if area == "C":
+        return "CV", op.offset * 2
+    if area == "AC":
+        return "AC", op.offset * 4 + 4 - width
+    return area, op.offset
+
+
+#: the LLVM type a value of each kind is computed in (wide enough for the
+#: result of one math step before its range check)
+WIDE = {"B": "i32", "W": "i32", "WU": "i32", "D": "i64", "DU": "i64"}
+
+
+def rd(f: Fn, op: Any, kind: str) -> str:
+    """Value of an operand as ``WIDE[kind]`` (B, WU, DU unsigned; W, D signed)."""
+    ty = WIDE[kind]
+    if isinstance(op, Const):
+        if isinstance(op.value, bytes) or op.is_real:
+            raise NotLowered("string and REAL constants are not lowered")
+        return str(int(const_expr(op, kind)))
+    if isinstance(op, Pointer):
+        return str(int(op.value))
+    width = VALUE_WIDTH[kind[0]]
+    slot, off = place(op, width)
+    acc = None
+    for i in range(width):
+        b = f.op(f"zext i8 {f.load8(slot, off + i)} to {ty}")
+        if acc is None:
+            acc = b
+        else:
+            acc = f.op(f"or {ty} {f.op(f'shl {ty} {acc}, 8')}, {b}")
+    assert acc is not None
+    if kind == "W":
+        acc = f.op(f"sext i16 {f.op(f'trunc i32 {acc} to i16')} to i32")
+    elif kind == "D":
+        acc = f.op(f"sext i32 {f.op(f'trunc i64 {acc} to i32')} to i64")
+    return acc
+
+
+def wr(f: Fn, op: Any, kind: str, v: str, cond: str | None) -> None:
+    """Store ``v`` (type ``WIDE[kind]``) big-endian; only where ``cond`` (i1)
+    holds when given (the old bytes are written back otherwise)."""
+    ty = WIDE[kind]
+    width = VALUE_WIDTH[kind[0]]
+    slot, off = place(op, width)
+    for i in range(width):
+        shift = 8 * (width - 1 - i)
+        x = f.op(f"lshr {ty} {v}, {shift}") if shift else v
+        byte = f.op(f"trunc {ty} {x} to i8")
+        if cond is not None:
+            old = f.load8(slot, off + i)
+            byte = f.op(f"select i1 {cond}, i8 {byte}, i8 {old}")
+        f.store8(slot, off + i, byte)
+
+
+def set_flags(f: Fn, cond: str, bits: str) -> None:
+    """``SM1 := SM1 & 248 | bits`` where ``cond`` holds (``bits``: i8)."""
+    old = f.load8("SM", 1)
+    new = f.op(f"or i8 {f.op(f'and i8 {old}, 248')}, {bits}")
+    f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
+
+
+def zn_bits(f: Fn, ty: str, r: str, signed: bool = True) -> str:
+    """i8 of SM1.0 (zero) and, for signed kinds, SM1.2 (negative) of ``r``."""
+    z = f.op(f"zext i1 {f.op(f'icmp eq {ty} {r}, 0')} to i8")
+    if not signed:
+        return z
+    n = f.op(f"zext i1 {f.op(f'icmp slt {ty} {r}, 0')} to i8")
+    return f.op(f"or i8 {z}, {f.op(f'shl i8 {n}, 2')}")
+
+
+# -- the table -------------------------------------------------------------------
+
+Lowering = Callable[..., None]
+LOWER: dict[str, Lowering] = {}
+
+
+def lowers(*mnemonics: str) -> Callable[[Lowering], Lowering]:
+    def deco(fn: Lowering) -> Lowering:
+        for m in mnemonics:
+            LOWER[m] = fn
+        return fn
+    return deco
+
+
+def _contact(how: str, inverted: bool) -> Lowering:
+    def lower(f: Fn, op: Any) -> None:
+        v = rbit(f, op)
+        if inverted:
+            v = f.op(f"xor i1 {v}, true")
+        if how == "push":
+            f.push(v)
+        else:
+            f.stack[-1] = f.op(f"{how} i1 {f.top}, {v}")
+    return lower
+
+
+for _m, _how, _inv in (("LD", "push", False), ("LDN", "push", True), ("A", "and", False),
+                       ("AN", "and", True), ("O", "or", False), ("ON", "or", True)):
+    LOWER[_m] = _contact(_how, _inv)
+
+
+@lowers("NOT")
+def _not(f: Fn) -> None:
+    f.stack[-1] = f.op(f"xor i1 {f.top}, true")
+
+
+def _fold(op: str) -> Lowering:
+    def lower(f: Fn) -> None:
+        below = f.level(1)
+        top = f.stack.pop()
+        f.stack[-1] = f.op(f"{op} i1 {below}, {top}")
+    return lower
+
+
+LOWER["ALD"] = _fold("and")
+LOWER["OLD"] = _fold("or")
+
+
+@lowers("LPS")
+def _lps(f: Fn) -> None:
+    f.push(f.top)
+
+
+@lowers("LRD")
+def _lrd(f: Fn) -> None:
+    f.stack[-1] = f.level(1)
+
+
+@lowers("LPP")
+def _lpp(f: Fn) -> None:
+    f.level(1)
+    f.stack.pop()
+
+
+@lowers("LDS")
+def _lds(f: Fn, n: Any) -> None:
+    if not isinstance(n, Const) or not isinstance(n.value, int):
+        raise NotLowered("the level is not a constant")
+    f.push(f.level(int(n.value)))
+
+
+@lowers("NOP")
+def _nop(f: Fn, *_ops: Any) -> None:
+    pass
+
+
+@lowers("=")
+def _assign(f: Fn, op: Any) -> None:
+    wbit(f, op, f.top)
+
+
+def _range(value: int) -> Lowering:
+    """S/R of n consecutive bits where the top is 1 (as isa.bitlogic._range)."""
+    def lower(f: Fn, op: Any, n: Any) -> None:
+        if not isinstance(n, Const) or not isinstance(n.value, int):
+            raise NotLowered("the bit count is not a constant")
+        area = _area(op)
+        if area in ("T", "C"):
+            raise NotLowered("S/R of timers and counters runs in their banks")
+        top = f.top
+        start = op.offset * 8 + op.bit
+        end = start + int(n.value)
+        bit = start
+        while bit < end:
+            byte, b = divmod(bit, 8)
+            span = min(8 - b, end - bit)
+            mask = ((1 << span) - 1) << b
+            old = f.load8(area, byte)
+            new = f.op(f"or i8 {old}, {mask}" if value else f"and i8 {old}, {~mask & 0xFF}")
+            f.store8(area, byte, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+            bit += span
+    return lower
+
+
+LOWER["S"] = _range(1)
+LOWER["R"] = _range(0)
+
+# compares (isa.compare): bytes unsigned, words and double words signed
+_REL = {"=": "eq", "<>": "ne"}
+_SIGNED = {"<": "slt", "<=": "sle", ">": "sgt", ">=": "sge"}
+_UNSIGNED = {"<": "ult", "<=": "ule", ">": "ugt", ">=": "uge"}
+
+
+def _compare(prefix: str, width: str, rel: str) -> Lowering:
+    kind = width
+    cond = _REL.get(rel) or (_UNSIGNED if width == "B" else _SIGNED)[rel]
+
+    def lower(f: Fn, a: Any, b: Any) -> None:
+        x, y = rd(f, a, kind), rd(f, b, kind)
+        v = f.op(f"icmp {cond} {WIDE[kind]} {x}, {y}")
+        if prefix == "LD":
+            f.push(v)
+        else:
+            f.stack[-1] = f.op(f"{'and' if prefix == 'A' else 'or'} i1 {f.top}, {v}")
+    return lower
+
+
+for _p in ("LD", "A", "O"):
+    for _w in ("B", "W", "D"):
+        for _r in ("=", "<>", "<", "<=", ">", ">="):
+            LOWER[f"{_p}{_w}{_r}"] = _compare(_p, _w, _r)
+
+
+def _move(kind: str) -> Lowering:
+    def lower(f: Fn, src: Any, dst: Any) -> None:
+        wr(f, dst, kind, rd(f, src, kind), f.top)
+    return lower
+
+
+LOWER["MOVB"] = _move("B")
+LOWER["MOVW"] = _move("WU")
+LOWER["MOVD"] = _move("DU")
+
+W_RANGE = (-32768, 32767)
+D_RANGE = (-2**31, 2**31 - 1)
+
+
+def _binop(kind: str, op: str, rng: tuple[int, int]) -> Lowering:
+    """``OUT := OUT op IN1`` with the SMB1 flags; on overflow SM1.1 and the
+    output unchanged (isa.math_int._binop / Gen.store_checked)."""
+    ty = WIDE[kind]
+
+    def lower(f: Fn, a: Any, out: Any) -> None:
+        top = f.top
+        r = f.op(f"{op} {ty} {rd(f, out, kind)}, {rd(f, a, kind)}")
+        lo = f.op(f"icmp sge {ty} {r}, {rng[0]}")
+        hi = f.op(f"icmp sle {ty} {r}, {rng[1]}")
+        ok = f.op(f"and i1 {lo}, {hi}")
+        wr(f, out, kind, r, f.op(f"and i1 {top}, {ok}"))
+        bits = f.op(f"select i1 {ok}, i8 {zn_bits(f, ty, r)}, i8 2")
+        set_flags(f, top, bits)
+    return lower
+
+
+LOWER["+I"] = _binop("W", "add", W_RANGE)
+LOWER["-I"] = _binop("W", "sub", W_RANGE)
+LOWER["*I"] = _binop("W", "mul", W_RANGE)
+LOWER["+D"] = _binop("D", "add", D_RANGE)
+LOWER["-D"] = _binop("D", "sub", D_RANGE)
+LOWER["*D"] = _binop("D", "mul", D_RANGE)
+
+
+def _incdec(kind: str, delta: int, lo: int, hi: int) -> Lowering:
+    """INC/DEC wrap around; SM1.1 on the wrap (isa.math_int._incdec)."""
+    ty = WIDE[kind]
+    width_bits = 8 * VALUE_WIDTH[kind[0]]
+    signed = lo < 0
+
+    def lower(f: Fn, out: Any) -> None:
+        top = f.top
+        r = f.op(f"add {ty} {rd(f, out, kind)}, {delta}")
+        a = f.op(f"icmp sge {ty} {r}, {lo}")
+        b = f.op(f"icmp sle {ty} {r}, {hi}")
+        ok = f.op(f"and i1 {a}, {b}")
+        # the wrapped value: the low bits, read back as the kind's range
+        low = f.op(f"trunc {ty} {r} to i{width_bits}")
+        ext = "sext" if signed else "zext"
+        wrapped = f.op(f"{ext} i{width_bits} {low} to {ty}")
+        zn = zn_bits(f, ty, wrapped, signed)
+        bits = f.op(f"select i1 {ok}, i8 {zn}, i8 {f.op(f'or i8 {zn}, 2')}")
+        set_flags(f, top, bits)
+        wr(f, out, kind, wrapped, top)
+    return lower
+
+
+LOWER["INCB"] = _incdec("B", 1, 0, 255)
+LOWER["DECB"] = _incdec("B", -1, 0, 255)
+LOWER["INCW"] = _incdec("W", 1, *W_RANGE)
+LOWER["DECW"] = _incdec("W", -1, *W_RANGE)
+LOWER["INCD"] = _incdec("D", 1, *D_RANGE)
+LOWER["DECD"] = _incdec("D", -1, *D_RANGE)
+
+
+@lowers("TON")
+def _ton(f: Fn, t: Any, pt: Any) -> None:
+    """TON of a 100 ms timer (engine.timers.TimerBank.ton, its full path).
+
+    IN = 0: stopped, value and bit cleared.  IN = 1: a stopped timer starts
+    from its value; a running one adds the 100 ms ticks of this scan
+    (capped at 32767).  The bit is CV >= PT.  The 1 ms and 10 ms timers
+    are advanced by the engine at the scan start: they stay in Python.
+    """
+    if not isinstance(t, Addr) or t.area != "T" or resolution_ms(t.offset) != 100:
+        raise NotLowered("only 100 ms timers run natively")
+    n = t.offset
+    en = f.top
+    p = rd(f, pt, "W")
+    f.stmt(f"store i16 {f.op(f'trunc i32 {p} to i16')}, "
+           f"ptr {f.at('T_PRE', 2 * n)}, align 1")
+    run_b = f.load8("T_RUN", n)
+    run = f.op(f"icmp ne i8 {run_b}, 0")
+    cv = rd(f, t, "W")
+    d100 = f.op(f"load i32, ptr {f.base('T_D100')}, align 4")
+    adv = f.op(f"add i32 {cv}, {d100}")
+    capped = f.op(f"select i1 {f.op(f'icmp sgt i32 {adv}, {MAX_CV}')}, i32 {MAX_CV}, i32 {adv}")
+    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
+    cvn = f.op(f"select i1 {en}, i32 {on}, i32 0")
+    bit = f.op(f"and i1 {en}, {f.op(f'icmp sge i32 {cvn}, {p}')}")
+    f.store8("T_RUN", n, f.op(f"zext i1 {en} to i8"))
+    wr(f, t, "W", cvn, None)
+    wbit_tc(f, "TB", n, bit)
+
+
+def wbit_tc(f: Fn, slot: str, n: int, v: str) -> None:
+    """Write a timer or counter bit (bit ``n`` of the TB/CB bitmap)."""
+    old = f.load8(slot, n >> 3)
+    kept = f.op(f"and i8 {old}, {~(1 << (n & 7)) & 0xFF}")
+    b = f.op(f"zext i1 {v} to i8")
+    if n & 7:
+        b = f.op(f"shl i8 {b}, {n & 7}")
+    f.store8(slot, n >> 3, f.op(f"or i8 {kept}, {b}"))
+
+
+def lower_piece(f: Fn, insns: list[tuple[str, list[Any]]]) -> None:
+    """Lower one piece's resolved instructions into ``f`` (raises NotLowered)."""
+    for mnemonic, ops in insns:
+        fn = LOWER.get(mnemonic)
+        if fn is None:
+            raise NotLowered(f"{mnemonic} is not lowered")
+        fn(f, *ops)
+    f.stack.clear()

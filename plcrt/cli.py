@@ -131,6 +131,10 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
                    help="give each symbol that no symbol table defines a free M (bits) or V "
                         "address, reported as warnings (for exports published without "
                         "their symbol table)")
+    p.add_argument("--backend", choices=("python", "native"), default=None,
+                   help="code generator: python (default; or $PLCRT_BACKEND) or native "
+                        "(machine code through llvmlite for the pieces it covers, "
+                        "pip install 'plcrt[native]'; docs/native.md)")
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="refuse program, symbol and data files larger than this "
                         "(default 16 MB, far above any S7-200 program)")
@@ -213,7 +217,8 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 encoding=getattr(args, "encoding", None),
                 max_file_mb=getattr(args, "max_file_mb", None),
                 auto_symbols=getattr(args, "auto_symbols", False),
-                clock=getattr(args, "clock", None))
+                clock=getattr(args, "clock", None),
+                backend=getattr(args, "backend", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:

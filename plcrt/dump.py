@@ -40,6 +40,7 @@ def render_dump(plc: Plc) -> str:
     out = [f"# plcrt dump of {', '.join(files) or plc.program.file}",
            "# Generated Python, for reading only: each '# [id] line n:' comment",
            "# shows the STL instruction whose code follows it.", ""]
+    out += _backend_lines(plc)
     last_runner = None
     for i, line in enumerate(lines):
         piece = _PIECE_DEF_RE.match(line)
@@ -110,3 +111,21 @@ def _stl_line(texts: dict[str, list[str]], file: str | None, lineno: int) -> str
 
 
 __all__ = ["render_dump"]
+
+
+def _backend_lines(plc: Plc) -> list[str]:
+    """With the native backend: how many pieces are machine code (the
+    ``_nsegK()`` calls of the block runners) and why the others are not."""
+    info = plc.backend
+    if info["name"] != "native":
+        return []
+    if "pieces" not in info:
+        return ["# native backend: every piece runs as Python (an instrumented program)", ""]
+    out = [f"# native backend: {info['pieces']} pieces run as machine code in "
+           f"{info['segments']} segments (_nsegK() in the block runners); "
+           f"{len(info['python'])} as the Python below"]
+    for block, net, why in info["python"][:50]:
+        out.append(printable(f"#   {block} network {net}: {why}"))
+    if len(info["python"]) > 50:
+        out.append(f"#   ... and {len(info['python']) - 50} more")
+    return out + [""]

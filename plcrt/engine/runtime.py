@@ -20,6 +20,7 @@ wall-clock pace (for demos); it never changes results.
 from __future__ import annotations
 
 import copy
+import os
 import time as _time
 import types
 from pathlib import Path
@@ -70,7 +71,7 @@ class Plc(AddressAccess):
                  system_symbols: dict[str, str] | None = None,
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False, library: bool = False,
-                 auto_symbols: bool = False, clock: Any = None, backend: str = "python",
+                 auto_symbols: bool = False, clock: Any = None, backend: str | None = None,
                  _entry: Any = None, _template: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
@@ -81,6 +82,13 @@ class Plc(AddressAccess):
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
                                  f"got {watchdog_ms!r:.40}")
+        if backend is None:
+            # the environment chooses for programs that do not (a test suite
+            # run on the native backend: PLCRT_BACKEND=native pytest)
+            backend = os.environ.get("PLCRT_BACKEND") or "python"
+            if backend not in BACKENDS:
+                raise PlcConfigError(f"PLCRT_BACKEND must be one of "
+                                     f"{', '.join(BACKENDS)}, got {backend!r:.40}")
         if backend not in BACKENDS:
             raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
                                  f"got {backend!r:.40}")

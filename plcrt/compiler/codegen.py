@@ -47,9 +47,13 @@ class Piece:
     start_depth: int = 0
     index: int = 0
     suffix: str = ""
-    #: (mnemonic, resolved operands) of each instruction, for the native
-    #: backend (recorded only when it is asked for)
-    resolved: list[tuple[str, list[Any]]] | None = None
+    #: (mnemonic, resolved operands, site) of each instruction, for the
+    #: native backend (recorded only when it is asked for); site: the index
+    #: of an EU/ED's edge memory byte, else -1
+    resolved: list[tuple[str, list[Any], int]] | None = None
+    #: logic-stack levels the piece starts with (a loop body inside its
+    #: FOR's network starts with the FOR's enable levels)
+    entry_depth: int = 0
 
 
 @dataclass
@@ -421,6 +425,7 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
                 # shares the FOR's network).
                 for _ in range(info.depth_after.get(loop_body, 0)):
                     gen.push("1")
+                piece.entry_depth = gen.depth
             emit_piece(unit, gen, piece, resolver)
             gen.pending = None  # a value left on the stack at the end is dead
             info.depth_after[piece.index] = gen.depth
@@ -442,8 +447,12 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
         segs = None
         if unit.native is not None:
             from .native import plan_pou
+            edges = unit.hooks.get("edges")
+            if edges is not None and unit.native.edges is None:
+                unit.native.edges = unit.bind(edges, "EM")
             segs = plan_pou(unit.native, p.ident, info.flow,
-                            [(pc.network.number, pc.resolved) for pc in info.pieces])
+                            [(pc.network.number, pc.resolved, pc.entry_depth)
+                             for pc in info.pieces])
             for pc in info.pieces:
                 pc.resolved = None
         maybe_cut()
@@ -520,6 +529,18 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
 
 def _runner(unit: Unit, info: PouInfo, fnames: list[str],
             segs: list[int | None] | None = None) -> list[str]:
+    if info.flow and segs is not None and any(s is not None for s in segs):
+        # native pieces of a block with jumps or loops: each is its own
+        # segment, wrapped as a piece function that falls through
+        wrapped = []
+        lines = []
+        for fname, seg in zip(fnames, segs):
+            if seg is None:
+                wrapped.append(fname)
+            else:
+                lines += [f"def _nw{seg}(L, _f=_nseg{seg}):", "    _f()"]
+                wrapped.append(f"_nw{seg}")
+        return lines + _runner(unit, info, wrapped)
     if segs is not None and any(s is not None for s in segs):
         # native segments (plcrt.compiler.native): one call per run of
         # lowered pieces, the Python piece functions for the others
@@ -606,7 +627,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             else:
                 spec.emit(gen, *ops)
             if piece.resolved is not None:
-                piece.resolved.append((insn.mnemonic, ops))
+                site = len(unit.hooks["edges"]) - 1 if insn.mnemonic in ("EU", "ED") else -1
+                piece.resolved.append((insn.mnemonic, ops, site))
         except (CodegenError, ResolveError) as e:
             gen.lines, gen.depth, gen.indent, gen.pending = saved
             if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):

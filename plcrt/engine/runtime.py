@@ -332,7 +332,9 @@ class Plc(AddressAccess):
         """The buffers the native segments reach (plcrt.compiler.native.lower.SLOTS)."""
         bufs: dict[str, Any] = dict(self.mem.areas)
         t = self.timers
-        bufs.update(T_RUN=t.running, T_PRE=t.preset, T_D100=t.d100_buf)
+        edges = self.unit.native.edges if self.unit.native is not None else None
+        bufs.update(T_RUN=t.running, T_PRE=t.preset, T_D100=t.d100_buf, T_PREV=t.prev_in,
+                    EDGES=self._bindings[edges] if edges else bytearray(1))
         return bufs
 
     @property

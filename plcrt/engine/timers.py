@@ -69,11 +69,11 @@ class TimerBank:
     def __init__(self, tv: bytearray, tb: bytearray, count: int = 256) -> None:
         self.tv = tv
         self.tb = tb
-        # running and preset are arrays, not lists: the native backend's
-        # TON (plcrt.compiler.native.lower) reads and writes them in place
+        # running, preset and prev_in are arrays, not lists: the native
+        # backend's TON and R (plcrt.compiler.native.lower) use them in place
         self.running = bytearray(count)
         self.preset = array("h", bytes(2 * count))
-        self.prev_in = [0] * count
+        self.prev_in = bytearray(count)
         self.kind = [""] * count
         self.res = [resolution_ms(n) for n in range(count)]
         self.d1 = self.d10 = self.d100 = 0  #: ticks since previous scan start

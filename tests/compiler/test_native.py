@@ -69,7 +69,8 @@ ROWS = {
     "NOP": "LD I0.0\nNOP 0\n= Q0.0",
     "=": "LD I0.1\n= V30.7\n= M1.3\n= S0.1",
     "S": "LD I0.0\nS M0.5, 12\nS V31.0, 1",
-    "R": "LD I0.1\nR M0.5, 5\nLD I0.7\nR V31.0, 1\nR M0.0, 16",
+    "R": "LD I0.1\nR M0.5, 5\nLD I0.7\nR V31.0, 1\nR M0.0, 16\n"
+         "LD I0.0\nTON T37, +50\nTON T38, +2\nLD I0.1\nR T37, 2",
     "MOVB": "LD I0.0\nMOVB VB1, VB20\nMOVB 16#FE, QB1\nMOVB VB2, AC0",
     "MOVW": "LD I0.0\nMOVW VW1, VW22\nMOVW -2, VW24\nMOVW VW0, T37\nMOVW AC0, C3",
     "MOVD": "LD I0.1\nMOVD VD8, VD26\nMOVD &VB10, VD30\nMOVD VD12, AC1\nMOVD AC1, VD34",
@@ -82,6 +83,9 @@ ROWS = {
     "INCB": "LD SM0.0\nINCB VB17\nINCB VB16", "DECB": "LD SM0.0\nDECB VB6\nDECB VB16",
     "INCW": "LD SM0.0\nINCW VW0\nINCW VW4", "DECW": "LD SM0.0\nDECW VW2\nDECW VW6",
     "INCD": "LD SM0.0\nINCD VD8", "DECD": "LD SM0.0\nDECD VD12\nDECD VD4",
+    "EU": "LD I0.0\nEU\n= Q0.0\nLD I0.1\nA I0.0\nEU\nINCW VW30",
+    "ED": "LD I0.0\nED\n= Q0.0\nLDN I0.1\nED\nINCW VW30",
+    "MOVR": "LD I0.0\nMOVR VD8, VD20\nMOVR 1.5, VD24\nMOVR -3.4e38, AC1\nMOVR 7, VD28",
     "TON": "LD I0.0\nTON T37, +3\nLD T37\n= Q0.0\nLDN I0.0\nTON T38, VW2\n"
            "LD I0.1\nTON T101, +1",
 }
@@ -114,7 +118,7 @@ def test_lowered_instruction_matches_python(mnemonic: str) -> None:
 
 def test_pieces_outside_the_table_fall_back_per_network_with_a_reason() -> None:
     text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\n= Q0.0\n"
-            "Network 2\nLD I0.0\nEU\n= Q0.1\nNetwork 3\nLD I0.0\nTOF T40, +5\n"
+            "Network 2\nLD I0.0\nLD I0.1\nCTU C3, +4\nNetwork 3\nLD I0.0\nTOF T40, +5\n"
             "Network 4\nLD I0.1\nTON T33, +5\nNetwork 5\nLD SM0.0\nCALL SBR_0, VW0\n"
             "Network 6\nLD I0.1\n= Q0.2\nEND_ORGANIZATION_BLOCK\n"
             "SUBROUTINE_BLOCK SBR_0:SBR0\nVAR_INPUT\nx:INT;\nEND_VAR\nBEGIN\nNetwork 1\n"
@@ -123,7 +127,7 @@ def test_pieces_outside_the_table_fall_back_per_network_with_a_reason() -> None:
     info = nat.backend
     reasons = {(b, n): why for b, n, why in info["python"]}
     assert reasons == {
-        ("OB1", 2): "EU is not lowered",
+        ("OB1", 2): "CTU is not lowered",
         ("OB1", 3): "TOF is not lowered",
         ("OB1", 4): "only 100 ms timers run natively",
         ("OB1", 5): "CALL is not lowered",
@@ -134,12 +138,21 @@ def test_pieces_outside_the_table_fall_back_per_network_with_a_reason() -> None:
     assert "_nseg0()" in nat.source and "_nseg2()" in nat.source
 
 
-def test_blocks_with_jumps_stay_python() -> None:
-    text = _ob1("LD I0.0\nJMP 1", "LD SM0.0\nINCW VW0", "LBL 1", "LD I0.1\n= Q0.0")
+def test_blocks_with_jumps_and_loops_run_their_other_pieces_natively() -> None:
+    """A jump may land on any piece: each lowered piece of such a block is
+    its own segment; the jumps, labels and loops stay Python."""
+    text = _ob1("LD I0.0\nJMP 1", "LD SM0.0\nINCW VW0", "LBL 1", "LD I0.1\n= Q0.0",
+                "LD SM0.0\nFOR VW10, +1, +3", "LD SM0.0\nINCW VW2", "NEXT",
+                "LD I0.0\nFOR VW12, +1, +2\nINCW VW4\nNEXT")
     py, nat = _run_both(text, scans=8)
-    assert nat.backend["pieces"] == 0
-    assert {why for *_, why in nat.backend["python"]} == \
-        {"the block has jumps, loops or SCR segments"}
+    info = nat.backend
+    assert info["python"] == [("OB1", 1, "JMP is not lowered"), ("OB1", 3, "LBL is not lowered"),
+                              ("OB1", 5, "FOR is not lowered"), ("OB1", 7, "NEXT is not lowered"),
+                              ("OB1", 8, "FOR is not lowered"), ("OB1", 8, "NEXT is not lowered")]
+    # networks 2, 4 and 6 (a loop body in a network of its own: it starts
+    # with the FOR's enable on the stack)
+    assert info["pieces"] == info["segments"] == 3
+    assert nat.mem.areas["V"][3] == 24 and nat.mem.areas["V"][5] == 8   # I0.0 on in 4 scans
 
 
 def test_instrumented_program_runs_as_python() -> None:

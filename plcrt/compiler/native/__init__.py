@@ -2,12 +2,12 @@
 
 ``plcrt.load(..., backend="native")`` compiles the pieces that
 :mod:`.lower` can lower (bit logic, the logic stack, byte/word/double-word
-compares and moves, integer math with its flags, 100 ms TON) to machine
-code; consecutive lowered pieces of a block become one *segment*, one call
-from the block's runner.  Everything else -- a piece with a call, a jump or
-loop in its block, an instruction outside the table, an L-memory operand,
-an instrumented program (coverage, breakpoints) -- runs as the Python
-backend's code, which is generated for every piece in either case (``plcrt
+compares and moves, integer math with its flags, edges, 100 ms TON and
+timer resets) to machine code; consecutive lowered pieces of a block become
+one *segment*, one call from the block's runner.  Everything else -- a piece
+with a call, a jump, a label or a loop, an instruction outside the table, an
+L-memory operand, an instrumented program (coverage, breakpoints) -- runs as
+the Python backend's code, which is generated for every piece in either case (``plcrt
 dump`` shows it).  Both backends give the same memory image after every
 scan: the differential tests compare them.
 
@@ -40,6 +40,8 @@ class NativePlan:
     names: list[str] = field(default_factory=list)
     pieces: int = 0
     python: list[tuple[str, int, str]] = field(default_factory=list)
+    #: the binding name of the program's EU/ED edge memory, if it has any
+    edges: str | None = None
 
     @property
     def ir(self) -> str:
@@ -47,29 +49,26 @@ class NativePlan:
 
 
 def plan_pou(plan: NativePlan, block: str, flow: bool,
-             pieces: list[tuple[int, list[tuple[str, list[Any]]] | None]]) -> list[int | None]:
+             pieces: list[tuple[int, list[tuple[str, list[Any], int]], int]]
+             ) -> list[int | None]:
     """Group the pieces of one block into segments.
 
-    ``pieces``: per piece, its network number and its resolved instructions
-    (None: the piece could not be recorded, it stays Python).  Returns, per
-    piece, the segment index it belongs to or None (Python).  Only blocks
-    without jumps and loops are lowered: their runner is a straight list of
-    calls.
+    ``pieces``: per piece, its network number, its resolved instructions and
+    the stack levels it starts with (a loop body that shares its FOR's
+    network starts with the FOR's enable levels, all 1).  Returns, per piece, the segment index it belongs to or None
+    (Python).  In a block without jumps and loops consecutive lowered pieces
+    share one segment (the runner is a straight list of calls); in a block
+    with them each lowered piece is its own segment, since a jump may land
+    on any piece.  The pieces that hold the jumps, labels and loops
+    themselves stay Python.
     """
     out: list[int | None] = [None] * len(pieces)
-    if flow:
-        for net, _ in pieces:
-            plan.python.append((block, net, "the block has jumps, loops or SCR segments"))
-        return out
     seg: Fn | None = None
-    for i, (net, insns) in enumerate(pieces):
-        if insns is None:
-            plan.python.append((block, net, "not recorded"))
-            seg = _close(plan, seg)
-            continue
+    for i, (net, insns, depth) in enumerate(pieces):
         f = seg if seg is not None else Fn()
         mark = (len(f.body), set(f.slots))
         try:
+            f.stack = ["true"] * depth
             lower_piece(f, insns)
         except NotLowered as e:
             del f.body[mark[0]:]
@@ -81,6 +80,8 @@ def plan_pou(plan: NativePlan, block: str, flow: bool,
         seg = f
         plan.pieces += 1
         out[i] = len(plan.names)
+        if flow:
+            seg = _close(plan, seg)
     _close(plan, seg)
     return out
 

@@ -24,6 +24,7 @@ This module is pure Python (no llvmlite): :mod:`.jit` compiles its output.
 
 from __future__ import annotations
 
+import struct
 from typing import Any, Callable
 
 from ..emit import VALUE_WIDTH, const_expr
@@ -32,7 +33,7 @@ from ...engine.timers import MAX_CV, resolution_ms
 
 #: the buffers a segment can reach, in the order of the context table
 SLOTS = ("I", "Q", "M", "V", "SM", "S", "TV", "TB", "CV", "CB", "AC", "AI", "AQ",
-         "T_RUN", "T_PRE", "T_D100")
+         "T_RUN", "T_PRE", "T_D100", "T_PREV", "EDGES")
 SLOT = {name: i for i, name in enumerate(SLOTS)}
 
 #: operand areas a native piece may read and write directly (L is per call,
@@ -55,6 +56,7 @@ class Fn:
         self.stack: list[str] = []
         self.slots: set[str] = set()
         self._n = 0
+        self.site = -1    #: the instruction's EU/ED edge memory byte
 
     # -- SSA -------------------------------------------------------------
     def t(self) -> str:
@@ -308,8 +310,11 @@ def _range(value: int) -> Lowering:
         if not isinstance(n, Const) or not isinstance(n.value, int):
             raise NotLowered("the bit count is not a constant")
         area = _area(op)
+        if area == "T" and not value:
+            _reset_timers(f, op.offset, int(n.value))
+            return
         if area in ("T", "C"):
-            raise NotLowered("S/R of timers and counters runs in their banks")
+            raise NotLowered("S/R of counters runs in their bank")
         top = f.top
         start = op.offset * 8 + op.bit
         end = start + int(n.value)
@@ -327,6 +332,44 @@ def _range(value: int) -> Lowering:
 
 LOWER["S"] = _range(1)
 LOWER["R"] = _range(0)
+
+
+def _reset_timers(f: Fn, first: int, count: int) -> None:
+    """``R Tn, k`` where the top is 1 (TimerBank.reset of each): stopped,
+    previous IN cleared, value and bit 0.  Only 100 ms timers: the 1 and
+    10 ms ones are also struck off the engine's list of running timers."""
+    if any(resolution_ms(n) != 100 for n in range(first, first + count)):
+        raise NotLowered("R of 1 ms or 10 ms timers runs in their bank")
+    top = f.top
+    for n in range(first, first + count):
+        for slot in ("T_RUN", "T_PREV"):
+            old = f.load8(slot, n)
+            f.store8(slot, n, f.op(f"select i1 {top}, i8 0, i8 {old}"))
+        wr(f, Addr("T", n, 0, 0), "W", "0", top)
+        old = f.load8("TB", n >> 3)
+        new = f.op(f"and i8 {old}, {~(1 << (n & 7)) & 0xFF}")
+        f.store8("TB", n >> 3, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+
+
+def _edge(rising: bool) -> Lowering:
+    """EU/ED (isa.bitlogic._edge): the edge memory byte keeps the last top
+    (2 before the first execution, which never reports an edge)."""
+    def lower(f: Fn) -> None:
+        if f.site < 0:
+            raise NotLowered("the edge has no memory byte")
+        top = f.top
+        prev = f.load8("EDGES", f.site)
+        f.store8("EDGES", f.site, f.op(f"zext i1 {top} to i8"))
+        if rising:
+            f.stack[-1] = f.op(f"and i1 {top}, {f.op(f'icmp eq i8 {prev}, 0')}")
+        else:
+            low = f.op(f"xor i1 {top}, true")
+            f.stack[-1] = f.op(f"and i1 {low}, {f.op(f'icmp eq i8 {prev}, 1')}")
+    return lower
+
+
+LOWER["EU"] = _edge(True)
+LOWER["ED"] = _edge(False)
 
 # compares (isa.compare): bytes unsigned, words and double words signed
 _REL = {"=": "eq", "<>": "ne"}
@@ -363,6 +406,18 @@ def _move(kind: str) -> Lowering:
 LOWER["MOVB"] = _move("B")
 LOWER["MOVW"] = _move("WU")
 LOWER["MOVD"] = _move("DU")
+
+
+@lowers("MOVR")
+def _movr(f: Fn, src: Any, dst: Any) -> None:
+    """MOVR copies the bit pattern; a constant is stored as IEEE single
+    (isa.move._movr through Gen.wr: struct ">f" of the rounded value)."""
+    if isinstance(src, Const):
+        bits = int.from_bytes(struct.pack(">f", float(const_expr(src, "R"))), "big")
+        value = str(bits)
+    else:
+        value = rd(f, src, "DU")
+    wr(f, dst, "DU", value, f.top)
 
 W_RANGE = (-32768, 32767)
 D_RANGE = (-2**31, 2**31 - 1)
@@ -464,11 +519,12 @@ def wbit_tc(f: Fn, slot: str, n: int, v: str) -> None:
     f.store8(slot, n >> 3, f.op(f"or i8 {kept}, {b}"))
 
 
-def lower_piece(f: Fn, insns: list[tuple[str, list[Any]]]) -> None:
+def lower_piece(f: Fn, insns: list[tuple[str, list[Any], int]]) -> None:
     """Lower one piece's resolved instructions into ``f`` (raises NotLowered)."""
-    for mnemonic, ops in insns:
+    for mnemonic, ops, site in insns:
         fn = LOWER.get(mnemonic)
         if fn is None:
             raise NotLowered(f"{mnemonic} is not lowered")
+        f.site = site
         fn(f, *ops)
     f.stack.clear()

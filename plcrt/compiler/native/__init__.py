@@ -77,6 +77,7 @@ def plan_pou(plan: NativePlan, block: str, flow: bool,
             plan.python.append((block, net, str(e)))
             seg = _close(plan, seg)
             continue
+        f.split()
         seg = f
         plan.pieces += 1
         out[i] = len(plan.names)

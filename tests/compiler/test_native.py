@@ -89,6 +89,23 @@ ROWS = {
     "TON": "LD I0.0\nTON T37, +3\nLD T37\n= Q0.0\nLDN I0.0\nTON T38, VW2\n"
            "LD I0.1\nTON T101, +1",
 }
+for _w, _a, _b in (("B", "VB1", "VB17"), ("W", "VW2", "VW4"), ("D", "VD8", "VD12")):
+    for _stem in ("AND", "OR", "XOR"):
+        ROWS[f"{_stem}{_w}"] = (f"LD I0.0\n{_stem}{_w} {_a}, {_b}\n{_stem}{_w} 16#0F, {_a}\n"
+                                f"{_stem}{_w} {_b}, AC0")
+    ROWS[f"INV{_w}"] = f"LD I0.0\nINV{_w} {_a}\nINV{_w} AC1"
+for _w, _a, _b in (("B", "VB18", "VB19"), ("W", "VW2", "VW18"), ("D", "VD8", "VD16")):
+    for _stem in ("SL", "SR", "RL", "RR"):
+        # counts 0, 1, width - 1, width, past the width, and 255, on
+        # patterns whose lowest and highest bits differ
+        ROWS[f"{_stem}{_w}"] = "LD I0.0\n" + "\n".join(
+            f"{_stem}{_w} {x}, {k}" for x in (_a, _b) for k in (0, 1, 7, 8, 16, 31, 32, 40, 255))
+ROWS["ITB"] = ("LD I0.0\nITB VW0, VB20\nITB +255, VB21\nITB VW6, VB22\nITB -1, VB23\n"
+               "ITB +256, VB24")
+ROWS["DTI"] = ("LD I0.0\nDTI VD8, VW20\nDTI VD12, VW22\nDTI +32767, VW24\nDTI VD4, VW26\n"
+               "DTI +32768, VW28\nDTI -32769, VW30\nDTI -32768, VW32")
+ROWS["BTI"] = "LD I0.0\nBTI VB17, VW20\nBTI VB16, AC0"
+ROWS["ITD"] = "LD I0.0\nITD VW2, VD20\nITD VW0, VD24\nITD AC0, AC1"
 for _p in ("LD", "A", "O"):
     for _w, _a, _b in (("B", "VB1", "VB2"), ("W", "VW0", "VW2"), ("D", "VD8", "VD12")):
         for _r in ("=", "<>", "<", "<=", ">", ">="):

@@ -506,6 +506,127 @@ LOWER["INCD"] = _incdec("D", 1, *D_RANGE)
 LOWER["DECD"] = _incdec("D", -1, *D_RANGE)
 
 
+# word logic (isa.wordlogic): unsigned bit patterns, SM1.0 only
+_UKIND = {"B": ("B", 8), "W": ("WU", 16), "D": ("DU", 32)}
+
+
+def set_sm1(f: Fn, cond: str, keep: int, bits: str) -> None:
+    """``SM1 := SM1 & keep | bits`` where ``cond`` holds."""
+    old = f.load8("SM", 1)
+    new = f.op(f"or i8 {f.op(f'and i8 {old}, {keep}')}, {bits}")
+    f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
+
+
+def _zero8(f: Fn, ty: str, v: str) -> str:
+    return f.op(f"zext i1 {f.op(f'icmp eq {ty} {v}, 0')} to i8")
+
+
+def _logic(op: str, width: str) -> Lowering:
+    kind, _bits = _UKIND[width]
+    ty = WIDE[kind]
+
+    def lower(f: Fn, a: Any, out: Any) -> None:
+        top = f.top
+        r = f.op(f"{op} {ty} {rd(f, out, kind)}, {rd(f, a, kind)}")
+        wr(f, out, kind, r, top)
+        set_sm1(f, top, 254, _zero8(f, ty, r))
+    return lower
+
+
+def _inv(width: str) -> Lowering:
+    kind, bits = _UKIND[width]
+    ty = WIDE[kind]
+
+    def lower(f: Fn, out: Any) -> None:
+        top = f.top
+        r = f.op(f"xor {ty} {rd(f, out, kind)}, {(1 << bits) - 1}")
+        wr(f, out, kind, r, top)
+        set_sm1(f, top, 254, _zero8(f, ty, r))
+    return lower
+
+
+def _shift(stem: str, width: str) -> Lowering:
+    """SL/SR/RL/RR by a constant count (isa.wordlogic): the result and SM1.0,
+    SM1.1 the last bit out; a count that shifts nothing refreshes SM1.0 only."""
+    kind, bits = _UKIND[width]
+    ty = WIDE[kind]
+    mask = (1 << bits) - 1
+    rotate = stem in ("RL", "RR")
+
+    def lower(f: Fn, out: Any, count: Any) -> None:
+        if not isinstance(count, Const) or not isinstance(count.value, int):
+            raise NotLowered("a shift by a count held in memory is not lowered")
+        k = int(count.value) & 0xFF
+        k = k % bits if rotate else min(k, bits)
+        top = f.top
+        v = rd(f, out, kind)
+        if k == 0:
+            set_sm1(f, top, 254, _zero8(f, ty, v))
+            return
+        if stem == "SL":
+            r = f.op(f"and {ty} {f.op(f'shl {ty} {v}, {k}')}, {mask}") if k < bits else "0"
+            last = f.op(f"and {ty} {f.op(f'lshr {ty} {v}, {bits - k}')}, 1")
+        elif stem == "SR":
+            r = f.op(f"lshr {ty} {v}, {k}") if k < bits else "0"
+            last = f.op(f"and {ty} {f.op(f'lshr {ty} {v}, {k - 1}')}, 1")
+        else:
+            a, b = (k, bits - k) if stem == "RL" else (bits - k, k)
+            hi = f.op(f"shl {ty} {v}, {a}")
+            lo = f.op(f"lshr {ty} {v}, {b}")
+            r = f.op(f"and {ty} {f.op(f'or {ty} {hi}, {lo}')}, {mask}")
+            last = f.op(f"and {ty} {r}, 1") if stem == "RL" else \
+                f.op(f"lshr {ty} {r}, {bits - 1}")
+        wr(f, out, kind, r, top)
+        out8 = f.op(f"trunc {ty} {last} to i8")
+        bits8 = f.op(f"or i8 {_zero8(f, ty, r)}, {f.op(f'shl i8 {out8}, 1')}")
+        set_sm1(f, top, 252, bits8)
+    return lower
+
+
+for _w in ("B", "W", "D"):
+    LOWER[f"AND{_w}"] = _logic("and", _w)
+    LOWER[f"OR{_w}"] = _logic("or", _w)
+    LOWER[f"XOR{_w}"] = _logic("xor", _w)
+    LOWER[f"INV{_w}"] = _inv(_w)
+    for _stem in ("SL", "SR", "RL", "RR"):
+        LOWER[f"{_stem}{_w}"] = _shift(_stem, _w)
+
+
+def _narrow(kin: str, kout: str, lo: int, hi: int) -> Lowering:
+    """ITB/DTI (isa.convert): in range, OUT and SM1.1 cleared; else SM1.1
+    set and OUT unchanged."""
+    ty = WIDE[kin]
+
+    def lower(f: Fn, a: Any, out: Any) -> None:
+        top = f.top
+        v = rd(f, a, kin)
+        ok = f.op(f"and i1 {f.op(f'icmp sge {ty} {v}, {lo}')}, "
+                  f"{f.op(f'icmp sle {ty} {v}, {hi}')}")
+        val = v if WIDE[kout] == ty else f.op(f"trunc {ty} {v} to {WIDE[kout]}")
+        wr(f, out, kout, val, f.op(f"and i1 {top}, {ok}"))
+        old = f.load8("SM", 1)
+        new = f.op(f"select i1 {ok}, i8 {f.op(f'and i8 {old}, 253')}, "
+                   f"i8 {f.op(f'or i8 {old}, 2')}")
+        f.store8("SM", 1, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+    return lower
+
+
+def _widen(kin: str, kout: str) -> Lowering:
+    """BTI/ITD (isa.convert): never fail, no flags."""
+    def lower(f: Fn, a: Any, out: Any) -> None:
+        v = rd(f, a, kin)
+        if WIDE[kin] != WIDE[kout]:
+            v = f.op(f"sext {WIDE[kin]} {v} to {WIDE[kout]}")
+        wr(f, out, kout, v, f.top)
+    return lower
+
+
+LOWER["ITB"] = _narrow("W", "B", 0, 255)
+LOWER["DTI"] = _narrow("D", "W", -32768, 32767)
+LOWER["BTI"] = _widen("B", "W")
+LOWER["ITD"] = _widen("W", "D")
+
+
 @lowers("TON")
 def _ton(f: Fn, t: Any, pt: Any) -> None:
     """TON of a 100 ms timer (engine.timers.TimerBank.ton, its full path).

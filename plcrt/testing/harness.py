@@ -159,7 +159,8 @@ class Harness:
              data: Any = None, plant: Any = None, scan_ms: float = 10.0,
              cpu: str | None = None, watch: Sequence[str] = (), history: int = 20,
              instrument: bool = False, max_time: Duration | None = None,
-             encoding: str | None = None, clock: Any = None) -> Harness:
+             encoding: str | None = None, clock: Any = None,
+             backend: str | None = None) -> Harness:
         """Load a program (paths, STL text, or an already parsed
         :class:`plcrt.lang.ir.Program`) and wrap it.
 
@@ -167,7 +168,9 @@ class Harness:
         probes in (slightly slower scans).  ``max_time`` limits the simulated
         time (see :meth:`limit_time`).  ``encoding`` is the text encoding of
         the files (detected by default, as in :func:`plcrt.load`);
-        ``clock`` the real-time clock's start (as in :func:`plcrt.load`).
+        ``clock`` the real-time clock's start (as in :func:`plcrt.load`);
+        ``backend`` the code generator (``"python"`` or ``"native"``, as in
+        :func:`plcrt.load`; default ``$PLCRT_BACKEND``, else Python).
         """
         from ..lang import ir
 
@@ -180,12 +183,12 @@ class Harness:
             # session and compiles it per test)
             plc = _plc_from_parsed(program, symbols=symbols, data=data, plant=plant,
                                    scan_ms=scan_ms, cpu=cpu, instrument=instrument,
-                                   encoding=encoding, clock=clock)
+                                   encoding=encoding, clock=clock, backend=backend)
             return cls(plc, watch=watch, history=history, max_time=max_time)
         program = path(program)
         plc = load(program, symbols=symbols, data=data, plant=plant,
                    scan_ms=scan_ms, cpu=cpu, instrument=instrument, encoding=encoding,
-                   clock=clock)
+                   clock=clock, backend=backend)
         return cls(plc, watch=watch, history=history, max_time=max_time)
 
     def __repr__(self) -> str:
@@ -507,6 +510,12 @@ class Harness:
 
     # -- results ----------------------------------------------------------
     @property
+    def backend(self) -> dict[str, Any]:
+        """How the program runs (:attr:`plcrt.Plc.backend`): Python, or
+        which pieces run as machine code on the native backend."""
+        return self.plc.backend
+
+    @property
     def diagnostics(self) -> list[Any]:
         """Compile-time and run-time diagnostics so far."""
         return list(self.plc.diagnostics)
@@ -608,7 +617,7 @@ def _release(plc: Plc, addresses: Iterable[str]) -> None:
 
 def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,
                      cpu: str | None, instrument: bool, encoding: str | None = None,
-                     clock: Any = None) -> Plc:
+                     clock: Any = None, backend: str | None = None) -> Plc:
     """:func:`plcrt.load` for a program that is already parsed: the same
     handling of the symbol table, data block and plant arguments (the tables
     are decoded alone here; :func:`plcrt.lang.sources.read_program` decodes
@@ -627,7 +636,7 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
         data = parse_datablock(*_text_or_path(data, encoding),
                                codepage=string_codepage(encoding or ""))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
-               instrument=instrument, clock=clock)
+               instrument=instrument, clock=clock, backend=backend)
 
 
 def _mapping(values: Any, method: str) -> Mapping[str, Any]:

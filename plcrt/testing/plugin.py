@@ -75,6 +75,8 @@ class _Session:
     max_time: float | None
     coverage: bool
     coverage_report: Path | None
+    #: the code generator of every PLC (None: $PLCRT_BACKEND, else Python)
+    backend: str | None = None
     #: parsed programs with their tables: (((path, mtime_ns, size), ...),
     #: which tables, encoding) -> (ir.Program, symbols, data).  The IR is
     #: frozen and the tables are only read, so one parse can serve every
@@ -132,6 +134,11 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--plc-max-time", dest="plc_max_time", metavar="DURATION", default=None,
                     help="fail a test whose PLC runs past this much simulated time, e.g. "
                          "60s or 10min (default: ini plc_max_time, else no limit)")
+    group.addoption("--plc-backend", dest="plc_backend", choices=("python", "native"),
+                    default=None,
+                    help="code generator of the PLCs: python or native (machine code through "
+                         "llvmlite; default: ini plc_backend, else $PLCRT_BACKEND, else python)")
+    parser.addini("plc_backend", "PLC code generator: python or native (plcrt)", default=None)
     parser.addini("plc_history", "scans kept for the PLC trace (plcrt)", default=None)
     parser.addini("plc_max_time", "simulated-time limit per PLC (plcrt)", default=None)
     parser.addini("plc_coverage", "report PLC network coverage (plcrt)", type="bool",
@@ -178,8 +185,12 @@ def _session_from_config(config: pytest.Config) -> _Session:
     if report_path is not None and not report_path.is_absolute():
         report_path = Path(config.invocation_params.dir) / report_path
     coverage = bool(_setting(config, "plc_coverage")) or report_path is not None
+    backend = _setting(config, "plc_backend")
+    if backend not in (None, "python", "native"):
+        raise pytest.UsageError(f"plc_backend must be python or native, got {backend!r:.40}")
     return _Session(rootpath=Path(config.rootpath), scan_ms=scan_ms, history=history,
-                    max_time=max_time, coverage=coverage, coverage_report=report_path)
+                    max_time=max_time, coverage=coverage, coverage_report=report_path,
+                    backend=backend)
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -349,7 +360,7 @@ def _pristine(sess: _Session, spec: _Spec, scan_ms: float) -> Plc:
         program_key = tuple(_option_key(p) for p in spec.program)
     key = (program_key, _option_key(spec.symbols), _option_key(spec.data),
            _option_key(spec.plant), scan_ms, spec.cpu, sess.coverage, spec.encoding,
-           _option_key(spec.clock))
+           _option_key(spec.clock), sess.backend)
     plc = sess.plcs.get(key)
     if plc is not None:
         sess.plcs.move_to_end(key)
@@ -360,7 +371,7 @@ def _pristine(sess: _Session, spec: _Spec, scan_ms: float) -> Plc:
         program, symbols, data = _parsed(sess, spec)
     plc = Harness.load(program, symbols=symbols, data=data, plant=spec.plant,
                        scan_ms=scan_ms, cpu=spec.cpu, instrument=sess.coverage,
-                       encoding=spec.encoding, clock=spec.clock).plc
+                       encoding=spec.encoding, clock=spec.clock, backend=sess.backend).plc
     sess.plcs[key] = plc
     while len(sess.plcs) > PRISTINE_PLCS:
         sess.plcs.popitem(last=False)

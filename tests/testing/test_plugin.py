@@ -529,3 +529,26 @@ def test_within_limit(plc):
     bad = _run(pytester, "--plc-max-time=soon")
     assert bad.ret == pytest.ExitCode.USAGE_ERROR
     bad.stderr.fnmatch_lines(["*--plc-max-time / plc_max_time: not a duration: 'soon'*"])
+
+
+def test_plc_backend_option_runs_the_tests_on_the_native_backend(
+        pytester: pytest.Pytester) -> None:
+    """--plc-backend native: every PLC of the session (its power-up copy and
+    each test's fork) runs the lowered networks as machine code."""
+    pytest.importorskip("llvmlite")
+    _write(pytester, "programs/timer.awl", TIMER)
+    _write(pytester, "test_backend.py", """\
+import pytest
+
+
+@pytest.mark.plc("programs/timer.awl")
+@pytest.mark.parametrize("run", range(2))
+def test_timer(plc, run):
+    assert plc.backend["name"] == "native" and plc.backend["pieces"] == 2
+    plc["I0.0"] = 1
+    assert plc.run_until("Q0.0") == pytest.approx(1.01)   # T37 done at 1.0 s, Q0.0 a scan later
+""")
+    _run(pytester, "--plc-backend", "native").assert_outcomes(passed=2)
+    _write(pytester, "pytest.ini", "[pytest]\nplc_backend = fast\n")
+    result = _run(pytester)
+    assert "plc_backend must be python or native" in result.stderr.str()

@@ -15,6 +15,10 @@ Run ``python bench/run.py`` (or ``make bench``).  It
    ``roundtrip.awl`` with its symbol table (if the shared corpus is
    present): a real export that uses every instruction family.
 
+``--native`` also times the native backend (docs/native.md) on the same
+programs and prints its speed-up over the Python backend; ``--seeds 5,6``
+adds a boolean and a mixed program per seed.
+
 This is a measuring tool, not a test: it asserts nothing and never fails on
 slow results (``--check`` makes it exit 1 below the targets).  ``--save DIR``
 writes the generated programs so they can be read or dumped with
@@ -202,9 +206,9 @@ def _prepare_inputs(plc: plcrt.Plc) -> None:
 
 
 def measure_scans(name: str, text: str, *, repeats: int, target_s: float,
-                  instrument: bool = False) -> ScanResult:
+                  instrument: bool = False, backend: str = "python") -> ScanResult:
     t0 = time.perf_counter()
-    plc = plcrt.load(text, instrument=instrument)
+    plc = plcrt.load(text, instrument=instrument, backend=backend)
     load_s = time.perf_counter() - t0
     _prepare_inputs(plc)
     plc.scan(200)  # warm-up: timers started, caches filled
@@ -309,9 +313,18 @@ def main(argv: list[str] | None = None) -> int:
                     help="minimum instructions per generated program")
     ap.add_argument("--save", metavar="DIR", help="write the generated programs to DIR")
     ap.add_argument("--check", action="store_true", help="exit 1 when below a target")
+    ap.add_argument("--native", action="store_true",
+                    help="also time the native backend (llvmlite) on the same programs "
+                         "and report its speed-up over the Python backend")
+    ap.add_argument("--seeds", default="",
+                    help="more generator seeds (comma-separated): each adds a boolean and a "
+                         "mixed program of its own, so no figure rests on one program")
     args = ap.parse_args(argv)
 
     programs = {"bool": bool_program(args.insns), "mixed": mixed_program(args.insns)}
+    for seed in (int(x) for x in args.seeds.split(",") if x.strip()):
+        programs[f"bool/s{seed}"] = bool_program(args.insns, seed=seed)
+        programs[f"mixed/s{seed}"] = mixed_program(args.insns, seed=seed)
     if args.save:
         out = Path(args.save)
         out.mkdir(parents=True, exist_ok=True)
@@ -327,6 +340,11 @@ def main(argv: list[str] | None = None) -> int:
         r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
                           instrument=True)
         scans[f"{name}+probes"] = dataclasses.replace(r, name=f"{name}+probes")
+    if args.native:
+        for name, text in programs.items():
+            r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
+                              backend="native")
+            scans[f"{name}+native"] = dataclasses.replace(r, name=f"{name}+native")
     corpus = measure_corpus(max(3, args.repeats // 2))
 
     if args.json:
@@ -345,6 +363,10 @@ def main(argv: list[str] | None = None) -> int:
                   f"{r.insns_per_s / 1e6:6.2f} M instructions/s "
                   f"({1e6 / r.scans_per_s:7.1f} us/scan, best of {r.repeats} x "
                   f"{r.scans_per_repeat} scans; load {r.load_s * 1e3:.0f} ms){verdict}")
+        for name in programs:
+            nat = scans.get(f"{name}+native")
+            if nat is not None:
+                print(f"{name:<12} native / python: {nat.insns_per_s / scans[name].insns_per_s:.1f}x")
         if corpus is None:
             print(f"corpus: {CORPUS_FILE} not found, skipped")
         else:

@@ -63,7 +63,8 @@ class Gen:
         self.loc = loc            #: location of the instruction being emitted
         self.insn_id = -1         #: index of that instruction in unit.locs
         self.eno_valid = False    #: the previous box set ``eno``
-        self.line_map: list[tuple[int, int]] = []  #: (first line index, insn id)
+        #: (index of the line where its code starts, insn id, indentation)
+        self.line_map: list[tuple[int, int, int]] = []
         #: perf: expression of the top stack level not stored yet, so that a
         #: run like ``LD a / A b / AN c`` becomes one assignment.  Any emitted
         #: statement stores it first, so memory is always read in program order.

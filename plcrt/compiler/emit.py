@@ -357,6 +357,10 @@ class Gen:
 
 
 _NAME_OR_ITEM = re.compile(r"[A-Za-z_]\w*(?:\[\d+\])?|\d+")
+#: one parenthesized whole with at most one level of parentheses inside,
+#: the shape of every contact (``(V[3] >> 2 & 1)``, ``((M[0] & 1) ^ 1)``):
+#: matched in C, the general scan below is for the rest
+_GROUP = re.compile(r"\((?:[^()'\"]|\([^()'\"]*\))*\)")
 
 
 def _is_atom(expr: str) -> bool:
@@ -364,7 +368,7 @@ def _is_atom(expr: str) -> bool:
     operator: a name, a number, ``name[n]``, or one parenthesized whole
     (``(V[3] >> 2 & 1)``, ``((M[0] & 1) ^ 1)``).  Text with a string
     literal is never taken for one (its parentheses are not counted)."""
-    if _NAME_OR_ITEM.fullmatch(expr):
+    if _NAME_OR_ITEM.fullmatch(expr) or _GROUP.fullmatch(expr):
         return True
     if not (expr.startswith("(") and expr.endswith(")")) or "'" in expr or '"' in expr:
         return False

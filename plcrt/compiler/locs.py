@@ -29,18 +29,15 @@ class LocTable(Sequence[SourceLoc]):
     the pairs seen).  ``table[i]`` returns a location equal to the one
     appended."""
 
-    __slots__ = ("_files", "_file_index", "_places", "_place_index", "_file", "_line",
-                 "_column", "_place")
+    __slots__ = ("_files", "_file_index", "_places", "_place_index", "_data")
 
     def __init__(self) -> None:
         self._files: list[str] = []
         self._file_index: dict[str, int] = {}
         self._places: list[tuple[str | None, int | None]] = []
         self._place_index: dict[tuple[str | None, int | None], int] = {}
-        self._file = array("I")
-        self._line = array("I")
-        self._column = array("I")
-        self._place = array("I")
+        #: file, line, column, place of each instruction, one after the other
+        self._data = array("I")
 
     def append(self, loc: SourceLoc) -> None:
         """Add the location of the next instruction id."""
@@ -53,13 +50,10 @@ class LocTable(Sequence[SourceLoc]):
         if p is None:
             p = self._place_index[key] = len(self._places)
             self._places.append(key)
-        self._file.append(f)
-        self._line.append(loc.line)
-        self._column.append(loc.column)
-        self._place.append(p)
+        self._data.extend((f, loc.line, loc.column, p))
 
     def __len__(self) -> int:
-        return len(self._line)
+        return len(self._data) >> 2
 
     @overload
     def __getitem__(self, index: int) -> SourceLoc: ...
@@ -70,9 +64,13 @@ class LocTable(Sequence[SourceLoc]):
     def __getitem__(self, index: int | slice) -> SourceLoc | list[SourceLoc]:
         if isinstance(index, slice):
             return [self[i] for i in range(*index.indices(len(self)))]
-        block, network = self._places[self._place[index]]
-        return SourceLoc(self._files[self._file[index]], self._line[index],
-                         self._column[index], block, network)
+        n = len(self)
+        if not -n <= index < n:
+            raise IndexError("instruction id out of range")
+        k = (index % n) * 4
+        f, line, column, p = self._data[k:k + 4]
+        block, network = self._places[p]
+        return SourceLoc(self._files[f], line, column, block, network)
 
     def __iter__(self) -> Iterator[SourceLoc]:
         return (self[i] for i in range(len(self)))

@@ -163,3 +163,21 @@ def test_the_program_runs_the_same_in_small_chunks(monkeypatch: pytest.MonkeyPat
     assert len(plc.unit.chunks) > 3
     assert _scan_all(plc) == whole
     cache.programs.clear()
+
+
+def test_a_large_compile_hands_free_heap_pages_back(monkeypatch: pytest.MonkeyPatch) -> None:
+    from plcrt.compiler import cache
+    calls: list[int] = []
+    monkeypatch.setattr(cache, "release_free_memory", lambda: calls.append(1) or True)
+    cache.compile_chunks("x = 1\n", [(1, 0)], "<t>")
+    assert calls == []                          # a small module: not worth it
+    monkeypatch.setattr(cache, "TRIM_SOURCE_CHARS", 4)
+    codes = cache.compile_chunks("x = 1\ny = 2\n", [(1, 0), (2, 6)], "<t>")
+    assert calls == [1] and [c.co_firstlineno for c in codes] == [1, 2]
+
+
+def test_releasing_free_memory_is_harmless() -> None:
+    from plcrt.compiler import cache
+    plc = plcrt.load(LOOP)
+    assert cache.release_free_memory() in (True, False)
+    assert len(_scan_all(plc)) == 6

@@ -27,6 +27,10 @@ line numbers to where the piece is in the whole module, so tracebacks,
 almost none: every automatic collection during it only walks what is still
 alive, so :func:`gc_paused` turns the cyclic collector off while parsing
 and compiling (the load itself makes no garbage cycles worth collecting).
+
+*Free pages.*  What a large compile does free (syntax trees, lines) stays
+mapped in the C heap; :func:`release_free_memory` hands it back to the
+system once the chunks are compiled.
 """
 
 from __future__ import annotations

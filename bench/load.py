@@ -17,7 +17,17 @@ Run ``python bench/load.py`` (``--json`` for one JSON document).  It
 4. measures the pytest fixture ``plc`` on a 1 000-statement program: the
    plugin's work per test timed in one process (``in_process``), and whole
    pytest runs of N and 2N tests with and without the fixture, whose
-   difference per added test is the fixture's overhead with pytest's own.
+   difference per added test is the fixture's overhead with pytest's own;
+5. with ``--awlsim``, times parse + compile of the same logic in plcrt and
+   in awlsim side by side (``--peer-size`` statements, 20 000 by default):
+   the peer benchmark's generator (``../shared/peers/gen.py``, ``--peers``)
+   writes it as S7-200 STL and as S7-300 AWL, each engine loads it in
+   fresh processes taking turns (``--peer-rounds``), and each reports its
+   first load in the process and the best of ``--peer-repeats`` more
+   (plcrt with its program cache off, so every load compiles; awlsim
+   parses, loads, builds and starts up).  awlsim runs from its virtual
+   environments (``--cache``, as for ``bench/peers.py``); without them
+   this part is skipped with a message.
 
 ``--plcrt DIR`` measures the plcrt package found in DIR instead (another
 checkout: the figures before a change, side by side in the same run with
@@ -31,6 +41,7 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -131,6 +142,30 @@ def child_fixture(path: str, tests: int = 200) -> dict[str, Any]:
             "per_test_ms": (t2 - t1) / tests * 1000}
 
 
+def child_peer_load(path: str, repeats: int = 3) -> dict[str, Any]:
+    """Parse + compile of ``path`` with ``plcrt.load``: the first load in
+    this process (after a tiny one: imports out of the way), then the best
+    of ``repeats``, every one compiled (program cache off)."""
+    import gc
+
+    import plcrt
+    from plcrt.compiler import cache
+    plcrt.load(TINY).scan(1)
+    cache.programs.max_entries = 0
+    text = Path(path).read_text()
+    times = []
+    statements = 0
+    for _ in range(1 + repeats):
+        gc.collect()
+        t0 = time.perf_counter()
+        plc = plcrt.load(text, scan_ms=1)
+        times.append(time.perf_counter() - t0)
+        statements = plc.program.instruction_count()
+        del plc
+    return {"mode": "peer", "statements": statements, "first_s": times[0],
+            "best_s": min(times[1:]), "all_s": times}
+
+
 def _run_child(path: Path, mode: str, plcrt_dir: str | None) -> dict[str, Any]:
     env = dict(os.environ)
     if plcrt_dir:
@@ -199,6 +234,94 @@ def fixture_overhead(text: str, tests: int, plcrt_dir: str | None) -> dict[str, 
 
 
 # ---------------------------------------------------------------------------
+# Side by side with awlsim
+# ---------------------------------------------------------------------------
+
+AWLSIM_ENVS = (("awlsim-cy", "venv-awlsim-cy", "2"), ("awlsim-py", "venv-awlsim", None))
+
+
+def _peer_cache(arg: str | None) -> Path:
+    """Where awlsim's environments are (as ``bench/peers.py`` looks)."""
+    if arg:
+        return Path(arg)
+    env = os.environ.get("PLCRT_PEERS_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "plcrt" / "peers"
+
+
+def _awlsim_load(py: Path, cython: str | None, peers: Path, path: Path,
+                 repeats: int) -> dict[str, Any]:
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    env.pop("AWLSIM_CYTHON", None)
+    if cython:
+        env["AWLSIM_CYTHON"] = cython           # the Cython core, or abort
+    r = subprocess.run([str(py), str(peers / "bench_awlsim.py"), "load", str(path),
+                        "--repeats", str(repeats)], env=env, capture_output=True, text=True,
+                       check=False, cwd=tempfile.gettempdir())
+    if r.returncode != 0:
+        return {"error": (r.stderr.strip().splitlines() or ["failed"])[-1][:200]}
+    out = json.loads(r.stdout)
+    return {"statements": out["statements"], "first_s": out["first"]["total_s"],
+            "best_s": out["best"]["total_s"], "parse_best_s": out["best"]["parse_s"]}
+
+
+def versus_awlsim(peers: Path, cache: Path, size: int, rounds: int, repeats: int,
+                  plcrt_dir: str | None, workdir: Path) -> dict[str, Any]:
+    """Parse + compile time of the same boolean logic in plcrt and awlsim,
+    in turns; the median over the rounds of each engine's figures."""
+    if not (peers / "gen.py").exists():
+        return {"skipped": f"no peer benchmark at {peers} (--peers DIR)"}
+    engines = {name: (cache / venv / "bin" / "python", cy) for name, venv, cy in AWLSIM_ENVS
+               if (cache / venv / "bin" / "python").exists()}
+    if not engines:
+        return {"skipped": f"awlsim's environments are not in {cache} (--cache DIR; "
+                           f"python bench/peers.py --setup creates them)"}
+    progdir = workdir / f"peer_{size}"
+    subprocess.run([sys.executable, str(peers / "gen.py"), str(progdir), "--bool", str(size),
+                    "--mixed", "10", "--seed", "1"], check=True, capture_output=True)
+    runs: dict[str, list[dict[str, Any]]] = {"plcrt": [], **{e: [] for e in engines}}
+    errors: dict[str, Any] = {}
+    for _ in range(rounds):
+        res = _run_child(progdir / "bool_s7200.awl", f"peer:{repeats}", plcrt_dir)
+        if "error" in res:
+            errors["plcrt"] = res["error"]
+        else:
+            runs["plcrt"].append(res)
+        for name, (py, cy) in engines.items():
+            res = _awlsim_load(py, cy, peers, progdir / "bool_s7300.awl", repeats)
+            if "error" in res:
+                errors[name] = res["error"]
+            else:
+                runs[name].append(res)
+    out: dict[str, Any] = {"rounds": rounds, "repeats": repeats, "errors": errors}
+    for name, rs in runs.items():
+        if rs:
+            out[name] = {"statements": rs[0]["statements"],
+                         "first_s": statistics.median(r["first_s"] for r in rs),
+                         "best_s": statistics.median(r["best_s"] for r in rs),
+                         "best_each_round_s": [round(r["best_s"], 3) for r in rs]}
+    if "plcrt" in out:
+        for name in engines:
+            if name in out:
+                out[f"{name}/plcrt"] = round(out[name]["best_s"] / out["plcrt"]["best_s"], 2)
+    return out
+
+
+def _peer_line(res: dict[str, Any]) -> str:
+    if "skipped" in res:
+        return f"versus awlsim: skipped: {res['skipped']}"
+    parts = []
+    for name in ("plcrt", *(e for e, _, _ in AWLSIM_ENVS)):
+        if name in res:
+            r = res[name]
+            parts.append(f"{name} {r['statements']} statements: first {r['first_s']:.3f} s, "
+                         f"best {r['best_s']:.3f} s")
+    ratios = ", ".join(f"{k} {v}" for k, v in res.items() if k.endswith("/plcrt"))
+    return "versus awlsim (parse + compile, median of rounds): " + "; ".join(parts) + \
+        (f" ({ratios}; above 1: plcrt faster)" if ratios else "") + \
+        (f"; errors {res['errors']}" if res["errors"] else "")
+
+
+# ---------------------------------------------------------------------------
 # Driver
 # ---------------------------------------------------------------------------
 
@@ -245,12 +368,28 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--plcrt", default=None, help="measure the plcrt package in this directory")
     ap.add_argument("--compare", default=None,
                     help="also measure the plcrt in this directory (before/after)")
+    ap.add_argument("--awlsim", action="store_true",
+                    help="also time parse + compile side by side with awlsim")
+    ap.add_argument("--awlsim-only", action="store_true",
+                    help="only the side-by-side time with awlsim")
+    ap.add_argument("--peers", default=str(HERE.parents[1] / "shared" / "peers"),
+                    help="the peer benchmark's folder (gen.py, bench_awlsim.py)")
+    ap.add_argument("--cache", default=None, help="where awlsim's environments are")
+    ap.add_argument("--peer-size", type=int, default=20000)
+    ap.add_argument("--peer-rounds", type=int, default=3)
+    ap.add_argument("--peer-repeats", type=int, default=3)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
         path, mode = args.child
-        print(json.dumps(child_fixture(path) if mode == "fixture" else child(path, mode)))
+        if mode == "fixture":
+            res = child_fixture(path)
+        elif mode.startswith("peer:"):
+            res = child_peer_load(path, int(mode.split(":")[1]))
+        else:
+            res = child(path, mode)
+        print(json.dumps(res))
         return 0
     sizes = [int(x) for x in args.sizes.split(",")]
     seeds = [int(x) for x in args.seeds.split(",")]
@@ -258,14 +397,24 @@ def main(argv: list[str] | None = None) -> int:
     result: dict[str, Any] = {
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "host": f"{platform.node()}, {platform.processor() or platform.machine()}, "
-                f"{os.cpu_count()} CPUs, Python {platform.python_version()}"}
+                f"{os.cpu_count()} CPUs, Python {platform.python_version()}",
+        "load_average_before": os.getloadavg()}
     with tempfile.TemporaryDirectory() as d:
         runs = [("after", args.plcrt)]
         if args.compare:
             runs.insert(0, ("before", args.compare))
         for label, where in runs:
             print(f"== {label}: {where or 'this checkout'}", file=sys.stderr)
-            result[label] = measure(where, sizes, seeds, shapes, args.fixture_tests, Path(d))
+            if not args.awlsim_only:
+                result[label] = measure(where, sizes, seeds, shapes, args.fixture_tests,
+                                        Path(d))
+            if args.awlsim or args.awlsim_only:
+                peer = versus_awlsim(Path(args.peers), _peer_cache(args.cache),
+                                     args.peer_size, args.peer_rounds, args.peer_repeats,
+                                     where, Path(d))
+                result.setdefault(label, {})["versus_awlsim"] = peer
+                print(_peer_line(peer), file=sys.stderr)
+    result["load_average_after"] = os.getloadavg()
     if args.json:
         print(json.dumps(result, indent=1))
     return 0

@@ -16,7 +16,7 @@ from .engine.runtime import Plc
 from .errors import PlcError
 from .safetext import printable
 
-# The comment codegen puts before each instruction's code.
+# The marker before each instruction's code (:func:`_with_markers`).
 _INSN_COMMENT_RE = re.compile(r"^(\s*)# \[(\d+)\] line (\d+)\s*$")
 _PIECE_DEF_RE = re.compile(r"^def n_([A-Z]+\d+)_(\d+)")
 _RUNNER_RE = re.compile(r"^(?:def |_pieces_|_costs_)pou_([A-Z]+\d+)")
@@ -35,7 +35,7 @@ def render_dump(plc: Plc) -> str:
     titles = {(p.ident, n.number): n.title for p in plc.program.pous for n in p.networks}
     names = {p.ident: p.name for p in plc.program.pous}
     locs = plc.unit.locs
-    lines = plc.source.splitlines()
+    lines = _with_markers(plc)
     files = sorted({str(f) for f in texts})
     out = [f"# plcrt dump of {', '.join(files) or plc.program.file}",
            "# Generated Python, for reading only: each '# [id] line n:' comment",
@@ -67,6 +67,24 @@ def render_dump(plc: Plc) -> str:
             line = f"{m.group(1)}# [{insn_id}] line {lineno}: {printable(stl)}"
         out.append(line)
     return "\n".join(out).rstrip("\n") + "\n"
+
+
+def _with_markers(plc: Plc) -> list[str]:
+    """The generated module's lines with the marker ``# [id] line n``
+    before the code of each instruction (the module itself has none: the
+    compiler records where each instruction's code starts)."""
+    table = plc.line_locs
+    starts, indents = table.starts, table.indents
+    locs = plc.unit.locs
+    out: list[str] = []
+    k, n = 0, len(starts)
+    for number, line in enumerate(plc.source.splitlines(), 1):
+        while k < n and starts[k] <= number:
+            out.append("    " * indents[k] + f"# [{k}] line {int(locs[k].line)}")
+            k += 1
+        out.append(line)
+    out += ["    " * indents[i] + f"# [{i}] line {int(locs[i].line)}" for i in range(k, n)]
+    return out
 
 
 def _piece_origin(lines: list[str], start: int, locs: Sequence[Any]) -> tuple[str, int] | None:

@@ -25,6 +25,7 @@ from ..lang.codepage import program_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .emit import CodegenError, Gen
+from .locs import LineLocs, LocTable
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
 #: S7-200: subroutines nest at most eight levels (System Manual, CALL).
@@ -89,7 +90,7 @@ class Unit:
         self.bindings: dict[str, Any] = {}
         self._ids: dict[int, str] = {}
         self._counter = 0
-        self.locs: list[SourceLoc] = []       #: instruction id -> location
+        self.locs = LocTable()                #: instruction id -> location
         self.texts: list[str] = []            #: instruction id -> mnemonic
         self.pous: dict[str, PouInfo] = {}    #: ident -> info
         self.by_name: dict[str, PouInfo] = {}
@@ -141,7 +142,7 @@ class Compiled:
     """Output of code generation: module source plus per-POU runners."""
 
     def __init__(self, source: str, namespace: dict[str, Any], unit: Unit,
-                 line_locs: dict[int, SourceLoc]) -> None:
+                 line_locs: LineLocs) -> None:
         self.source = source
         self.namespace = namespace
         self.unit = unit
@@ -377,10 +378,14 @@ def _cycle(unit: Unit, start: str, comp: dict[str, int]) -> list[str]:
     return []
 
 
-def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
-    """Emit the module source for all POUs (diagnostics go to ``unit.diag``)."""
+def generate(unit: Unit) -> tuple[str, LineLocs]:
+    """Emit the module source for all POUs (diagnostics go to ``unit.diag``).
+
+    The module has no comments: where each instruction's code starts is in
+    the returned :class:`LineLocs` (``plcrt dump`` shows it as a marker
+    comment), which keeps the text compiled and kept small."""
     out: list[str] = []
-    line_locs: dict[int, SourceLoc] = {}
+    line_locs = LineLocs(unit.locs)
     constants = [op.text for info in unit.pous.values() for net in info.pou.networks
                  for insn in net.insns for op in insn.operands if op.text.startswith('"')]
     codepage, chosen = program_codepage(unit.program.encoding, constants)
@@ -435,13 +440,14 @@ def generate(unit: Unit) -> tuple[str, dict[int, SourceLoc]]:
             base = len(out)
             out.append(header)
             body = gen.lines
-            if all(ln.lstrip().startswith("#") for ln in body):
-                # only instruction comments (LBL, SCRE, NOP ...): a def
-                # needs at least one statement
-                body = body + ["    pass"]
+            if not body:
+                # only instructions without code (LBL, SCRE, NOP ...): a
+                # def needs at least one statement
+                body = ["    pass"]
             out.extend(body)
-            for rel, insn_id in gen.line_map:
-                line_locs[base + 2 + rel] = unit.locs[insn_id]
+            for rel, insn_id, indent in gen.line_map:
+                assert insn_id == len(line_locs.starts)   # ids follow the text
+                line_locs.add(base + 2 + rel, indent)
             out.append("")
             fnames.append(fname)
         segs = None
@@ -612,12 +618,13 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         unit.texts.append(insn.mnemonic)
         gen.loc = loc
         gen.insn_id = insn_id
-        gen.line_map.append((len(gen.lines), insn_id))
-        # The comment carries only the instruction id and line number.
-        gen.comment(f"[{insn_id}] line {int(loc.line)}")
+        # where its code starts (the module has no comment lines: they
+        # made it a third longer to compile and keep)
+        gen.line_map.append((len(gen.lines), insn_id, gen.indent))
         if unit.probes is not None and not broken:
             _output_probe(unit, gen, piece, insn, loc)
-        saved = (list(gen.lines), gen.depth, gen.indent, gen.pending)
+        # perf: emitters only append lines, so the length is what to restore
+        saved = (len(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
             if unit.probes is not None and not broken and \
                     _contact_probe(unit, gen, piece, insn, ops, loc):
@@ -630,7 +637,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 site = len(unit.hooks["edges"]) - 1 if insn.mnemonic in ("EU", "ED") else -1
                 piece.resolved.append((insn.mnemonic, ops, site))
         except (CodegenError, ResolveError) as e:
-            gen.lines, gen.depth, gen.indent, gen.pending = saved
+            del gen.lines[saved[0]:]
+            _, gen.depth, gen.indent, gen.pending = saved
             if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):
                 unit.diag.error(f"{insn.mnemonic}: {e}", getattr(e, "loc", None) or loc)
             broken = True

@@ -15,6 +15,7 @@ It is not the driver: splitting programs into functions, control flow and
 
 from __future__ import annotations
 
+import re
 from contextlib import contextmanager
 from typing import Any, Iterator
 
@@ -63,12 +64,16 @@ class Gen:
         self.loc = loc            #: location of the instruction being emitted
         self.insn_id = -1         #: index of that instruction in unit.locs
         self.eno_valid = False    #: the previous box set ``eno``
-        self.line_map: list[tuple[int, int]] = []  #: (first line index, insn id)
+        #: (index of the line where its code starts, insn id, indentation)
+        self.line_map: list[tuple[int, int, int]] = []
         #: perf: expression of the top stack level not stored yet, so that a
         #: run like ``LD a / A b / AN c`` becomes one assignment.  Any emitted
         #: statement stores it first, so memory is always read in program order.
         self.pending: str | None = None
         self._terms = 0
+        #: (pending expression, its top-level operator) once combine()
+        #: built it: decides which parentheses the next combine() needs
+        self._pending_op: tuple[str, str] | None = None
 
     # -- source ---------------------------------------------------------
     def line(self, text: str) -> None:
@@ -161,7 +166,18 @@ class Gen:
     def combine(self, op: str, expr: str) -> None:
         """``top := top <op> expr`` for ``op`` in ``&``, ``|`` (A, O, ...)."""
         if self.pending is not None and self._terms < 24:
-            self.pending = f"({self.pending}) {op} ({expr})"
+            # perf: only the parentheses the operators need (an expression
+            # with fewer of them compiles faster; the syntax tree is the
+            # same).  ``&`` binds tighter than ``|``: ``a & b | c`` is
+            # ``(a & b) | c``, but ``(a | b) & c`` keeps its parentheses.
+            pending = self.pending
+            shape = self._pending_op
+            top = shape[1] if shape is not None and shape[0] is pending else None
+            if not (top == op or (top == "&" and op == "|")
+                    or (top is None and _is_atom(pending))):
+                pending = f"({pending})"
+            self.pending = f"{pending} {op} {expr if _is_atom(expr) else f'({expr})'}"
+            self._pending_op = (self.pending, op)
             self._terms += 1
         else:
             self.line(f"{self.top} {op}= {expr}")
@@ -338,6 +354,33 @@ class Gen:
         """Record the box's ENO (for a following AENO)."""
         self.line(f"eno = {expr}")
         self.eno_valid = True
+
+
+_NAME_OR_ITEM = re.compile(r"[A-Za-z_]\w*(?:\[\d+\])?|\d+")
+#: one parenthesized whole with at most one level of parentheses inside,
+#: the shape of every contact (``(V[3] >> 2 & 1)``, ``((M[0] & 1) ^ 1)``):
+#: matched in C, the general scan below is for the rest
+_GROUP = re.compile(r"\((?:[^()'\"]|\([^()'\"]*\))*\)")
+
+
+def _is_atom(expr: str) -> bool:
+    """Whether ``expr`` needs no parentheses as an operand of any binary
+    operator: a name, a number, ``name[n]``, or one parenthesized whole
+    (``(V[3] >> 2 & 1)``, ``((M[0] & 1) ^ 1)``).  Text with a string
+    literal is never taken for one (its parentheses are not counted)."""
+    if _NAME_OR_ITEM.fullmatch(expr) or _GROUP.fullmatch(expr):
+        return True
+    if not (expr.startswith("(") and expr.endswith(")")) or "'" in expr or '"' in expr:
+        return False
+    depth = 0
+    for i, ch in enumerate(expr):
+        if ch == "(":
+            depth += 1
+        elif ch == ")":
+            depth -= 1
+            if depth == 0:
+                return i == len(expr) - 1
+    return False
 
 
 def _is_int_literal(expr: str) -> bool:

@@ -99,6 +99,12 @@ class Resolver:
         self.symbols = symbols
         self.system = {k.upper(): v for k, v in (system_symbols or {}).items()}
         self.locals = local_vars or {}
+        #: (operand text, role) -> resolved operand.  Resolving depends only
+        #: on the text, the role and this resolver's fixed tables, and the
+        #: results are immutable, so a program that names the same address
+        #: many times resolves it once (failures are not kept: they raise
+        #: again, with the same message, at each use)
+        self._done: dict[tuple[str, Role], Resolved] = {}
 
     # -- text -> typed operand ------------------------------------------
     def parse(self, text: str) -> Resolved:
@@ -166,8 +172,12 @@ class Resolver:
         Raises:
             ResolveError: with a message naming the operand and the role.
         """
-        op = self.parse(operand.text)
-        return check_role(op, role, operand.text, self.model)
+        key = (operand.text, role)
+        done = self._done.get(key)
+        if done is None:
+            done = check_role(self.parse(operand.text), role, operand.text, self.model)
+            self._done[key] = done
+        return done
 
 
 _READ_BYTE_AREAS = ("I", "Q", "M", "V", "SM", "S", "L")

@@ -141,6 +141,10 @@ def _parse(text: str, file: str) -> Program | None:
     lines = prepared.split("\n")
     count = len(lines)
     pous: list[Pou] = []
+    # one string object per distinct mnemonic spelling and operand text: a
+    # program names the same few hundred addresses over and over, and the
+    # IR of every statement is kept as long as the program is loaded
+    shared: dict[str, str] = {}
     index = 0
     while index < count:
         line = lines[index]
@@ -155,7 +159,7 @@ def _parse(text: str, file: str) -> Program | None:
             if _COMMENT_LINE.match(line):
                 continue            # file-level comments are dropped
             return None
-        block = _block(lines, index, header, file, folded)
+        block = _block(lines, index, header, file, folded, shared)
         if block is None:
             return None
         pou, index = block
@@ -180,9 +184,11 @@ def _next_line(lines: list[str], index: int) -> tuple[str, int] | None:
 
 
 def _block(lines: list[str], index: int, header: re.Match[str], file: str,
-           folded: set[int]) -> tuple[Pou, int] | None:
+           folded: set[int], shared: dict[str, str]) -> tuple[Pou, int] | None:
     """Read one block whose header line is ``lines[index - 1]``; return the
-    :class:`Pou` and the index of the line after its END line."""
+    :class:`Pou` and the index of the line after its END line.  ``shared``
+    maps each mnemonic as written and each operand text to the one string
+    object every statement of the text uses for it."""
     kind_group = 1 if header.group(1) else 2 if header.group(2) else 3
     kind = _KINDS[kind_group - 1]
     first, second = header.group(4), header.group(5)
@@ -261,6 +267,8 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
     comma_match = _COMMA.match
     tail_match = _TAIL.match
     append_insn = insns.append
+    share = shared.setdefault
+    upper: dict[str, str] = {}      # mnemonic as written -> its shared upper case
     while True:
         # perf: _next_line inline here, the loop that runs once per statement
         if index >= count:
@@ -286,7 +294,10 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
                 and (k := _BODY_KEYWORD.match(line, m.start(1)))
                 and _FOLDED.search(line, k.start(), k.end())):
             return None             # "TıTLE=": a keyword to lark, not to MNEMONIC
-        mnemonic = m.group(1).upper()
+        raw = m.group(1)
+        mnemonic = upper.get(raw)
+        if mnemonic is None:
+            mnemonic = upper[raw] = share(raw.upper(), raw.upper())
         if mnemonic.startswith(_STRUCTURAL):
             if net_number >= 0 and (t := _TITLE_LINE.match(line)):
                 if not net_title:
@@ -317,8 +328,10 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
         o = operand_match(line, m.end())
         if o is not None:
             while True:
+                text = o.group(1)
                 operands.append(Operand(
-                    o.group(1), SourceLoc(file, index, o.start(1) + 1, ident, net_number)))
+                    share(text, text),
+                    SourceLoc(file, index, o.start(1) + 1, ident, net_number)))
                 pos = o.end()
                 c = comma_match(line, pos)
                 if c is None:

@@ -46,14 +46,27 @@ class MotionEn3(MotionBlock):
 
     def __call__(self, em_no: int, p_dor_ccw: int, sev0: int, sev1: int,
                  clr0: int, clr1: int) -> tuple:
+        # perf: nothing to do when the inputs are as last scan and no CLR
+        # pulse or emergency stop is pending: the module is enabled for this
+        # scan and the outputs are those of the last call
+        mod = self.module
+        if mod is not None and mod.slot == em_no \
+                and (em_no, p_dor_ccw, sev0, sev1, clr0, clr1) == self._last_key \
+                and not mod.clr_pending and not mod.stf_any and self._last_out[2] == 1:
+            mod.enabled_scan = self.plc.scans
+            return self._last_out
+        return self.call_exact(em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
+
+    def call_exact(self, em_no: int, p_dor_ccw: int, sev0: int, sev1: int,
+                   clr0: int, clr1: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         mod = self.plc.modules.get(em_no)
         if mod is None:
             self.warn(f"no EM253 module in slot {em_no} (EmNo): Status 4", "nomodule")
             return clr0, clr1, 4
+        self.module = mod
         mod.enabled_scan = self.plc.scans
         key = (em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
-        # perf: nothing to do when the inputs are as last scan and no CLR
-        # pulse or emergency stop is pending
         if key == self._last_key and not mod.clr_pending and not mod.stf_any \
                 and self._last_out[2] == 1:
             return self._last_out
@@ -94,11 +107,17 @@ class GetAbsPos(MotionBlock):
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
         mod = self.module
-        if mod is not None and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no:  # perf: the usual case
-            assert self.axis is not None
-            self.last_out = (self.axis.position(self.plc.now_us), 1)
-            return self.last_out
+        plc = self.plc
+        # perf: the usual case: the module and axis of the last call, enabled
+        # in this scan; the time read from the PLC's field, not its property
+        if mod is not None and mod.enabled_scan == plc.scans and mod.slot == em_no \
+                and self._axis_no == axis_no:
+            self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
+            return out
+        return self.call_exact(em_no, axis_no)
+
+    def call_exact(self, em_no: int, axis_no: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         if not self.find(em_no, axis_no):
             return self.last_out
         assert self.axis is not None
@@ -127,14 +146,21 @@ class SpdCtrl(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
-        # perf: steady running (Run held, nothing to update) only reports speed
+        # perf: steady running (Run held, nothing to update, the block's own
+        # move running) only reports speed
         mod, ax = self.module, self.axis
         if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and mod is not None and ax is not None and ax.owner is self and ax.segs \
+                and ax is not None and ax.owner is self and ax.segs \
                 and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            self.last_spd = spd = ax.speed(self.plc.now_us)
+            self.last_spd = spd = ax.speed(self.plc._t_us)
             return INNER_OK, 0, self.status, spd
+        return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, inner, update,
+                               direction, e_stop, run)
+
+    def call_exact(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
+                   e_stop, run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -219,13 +245,19 @@ class PosGotoR(MotionBlock):
         # perf: a move in progress with Run held only reports C_Pos and C_Spd
         mod, ax = self.module, self.axis
         if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and mod is not None and ax is not None and ax.owner is self and ax.segs \
+                and ax is not None and ax.owner is self and ax.segs \
                 and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            t = self.plc.now_us
+            t = self.plc._t_us
             self.last_spd = spd = ax.speed(t)
             self.c_pos = c_pos = ax.travel(t)
             return INNER_OK, 0, self.status, c_pos, spd
+        return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update,
+                               e_stop, run)
+
+    def call_exact(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
+                   run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -323,6 +355,28 @@ class Homing(MotionBlock):
 
     def __call__(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
                  run) -> tuple:
+        # perf: Run held, no E_Stop, InnerState as the block keeps it, the
+        # module and axis of the last call enabled in this scan, and either
+        # the axis moving for this block (poll() has nothing to report) or
+        # no homing active: only C_Spd and C_Status to report
+        mod, ax, seq = self.module, self.axis, self.seq
+        if run and self.prev_run and not e_stop and inner == INNER_OK \
+                and ax is not None and mod.enabled_scan == self.plc.scans \
+                and mod.slot == em_no and self._axis_no == axis_no and self.initialised:
+            if ax.owner is self and ax.segs:
+                self.last_spd = spd = ax.speed(self.plc._t_us)
+                return INNER_OK, self.status, spd
+            if seq is None or not seq.active:
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, self.status, 0
+        return self.call_exact(em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
+                               run)
+
+    def call_exact(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
+                   run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):

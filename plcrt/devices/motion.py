@@ -283,8 +283,15 @@ def first_time_at(seg: Seg, target: Fraction | int, lo: int) -> Optional[int]:
         x1 = seg.x1
         if x1.numerator // x1.denominator < tgt:
             return None
-    pulses = seg.pulses
     end = seg.t1_ceil
+    if seg.A == 0 and seg.B > 0:
+        # perf: a cruise: B t + C >= tgt D is linear in t, so the first whole
+        # µs is a ceiling division (what the bisection below finds: pulses()
+        # floors (B t + C) / D with D > 0); at and after the end the travel
+        # counts as x1, which reaches tgt (checked above)
+        first = max(lo, -((seg.C - tgt * seg.D) // seg.B))
+        return first if end is None or first < end else end
+    pulses = seg.pulses
 
     def reached(t: int) -> bool:
         if end is not None and t >= end:

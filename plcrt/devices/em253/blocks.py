@@ -49,9 +49,9 @@ class MotionEn3(MotionBlock):
         # perf: nothing to do when the inputs are as last scan and no CLR
         # pulse or emergency stop is pending: the module is enabled for this
         # scan and the outputs are those of the last call
+        # (the key holds EmNo: when it matches, self.module is that slot's)
         mod = self.module
-        if mod is not None and mod.slot == em_no \
-                and (em_no, p_dor_ccw, sev0, sev1, clr0, clr1) == self._last_key \
+        if (em_no, p_dor_ccw, sev0, sev1, clr0, clr1) == self._last_key \
                 and not mod.clr_pending and not mod.stf_any and self._last_out[2] == 1:
             mod.enabled_scan = self.plc.scans
             return self._last_out
@@ -147,13 +147,14 @@ class SpdCtrl(MotionBlock):
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
         # perf: steady running (Run held, nothing to update, the block's own
-        # move running) only reports speed
-        mod, ax = self.module, self.axis
+        # move running: it started it, so it is initialised) only reports
+        # speed
+        ax, plc = self.axis, self.plc
         if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
                 and ax is not None and ax.owner is self and ax.segs \
-                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
-            self.last_spd = spd = ax.speed(self.plc._t_us)
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
+                and self._axis_no == axis_no:
+            self.last_spd = spd = ax.speed(plc._t_us)
             return INNER_OK, 0, self.status, spd
         return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, inner, update,
                                direction, e_stop, run)
@@ -242,13 +243,14 @@ class PosGotoR(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
                  run) -> tuple:
-        # perf: a move in progress with Run held only reports C_Pos and C_Spd
-        mod, ax = self.module, self.axis
+        # perf: a move of this block in progress (so it is initialised) with
+        # Run held only reports C_Pos and C_Spd
+        ax, plc = self.axis, self.plc
         if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
                 and ax is not None and ax.owner is self and ax.segs \
-                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
-            t = self.plc._t_us
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
+                and self._axis_no == axis_no:
+            t = plc._t_us
             self.last_spd = spd = ax.speed(t)
             self.c_pos = c_pos = ax.travel(t)
             return INNER_OK, 0, self.status, c_pos, spd

@@ -61,6 +61,7 @@ class EM253Module:
         self._do2 = slice(self.do, self.do + 2)
         self._in2 = self._out2 = b"\0\0"   #: the terminal bytes last written
         self._plant_next = NEVER   #: time of the next scripted input (STF) event
+        self._clr_shown = False    #: a CLR output bit is on in the bytes last written
         self._write_terminals(0)
         self._plant_next = min((evs[0][0] for evs in self._events if evs), default=NEVER)
 
@@ -73,10 +74,11 @@ class EM253Module:
         a0, a1 = self.axes
         # perf: nothing is due on either axis (Axis.wake: no crossing, no
         # end of a move, no input bit change, no command since the last
-        # step), no scripted input event and no CLR pulse: the terminals are
-        # the bytes of the last step, written again as every scan does
+        # step), no scripted input event, no CLR pulse pending and none
+        # shown: the terminals are the bytes of the last step, written again
+        # as every scan does
         if t_to < a0.wake and t_to < a1.wake and t_to < self._plant_next \
-                and not self.clr_pending:
+                and not self.clr_pending and not self._clr_shown:
             self._pi[self._di2] = self._in2
             self._q[self._do2] = self._out2
             return
@@ -129,6 +131,8 @@ class EM253Module:
         (b0, o0), (b1, o1) = cache  # type: ignore[misc]
         self._in2 = self._pi[self._di2] = bytes((b0, b1))
         self._out2 = self._q[self._do2] = bytes((o0, o1))
+        # a CLR bit on: the next step must see MOTION_EN3 end the pulse
+        self._clr_shown = bool((o0 | o1) & 2)
 
     @staticmethod
     def _bytes(ax: Axis, t: int, clr: bool) -> tuple[int, int]:

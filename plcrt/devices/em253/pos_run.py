@@ -28,16 +28,17 @@ class PosRun(MotionBlock):
 
     def __call__(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
                  run) -> tuple:
-        # perf: the envelope running with Run held, nothing to update, no
-        # E_Stop, InnerState as the block keeps it, the module and axis of
-        # the last call enabled in this scan: command() has nothing to do,
-        # only C_Step, C_Pos and C_Spd to report
-        mod, ax = self.module, self.axis
+        # perf: the envelope of this block running (so it is initialised)
+        # with Run held, nothing to update, no E_Stop, InnerState as the
+        # block keeps it, the module and axis of the last call enabled in
+        # this scan: command() has nothing to do, only C_Step, C_Pos and
+        # C_Spd to report
+        ax, plc = self.axis, self.plc
         if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
                 and ax is not None and ax.owner is self and ax.segs \
-                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
-            t = self.plc._t_us
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
+                and self._axis_no == axis_no:
+            t = plc._t_us
             self.mode_in = mode
             self.last = (step, c_pos) = self._step_at(ax.travel(t))
             self.last_spd = spd = ax.speed(t)

@@ -42,8 +42,8 @@ F = Fraction
 EM253 = Path(__file__).resolve().parents[2] / "programs" / "em253"
 
 #: the block classes whose __call__ has a shortcut in front of call_exact
-BLOCKS = (em_blocks.MotionEn3, em_blocks.GetAbsPos, em_blocks.SpdCtrl, em_blocks.PosGotoR,
-          em_blocks.Homing, PosRun)
+BLOCKS = (em_blocks.MotionEn3, em_blocks.GetAbsPos, em_blocks.SetAbsPos, em_blocks.SpdCtrl,
+          em_blocks.PosGotoR, em_blocks.Homing, PosRun)
 
 #: example -> (plant, data block, bits set at power-up, bits toggled at
 #: random scan starts, Update bytes set to 1 at random scan starts)

@@ -300,7 +300,8 @@ class Axis:
         L+ at and above limit_pos, L- at and below limit_neg, Z on the
         positions z_offset + k z_period), or None."""
         p = self.plant
-        edges = []
+        best: Optional[int] = None
+        edges: list[int] = []
         if p.rps is not None:
             lo, hi = p.rps
             edges += (lo, hi + 1) if d > 0 else (hi, lo - 1)
@@ -316,9 +317,10 @@ class Axis:
                 edges.append(m - (r or p.z_period))
             if not r:
                 edges.append(m + d)   # leaving the Z mark it stands on
-        if d > 0:
-            return min((e for e in edges if e > m), default=None)
-        return max((e for e in edges if e < m), default=None)
+        for e in edges:
+            if (e - m) * d > 0 and (best is None or (e - best) * d < 0):
+                best = e
+        return best
 
     # -- time advance ------------------------------------------------------
     def advance(self, t_to: int) -> None:

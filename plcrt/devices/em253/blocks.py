@@ -130,6 +130,16 @@ class SetAbsPos(MotionBlock):
     name = "SET_AbsPos"
 
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
+        # perf: Start = 0 with the module and axis of the last call, enabled
+        # in this scan: nothing to do
+        mod = self.module
+        if not start and mod is not None and mod.enabled_scan == self.plc.scans \
+                and mod.slot == em_no and self._axis_no == axis_no:
+            return 0, self.status
+        return self.call_exact(em_no, axis_no, pos, start)
+
+    def call_exact(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         if not self.find(em_no, axis_no):
             return start, self.status
         assert self.axis is not None
@@ -146,16 +156,25 @@ class SpdCtrl(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
-        # perf: steady running (Run held, nothing to update, the block's own
-        # move running: it started it, so it is initialised) only reports
-        # speed
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either steady
+        # running (the block's own move, Run held, nothing to update) or
+        # nothing to start (no move of this block, no Run edge): command()
+        # has nothing to do, only C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and ax is not None and ax.owner is self and ax.segs \
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
                 and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no:
-            self.last_spd = spd = ax.speed(plc._t_us)
-            return INNER_OK, 0, self.status, spd
+                and self._axis_no == axis_no and self.initialised:
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    self.last_spd = spd = ax.speed(plc._t_us)
+                    return INNER_OK, 0, self.status, spd
+            elif self.prev_run or not run:
+                self.prev_run = run
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, 0, self.status, 0
         return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, inner, update,
                                direction, e_stop, run)
 
@@ -243,17 +262,28 @@ class PosGotoR(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
                  run) -> tuple:
-        # perf: a move of this block in progress (so it is initialised) with
-        # Run held only reports C_Pos and C_Spd
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either a move of
+        # this block running with Run held and nothing to update, or nothing
+        # to start (no move of this block, no Run edge): command() has
+        # nothing to do, only C_Pos, C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and ax is not None and ax.owner is self and ax.segs \
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
                 and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no:
-            t = plc._t_us
-            self.last_spd = spd = ax.speed(t)
-            self.c_pos = c_pos = ax.travel(t)
-            return INNER_OK, 0, self.status, c_pos, spd
+                and self._axis_no == axis_no and self.initialised:
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    t = plc._t_us
+                    self.last_spd = spd = ax.speed(t)
+                    self.c_pos = c_pos = ax.travel(t)
+                    return INNER_OK, 0, self.status, c_pos, spd
+            elif self.prev_run or not run:
+                self.prev_run = run
+                # C_Pos keeps this block's last move (see call_exact)
+                self.c_pos, self.last_spd = self.last_pos, 0
+                if self.status == ST_RUN and ax.owner is self:
+                    self.status = ST_STOPPED
+                return INNER_OK, 0, self.status, self.c_pos, 0
         return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update,
                                e_stop, run)
 
@@ -357,18 +387,24 @@ class Homing(MotionBlock):
 
     def __call__(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
                  run) -> tuple:
-        # perf: Run held, no E_Stop, InnerState as the block keeps it, the
-        # module and axis of the last call enabled in this scan, and either
-        # the axis moving for this block (poll() has nothing to report) or
-        # no homing active: only C_Spd and C_Status to report
-        mod, ax, seq = self.module, self.axis, self.seq
-        if run and self.prev_run and not e_stop and inner == INNER_OK \
-                and ax is not None and mod.enabled_scan == self.plc.scans \
-                and mod.slot == em_no and self._axis_no == axis_no and self.initialised:
+        # perf: no Run edge, no E_Stop, InnerState as the block keeps it,
+        # the module and axis of the last call enabled in this scan, and
+        # either the axis moving for this block (poll() has nothing to
+        # report) with Run held or no homing active, or no homing active
+        # and the axis not moving for it: only C_Spd and C_Status to report
+        ax, seq, plc = self.axis, self.seq, self.plc
+        if not e_stop and inner == INNER_OK and ax is not None \
+                and (self.prev_run or not run) and self.module.enabled_scan == plc.scans \
+                and self.module.slot == em_no and self._axis_no == axis_no \
+                and self.initialised:
+            active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
-                self.last_spd = spd = ax.speed(self.plc._t_us)
-                return INNER_OK, self.status, spd
-            if seq is None or not seq.active:
+                if run or not active:
+                    self.prev_run = run
+                    self.last_spd = spd = ax.speed(plc._t_us)
+                    return INNER_OK, self.status, spd
+            elif not active:
+                self.prev_run = run
                 if self.status == ST_RUN:
                     self.status = ST_STOPPED
                 self.last_spd = 0

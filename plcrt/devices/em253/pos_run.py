@@ -28,21 +28,31 @@ class PosRun(MotionBlock):
 
     def __call__(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
                  run) -> tuple:
-        # perf: the envelope of this block running (so it is initialised)
-        # with Run held, nothing to update, no E_Stop, InnerState as the
-        # block keeps it, the module and axis of the last call enabled in
-        # this scan: command() has nothing to do, only C_Step, C_Pos and
-        # C_Spd to report
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either the
+        # envelope of this block running with Run held and nothing to
+        # update, or nothing to start (no envelope of this block running,
+        # no Run edge): command() has nothing to do, only C_Step, C_Pos,
+        # C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and ax is not None and ax.owner is self and ax.segs \
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
                 and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no:
-            t = plc._t_us
-            self.mode_in = mode
-            self.last = (step, c_pos) = self._step_at(ax.travel(t))
-            self.last_spd = spd = ax.speed(t)
-            return INNER_OK, 0, self.status, c_pos, spd, step
+                and self._axis_no == axis_no and self.initialised:
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    t = plc._t_us
+                    self.mode_in = mode
+                    self.last = (step, c_pos) = self._step_at(ax.travel(t))
+                    self.last_spd = spd = ax.speed(t)
+                    return INNER_OK, 0, self.status, c_pos, spd, step
+            elif self.prev_run or not run:
+                self.prev_run = run
+                self.mode_in = mode
+                step, c_pos = getattr(self, "last", (0, 0))
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, 0, self.status, c_pos, 0, step
         return self.call_exact(em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
                                run)
 

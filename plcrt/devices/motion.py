@@ -265,7 +265,7 @@ def first_time_at(seg: Seg, target: Fraction | int, lo: int) -> Optional[int]:
     following segment starts there and the quadratic must not be
     extrapolated: past the end of a ramp down to 0 it would fall again).
     """
-    # (an int first: isinstance() against Fraction, an ABC, is slow)
+    # perf: an int first (isinstance() against Fraction, an ABC, is slow)
     if type(target) is int:
         tgt = target
     else:

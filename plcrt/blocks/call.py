@@ -9,11 +9,14 @@ kind and width, addresses where the block writes), then emits::
 
 ``_blk3`` is the per-call-site callable built by the block's factory, so
 each call site has its own state (like the memory a Micro/WIN library
-subroutine gets per instance).
+subroutine gets per instance).  When the block is an object with a Python
+``__call__``, the code calls that bound method (``_call4``) and the object
+is bound too, for the copies of its state.
 """
 
 from __future__ import annotations
 
+from types import FunctionType
 from typing import Any
 
 from ..compiler.operands import Addr, Const, Indirect
@@ -79,7 +82,19 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
     at_load = getattr(factory, "at_load", None)
     if at_load is not None:
         at_load(g, itf, plc)          # load-time warnings of the block's family
-    fn = g.bind(factory(plc, g.loc, itf), "blk")
+    block = factory(plc, g.loc, itf)
+    call = getattr(type(block), "__call__", None)
+    if not (isinstance(call, FunctionType) and hasattr(block, "__dict__")):
+        fn = g.bind(block, "blk")
+    else:
+        # perf: the generated code calls the block's bound __call__: a
+        # Python function called as such is run in the caller's evaluation
+        # loop, an object's __call__ through a slot and a new one (about
+        # half the cost of a call).  The block object stays bound as well:
+        # fork() and snapshots copy its state through that binding, and the
+        # method, rebound for each PLC, is bound to that PLC's block.
+        g.unit.bind(block, "blk")
+        fn = g.bind(block.__call__, "call")
     with g.box():
         r = g.tmp("r")
         g.line(f"{r} = {fn}({', '.join(reads)})")

@@ -265,9 +265,27 @@ def first_time_at(seg: Seg, target: Fraction | int, lo: int) -> Optional[int]:
     following segment starts there and the quadratic must not be
     extrapolated: past the end of a ramp down to 0 it would fall again).
     """
-    tgt = -((-target.numerator) // target.denominator) if isinstance(target, Fraction) \
-        else int(target)
-    hi = seg.t1_ceil
+    # perf: an int first (isinstance() against Fraction, an ABC, is slow)
+    if type(target) is int:
+        tgt = target
+    else:
+        tgt = -((-target.numerator) // target.denominator) if isinstance(target, Fraction) \
+            else int(target)
+    end = seg.t1_ceil
+    if end is not None and end < lo:
+        return None
+    if seg.A == 0 and seg.B > 0:
+        # perf: a cruise: B t + C >= tgt D is linear in t, so the first whole
+        # µs is a ceiling division (what the bisection below finds: pulses()
+        # floors (B t + C) / D with D > 0).  Before the end that µs is the
+        # answer (the travel there is below x1, so x1 reaches tgt too); at
+        # and after the end the travel counts as x1
+        first = max(lo, -((seg.C - tgt * seg.D) // seg.B))
+        if end is None or first < end:
+            return first
+        x1 = seg.x1
+        return end if x1.numerator // x1.denominator >= tgt else None
+    hi = end
     if hi is None:
         v = seg.v0
         if v <= 0:
@@ -278,13 +296,10 @@ def first_time_at(seg: Seg, target: Fraction | int, lo: int) -> Optional[int]:
             return lo
         hi = lo + int(need * US / v) + 2
     else:
-        if hi < lo:
-            return None
         x1 = seg.x1
         if x1.numerator // x1.denominator < tgt:
             return None
     pulses = seg.pulses
-    end = seg.t1_ceil
 
     def reached(t: int) -> bool:
         if end is not None and t >= end:

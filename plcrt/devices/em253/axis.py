@@ -22,9 +22,12 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable, Optional
 
-from ..motion import Seg, cruise, first_time_at, plan_distance, ramp
+from ..motion import US, Seg, cruise, first_time_at, plan_distance, ramp
 
 F0 = Fraction(0)
+NEVER = 1 << 62   #: a time after every simulated time (µs)
+#: the "segment" of a stopped axis: travel 0 and speed 0 at every time
+_STOPPED = Seg(F0, None, F0, F0, F0)
 
 
 @dataclass
@@ -62,10 +65,12 @@ class Axis:
         self._next: Optional[tuple[int, int, Callable]] = None  # (t, pos, handler)
         self.pulses_total = 0       #: statistics: pulses generated
         self.last_travel = 0
-        self.dirty = True           #: terminals need rewriting (state changed while stopped)
-        self._tc_t = -1
-        self._tc_segs: list = []
-        self._tc_n = 0
+        #: perf: before this time (µs) the module need not look at the axis:
+        #: no watched crossing, no end of the move and no change of an input
+        #: bit (RPS, L+, L-, Z) is due (:meth:`next_change`).  Whatever
+        #: changes the axis sets it to 0, so the next step looks again.
+        self.wake = 0
+        self._stopped_window()
         self.owner: object = None   #: the block instance that commands the axis
 
     # -- state at a time ----------------------------------------------------
@@ -73,7 +78,13 @@ class Axis:
     def moving(self) -> bool:
         return bool(self.segs)
 
+    def _stopped_window(self) -> None:
+        """perf: the window of a stopped axis covers all time (travel 0)."""
+        self._w_lo, self._w_hi, self._w_seg = -NEVER, NEVER, _STOPPED
+
     def _seg_at(self, t: int) -> Seg:
+        """The segment of the current move that holds time ``t``; it and its
+        time window become the reader's window (see :meth:`travel`)."""
         segs = self.segs
         i = self.si
         # perf: time mostly moves forward, so the index mostly advances;
@@ -86,25 +97,36 @@ class Axis:
                 break
             i += 1
         self.si = i
-        return segs[i]
+        s = segs[i]
+        # perf: the times in which segment i is the one _seg_at finds: from
+        # the end of the one before (all time before for the first) to its
+        # own end (all time after for an endless cruise; at and after the
+        # end of the last segment the travel stops growing: not in it)
+        self._w_seg = s
+        self._w_lo = (segs[i - 1].t1_ceil or 0) if i else -NEVER
+        self._w_hi = NEVER if s.t1_ceil is None else s.t1_ceil
+        return s
 
     def travel(self, t: int) -> int:
         """Whole pulses of the current move emitted by time ``t``."""
+        # perf: inside the window of the last segment found, the segment's
+        # polynomial (Seg.pulses) inline; readers ask at every scan start
+        if self._w_lo <= t < self._w_hi:
+            s = self._w_seg
+            return (s.A * t * t + s.B * t + s.C) // s.D
         if not self.segs:
             return 0
-        if t == self._tc_t and self._tc_segs is self.segs:
-            return self._tc_n  # perf: several readers per scan
         s = self._seg_at(t)
         if s.t1_ceil is not None and t >= s.t1_ceil:
             x = s.x1
-            n = x.numerator // x.denominator
-        else:
-            n = s.pulses(t)
-        self._tc_t, self._tc_segs, self._tc_n = t, self.segs, n
-        return n
+            return x.numerator // x.denominator
+        return s.pulses(t)
 
     def position(self, t: int) -> int:
         """The module's position counter at time ``t``."""
+        if self._w_lo <= t < self._w_hi:   # perf: travel() inline
+            s = self._w_seg
+            return self.counter + self.direction * ((s.A * t * t + s.B * t + s.C) // s.D)
         return self.counter + self.direction * self.travel(t)
 
     def mechanical(self, t: int) -> int:
@@ -115,6 +137,9 @@ class Axis:
 
     def speed(self, t: int) -> int:
         """Signed output frequency in Hz (0 when stopped)."""
+        if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
+            s = self._w_seg
+            return self.direction * ((2 * s.A * t + s.B) * US // s.D)
         if not self.segs:
             return 0
         s = self._seg_at(t)
@@ -144,10 +169,11 @@ class Axis:
         end of the move) and tell the move's owner."""
         self._rebase(t)
         # the terminals (P, D, limits, Z) must be recomputed at the next
-        # scan end: a stopped axis is no longer recomputed every scan
-        self.dirty = True
+        # scan end: a stopped axis is not looked at again until it changes
+        self.wake = 0
         self.segs = []
         self.si = 0
+        self._stopped_window()
         self.t_end = None
         self.watch = []
         self._next = None
@@ -169,9 +195,13 @@ class Axis:
             # current move in now, or they would be lost from the counter
             self._rebase(t)
         self.direction = direction
-        self.dirty = True
+        self.wake = 0
         self.segs = segs
         self.si = 0
+        if segs:
+            self._w_lo = self._w_hi = 0   # no window until a reader finds one
+        else:
+            self._stopped_window()
         self.on_done = on_done
         last = segs[-1] if segs else None
         self.t_end = None if last is None or last.t1_ceil is None else last.t1_ceil
@@ -188,14 +218,14 @@ class Axis:
         else:
             self.mech_offset = self.frozen - self.position(t)
         self.masked = masked
-        self.dirty = True
+        self.wake = 0
         self._arm(t)
 
     def set_position(self, t: int, value: int) -> None:
         """SET_AbsPos / homing: the counter reads ``value`` now."""
         n = self.travel(t)
         mech = self.mechanical(t)
-        self.dirty = True
+        self.wake = 0
         self.counter = value - self.direction * n
         if not self.masked:
             self.mech_offset = mech - value
@@ -209,6 +239,7 @@ class Axis:
     def _arm(self, t: int) -> None:
         """Find the earliest watched crossing ahead in the current move."""
         self._next = None
+        self.wake = 0   # the next event may be earlier than the module knows
         if not self.segs or self.masked or not self.watch:
             return
         d = self.direction
@@ -224,6 +255,9 @@ class Axis:
         self._next = best
 
     def _time_of_travel(self, need: int, t: int) -> Optional[int]:
+        """First µs at or after ``t`` at which the move's travel reaches
+        ``need`` whole pulses, or None when the move ends before."""
+        self._seg_at(t)   # the search starts in the segment of ``t``
         for i in range(self.si, len(self.segs)):
             s = self.segs[i]
             lo = t if i == self.si else max(t, -((-s.t0.numerator) // s.t0.denominator))
@@ -233,6 +267,60 @@ class Axis:
                     continue
                 return te
         return None
+
+    # -- when to look again -----------------------------------------------
+    def next_change(self, t: int) -> int:
+        """The earliest time after ``t`` at which the axis does something by
+        itself: a watched crossing, the end of its move, or a change of one
+        of its input bits (RPS, L+, L-, Z), which depend on the mechanical
+        position only.  :data:`NEVER` for a stopped axis.  Until then its
+        terminal bytes are those at ``t`` and :meth:`advance` has nothing
+        to do (perf: the module skips the axis until then)."""
+        if not self.segs:
+            return NEVER
+        nxt = self._next
+        wake = NEVER if nxt is None else nxt[0]
+        t_end = self.t_end
+        if t_end is not None and t_end < wake:
+            wake = t_end
+        if self.masked:
+            return wake   # the mechanics stay put: no input bit changes
+        d = self.direction
+        base = self.counter + self.mech_offset
+        edge = self._next_edge(base + d * self.travel(t), d)
+        if edge is not None:
+            te = self._time_of_travel((edge - base) * d, t)
+            if te is not None and te < wake:
+                wake = te
+        return wake
+
+    def _next_edge(self, m: int, d: int) -> Optional[int]:
+        """The nearest mechanical position beyond ``m`` in direction ``d`` at
+        which an input bit changes (module._bytes: RPS active in [lo, hi],
+        L+ at and above limit_pos, L- at and below limit_neg, Z on the
+        positions z_offset + k z_period), or None."""
+        p = self.plant
+        best: Optional[int] = None
+        edges: list[int] = []
+        if p.rps is not None:
+            lo, hi = p.rps
+            edges += (lo, hi + 1) if d > 0 else (hi, lo - 1)
+        if p.limit_pos is not None:
+            edges.append(p.limit_pos if d > 0 else p.limit_pos - 1)
+        if p.limit_neg is not None:
+            edges.append(p.limit_neg + 1 if d > 0 else p.limit_neg)
+        if p.z_period:
+            r = (m - p.z_offset) % p.z_period
+            if d > 0:
+                edges.append(m + (p.z_period - r if r else p.z_period))
+            else:
+                edges.append(m - (r or p.z_period))
+            if not r:
+                edges.append(m + d)   # leaving the Z mark it stands on
+        for e in edges:
+            if (e - m) * d > 0 and (best is None or (e - best) * d < 0):
+                best = e
+        return best
 
     # -- time advance ------------------------------------------------------
     def advance(self, t_to: int) -> None:

@@ -46,14 +46,27 @@ class MotionEn3(MotionBlock):
 
     def __call__(self, em_no: int, p_dor_ccw: int, sev0: int, sev1: int,
                  clr0: int, clr1: int) -> tuple:
+        # perf: nothing to do when the inputs are as last scan and no CLR
+        # pulse or emergency stop is pending: the module is enabled for this
+        # scan and the outputs are those of the last call
+        # (the key holds EmNo: when it matches, self.module is that slot's)
+        mod = self.module
+        if (em_no, p_dor_ccw, sev0, sev1, clr0, clr1) == self._last_key \
+                and not mod.clr_pending and not mod.stf_any and self._last_out[2] == 1:
+            mod.enabled_scan = self.plc.scans
+            return self._last_out
+        return self.call_exact(em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
+
+    def call_exact(self, em_no: int, p_dor_ccw: int, sev0: int, sev1: int,
+                   clr0: int, clr1: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         mod = self.plc.modules.get(em_no)
         if mod is None:
             self.warn(f"no EM253 module in slot {em_no} (EmNo): Status 4", "nomodule")
             return clr0, clr1, 4
+        self.module = mod
         mod.enabled_scan = self.plc.scans
         key = (em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
-        # perf: nothing to do when the inputs are as last scan and no CLR
-        # pulse or emergency stop is pending
         if key == self._last_key and not mod.clr_pending and not mod.stf_any \
                 and self._last_out[2] == 1:
             return self._last_out
@@ -94,11 +107,17 @@ class GetAbsPos(MotionBlock):
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
         mod = self.module
-        if mod is not None and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no:  # perf: the usual case
-            assert self.axis is not None
-            self.last_out = (self.axis.position(self.plc.now_us), 1)
-            return self.last_out
+        plc = self.plc
+        # perf: the usual case: the module and axis of the last call, enabled
+        # in this scan; the time read from the PLC's field, not its property
+        if mod is not None and mod.enabled_scan == plc.scans and mod.slot == em_no \
+                and self._axis_no == axis_no:
+            self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
+            return out
+        return self.call_exact(em_no, axis_no)
+
+    def call_exact(self, em_no: int, axis_no: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         if not self.find(em_no, axis_no):
             return self.last_out
         assert self.axis is not None
@@ -111,6 +130,16 @@ class SetAbsPos(MotionBlock):
     name = "SET_AbsPos"
 
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
+        # perf: Start = 0 with the module and axis of the last call, enabled
+        # in this scan: nothing to do
+        mod = self.module
+        if not start and mod is not None and mod.enabled_scan == self.plc.scans \
+                and mod.slot == em_no and self._axis_no == axis_no:
+            return 0, self.status
+        return self.call_exact(em_no, axis_no, pos, start)
+
+    def call_exact(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         if not self.find(em_no, axis_no):
             return start, self.status
         assert self.axis is not None
@@ -127,14 +156,31 @@ class SpdCtrl(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
-        # perf: steady running (Run held, nothing to update) only reports speed
-        mod, ax = self.module, self.axis
-        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and mod is not None and ax is not None and ax.owner is self and ax.segs \
-                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either steady
+        # running (the block's own move, Run held, nothing to update) or
+        # nothing to start (no move of this block, no Run edge): command()
+        # has nothing to do, only C_Spd and C_Status to report
+        ax, plc = self.axis, self.plc
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            self.last_spd = spd = ax.speed(self.plc.now_us)
-            return INNER_OK, 0, self.status, spd
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    self.last_spd = spd = ax.speed(plc._t_us)
+                    return INNER_OK, 0, self.status, spd
+            elif self.prev_run or not run:
+                self.prev_run = run
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, 0, self.status, 0
+        return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, inner, update,
+                               direction, e_stop, run)
+
+    def call_exact(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
+                   e_stop, run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -216,16 +262,34 @@ class PosGotoR(MotionBlock):
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
                  run) -> tuple:
-        # perf: a move in progress with Run held only reports C_Pos and C_Spd
-        mod, ax = self.module, self.axis
-        if run and self.prev_run and not update and not e_stop and inner == INNER_OK \
-                and mod is not None and ax is not None and ax.owner is self and ax.segs \
-                and mod.enabled_scan == self.plc.scans and mod.slot == em_no \
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either a move of
+        # this block running with Run held and nothing to update, or nothing
+        # to start (no move of this block, no Run edge): command() has
+        # nothing to do, only C_Pos, C_Spd and C_Status to report
+        ax, plc = self.axis, self.plc
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
                 and self._axis_no == axis_no and self.initialised:
-            t = self.plc.now_us
-            self.last_spd = spd = ax.speed(t)
-            self.c_pos = c_pos = ax.travel(t)
-            return INNER_OK, 0, self.status, c_pos, spd
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    t = plc._t_us
+                    self.last_spd = spd = ax.speed(t)
+                    self.c_pos = c_pos = ax.travel(t)
+                    return INNER_OK, 0, self.status, c_pos, spd
+            elif self.prev_run or not run:
+                self.prev_run = run
+                # C_Pos keeps this block's last move (see call_exact)
+                self.c_pos, self.last_spd = self.last_pos, 0
+                if self.status == ST_RUN and ax.owner is self:
+                    self.status = ST_STOPPED
+                return INNER_OK, 0, self.status, self.c_pos, 0
+        return self.call_exact(em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update,
+                               e_stop, run)
+
+    def call_exact(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
+                   run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -323,6 +387,34 @@ class Homing(MotionBlock):
 
     def __call__(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
                  run) -> tuple:
+        # perf: no Run edge, no E_Stop, InnerState as the block keeps it,
+        # the module and axis of the last call enabled in this scan, and
+        # either the axis moving for this block (poll() has nothing to
+        # report) with Run held or no homing active, or no homing active
+        # and the axis not moving for it: only C_Spd and C_Status to report
+        ax, seq, plc = self.axis, self.seq, self.plc
+        if not e_stop and inner == INNER_OK and ax is not None \
+                and (self.prev_run or not run) and self.module.enabled_scan == plc.scans \
+                and self.module.slot == em_no and self._axis_no == axis_no \
+                and self.initialised:
+            active = seq is not None and seq.active
+            if ax.owner is self and ax.segs:
+                if run or not active:
+                    self.prev_run = run
+                    self.last_spd = spd = ax.speed(plc._t_us)
+                    return INNER_OK, self.status, spd
+            elif not active:
+                self.prev_run = run
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, self.status, 0
+        return self.call_exact(em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
+                               run)
+
+    def call_exact(self, em_no, axis_no, mode, v_low, v_high, offset, inner, e_stop,
+                   run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):

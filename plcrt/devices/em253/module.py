@@ -21,7 +21,7 @@ from typing import Any, Optional
 
 from ...errors import PlcConfigError
 from .. import AxisState
-from .axis import Axis, AxisPlant
+from .axis import NEVER, Axis, AxisPlant
 
 CLR_PULSE_US = 200_000  #: CLR output pulse length (manual 2.1: "about 200 ms")
 SINGLE_ENDED_MAX_HZ = 200_000
@@ -54,13 +54,39 @@ class EM253Module:
         self.stf_any = False
         self._cache: list[tuple[int, int] | None] = [None, None]
         self._events = [list(a.plant.events) for a in self.axes]
+        #: perf: bound once; fork() maps these buffers to the twin's
+        self._pi = plc.mem.areas["PI"]
+        self._q = plc.mem.areas["Q"]
+        self._di2 = slice(self.di, self.di + 2)
+        self._do2 = slice(self.do, self.do + 2)
+        self._in2 = self._out2 = b"\0\0"   #: the terminal bytes last written
+        self._plant_next = NEVER   #: time of the next scripted input (STF) event
+        self._clr_shown = False    #: a CLR output bit is on in the bytes last written
         self._write_terminals(0)
+        self._plant_next = min((evs[0][0] for evs in self._events if evs), default=NEVER)
 
     @property
     def max_hz(self) -> int:
         return DIFFERENTIAL_MAX_HZ if self.differential else SINGLE_ENDED_MAX_HZ
 
     def step(self, plc: Any, t_from: int, t_to: int) -> None:
+        """Advance both axes over (t_from, t_to] and write the terminals."""
+        a0, a1 = self.axes
+        # perf: nothing is due on either axis (Axis.wake: no crossing, no
+        # end of a move, no input bit change, no command since the last
+        # step), no scripted input event, no CLR pulse pending and none
+        # shown: the terminals are the bytes of the last step, written again
+        # as every scan does
+        if t_to < a0.wake and t_to < a1.wake and t_to < self._plant_next \
+                and not self.clr_pending and not self._clr_shown:
+            self._pi[self._di2] = self._in2
+            self._q[self._do2] = self._out2
+            return
+        self.step_exact(t_from, t_to)
+
+    def step_exact(self, t_from: int, t_to: int) -> None:
+        """:meth:`step` without the shortcut: every event up to ``t_to`` in
+        time order, then the terminals."""
         for i, ax in enumerate(self.axes):
             evs = self._events[i]
             while evs and evs[0][0] <= t_to:
@@ -71,12 +97,13 @@ class EM253Module:
                     self.set_stf(i, te, value)
             ax.advance(t_to)
         self._write_terminals(t_to, t_from)
+        self._plant_next = min((evs[0][0] for evs in self._events if evs), default=NEVER)
 
     def set_stf(self, i: int, t: int, value: bool) -> None:
         """Hardware emergency stop: pulses stop at once, no ramp (manual 2.1)."""
         ax = self.axes[i]
         ax.stf = value
-        ax.dirty = True
+        ax.wake = 0
         self.stf_any = any(a.stf for a in self.axes)
         if value and ax.moving:
             ax.stop_now(t)
@@ -88,21 +115,24 @@ class EM253Module:
         """Input terminals into PI, output terminals into Q, for time ``t``.
 
         The bytes are written every scan (the module owns them), but only
-        recomputed for a moving axis or after a change (perf).
+        recomputed when the axis's wake time has come (a change, an event,
+        an input bit reached: :meth:`Axis.next_change`) or its CLR bit
+        changes (perf).
         """
-        pi = self.plc.mem.areas["PI"]
-        q = self.plc.mem.areas["Q"]
         t_from = t if t_from is None else t_from
+        cache = self._cache
         for i, ax in enumerate(self.axes):
             until = self.clr_until[i]
             clr = until is not None and t_from < until
-            cached = self._cache[i]
-            if ax.segs or ax.dirty or cached is None or bool(cached[1] & 2) != clr:
-                ax.dirty = False
-                cached = self._cache[i] = self._bytes(ax, t, clr)
-            b, o = cached
-            pi[self.di + i] = b
-            q[self.do + i] = o
+            cached = cache[i]
+            if t >= ax.wake or cached is None or bool(cached[1] & 2) != clr:
+                cache[i] = self._bytes(ax, t, clr)
+                ax.wake = ax.next_change(t)
+        (b0, o0), (b1, o1) = cache  # type: ignore[misc]
+        self._in2 = self._pi[self._di2] = bytes((b0, b1))
+        self._out2 = self._q[self._do2] = bytes((o0, o1))
+        # a CLR bit on: the next step must see MOTION_EN3 end the pulse
+        self._clr_shown = bool((o0 | o1) & 2)
 
     @staticmethod
     def _bytes(ax: Axis, t: int, clr: bool) -> tuple[int, int]:

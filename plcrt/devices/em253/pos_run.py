@@ -7,6 +7,7 @@ look-ahead, Update of a running envelope, and C_Step / C_Pos.  Decisions
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from fractions import Fraction
 from typing import Optional
 
@@ -23,9 +24,41 @@ MAX_STEPS = 32
 class PosRun(MotionBlock):
     name = "POS_RUN"
     mode_in = 0   #: the Mode input of the current call
+    _b_of: object = None   #: the bounds list _b_ceil and _b_floor were made from
 
     def __call__(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
                  run) -> tuple:
+        # perf: no E_Stop, InnerState as the block keeps it, the module and
+        # axis of the last call enabled in this scan, and either the
+        # envelope of this block running with Run held and nothing to
+        # update, or nothing to start (no envelope of this block running,
+        # no Run edge): command() has nothing to do, only C_Step, C_Pos,
+        # C_Spd and C_Status to report
+        ax, plc = self.axis, self.plc
+        if not e_stop and not update and inner == INNER_OK and ax is not None \
+                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
+                and self._axis_no == axis_no and self.initialised:
+            if ax.owner is self and ax.segs:
+                if run and self.prev_run:
+                    t = plc._t_us
+                    self.mode_in = mode
+                    self.last = (step, c_pos) = self._step_at(ax.travel(t))
+                    self.last_spd = spd = ax.speed(t)
+                    return INNER_OK, 0, self.status, c_pos, spd, step
+            elif self.prev_run or not run:
+                self.prev_run = run
+                self.mode_in = mode
+                step, c_pos = getattr(self, "last", (0, 0))
+                if self.status == ST_RUN:
+                    self.status = ST_STOPPED
+                self.last_spd = 0
+                return INNER_OK, 0, self.status, c_pos, 0, step
+        return self.call_exact(em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
+                               run)
+
+    def call_exact(self, em_no, axis_no, mode, v_ss, ptr, steps, inner, update, e_stop,
+                   run) -> tuple:
+        """The instruction without the shortcut of :meth:`__call__`."""
         rising = run and not self.prev_run
         self.prev_run = run
         if not self.find(em_no, axis_no) or not self.inner(inner):
@@ -229,13 +262,19 @@ class PosRun(MotionBlock):
         At a boundary the next step has begun (0 pulses sent in it); at the
         envelope's end the last step is complete.
         """
-        start = 0
-        last = len(self.bounds) - 1
-        for i, b in enumerate(self.bounds):
-            if x < b or i == last:
-                return i + 1, x - start
-            start = int(b)
-        return 0, 0
+        bounds = self.bounds
+        if not bounds:
+            return 0, 0
+        # perf: x is whole, so x < b exactly when x < ceil(b); the ceilings
+        # and floors of the step ends are computed once per plan, and the
+        # step found by bisection (a Fraction comparison per step was the
+        # slow part)
+        if self._b_of is not bounds:
+            self._b_ceil = [-((-b.numerator) // b.denominator) for b in map(Fraction, bounds)]
+            self._b_floor = [int(b) for b in bounds]
+            self._b_of = bounds
+        i = min(bisect_right(self._b_ceil, x), len(bounds) - 1)
+        return i + 1, x - (self._b_floor[i - 1] if i else 0)
 
     def _progress(self, t: int) -> tuple[int, int]:
         if not self.owns() or not hasattr(self, "bounds"):

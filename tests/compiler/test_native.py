@@ -86,6 +86,10 @@ ROWS = {
     "EU": "LD I0.0\nEU\n= Q0.0\nLD I0.1\nA I0.0\nEU\nINCW VW30",
     "ED": "LD I0.0\nED\n= Q0.0\nLDN I0.1\nED\nINCW VW30",
     "MOVR": "LD I0.0\nMOVR VD8, VD20\nMOVR 1.5, VD24\nMOVR -3.4e38, AC1\nMOVR 7, VD28",
+    "TONR": "LD I0.0\nTONR T5, +4\nLD T5\n= Q0.0\nLD I0.1\nTONR T6, VW2\nLD Q0.7\nR T5, 1\n"
+            "LD T5\n= Q0.7",
+    "TOF": "LD I0.0\nTOF T40, +3\nLD T40\n= Q0.0\nLDN I0.1\nTOF T41, +1\nLD I0.7\nR T40, 1\n"
+           "LD SM0.1\nTOF T42, +2\nLD T42\n= Q0.1",
     "TON": "LD I0.0\nTON T37, +3\nLD T37\n= Q0.0\nLDN I0.0\nTON T38, VW2\n"
            "LD I0.1\nTON T101, +1",
 }
@@ -135,7 +139,7 @@ def test_lowered_instruction_matches_python(mnemonic: str) -> None:
 
 def test_pieces_outside_the_table_fall_back_per_network_with_a_reason() -> None:
     text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\n= Q0.0\n"
-            "Network 2\nLD I0.0\nLD I0.1\nCTU C3, +4\nNetwork 3\nLD I0.0\nTOF T40, +5\n"
+            "Network 2\nLD I0.0\nLD I0.1\nCTU C3, +4\nNetwork 3\nLD I0.0\nPLS 0\n"
             "Network 4\nLD I0.1\nTON T33, +5\nNetwork 5\nLD SM0.0\nCALL SBR_0, VW0\n"
             "Network 6\nLD I0.1\n= Q0.2\nEND_ORGANIZATION_BLOCK\n"
             "SUBROUTINE_BLOCK SBR_0:SBR0\nVAR_INPUT\nx:INT;\nEND_VAR\nBEGIN\nNetwork 1\n"
@@ -145,7 +149,7 @@ def test_pieces_outside_the_table_fall_back_per_network_with_a_reason() -> None:
     reasons = {(b, n): why for b, n, why in info["python"]}
     assert reasons == {
         ("OB1", 2): "CTU is not lowered",
-        ("OB1", 3): "TOF is not lowered",
+        ("OB1", 3): "PLS is not lowered",
         ("OB1", 4): "only 100 ms timers run natively",
         ("OB1", 5): "CALL is not lowered",
         ("SBR0", 1): "operand area L is not reached natively",

@@ -2,14 +2,15 @@
 
 ``plcrt.load(..., backend="native")`` compiles the pieces that
 :mod:`.lower` can lower (bit logic, the logic stack, byte/word/double-word
-compares and moves, integer math with its flags, edges, 100 ms TON and
-timer resets) to machine code; consecutive lowered pieces of a block become
-one *segment*, one call from the block's runner.  Everything else -- a piece
-with a call, a jump, a label or a loop, an instruction outside the table, an
-L-memory operand, an instrumented program (coverage, breakpoints) -- runs as
-the Python backend's code, which is generated for every piece in either case (``plcrt
-dump`` shows it).  Both backends give the same memory image after every
-scan: the differential tests compare them.
+compares and moves, integer math with its flags, word logic, conversions,
+edges, the 100 ms timers' boxes and resets) to machine code; consecutive
+lowered pieces of a block become one *segment*, one call from the block's
+runner.  Everything else -- a piece with a call, a jump, a label or a
+loop, an instruction outside the table, an L-memory operand, an
+instrumented program (coverage, breakpoints) -- runs as the Python
+backend's code, which is generated for every piece in either case
+(``plcrt dump`` shows it).  Both backends give the same memory image after
+every scan: the differential tests compare them.
 
 This package is not the compiler of llvmlite itself (:mod:`.jit`), and
 imports it only there: the default install stays pure Python.

@@ -657,6 +657,79 @@ def _ton(f: Fn, t: Any, pt: Any) -> None:
     wbit_tc(f, "TB", n, bit)
 
 
+def _tc_bit(f: Fn, slot: str, n: int) -> str:
+    """``i1`` of bit ``n`` of the TB/CB bitmap."""
+    v = f.load8(slot, n >> 3)
+    if n & 7:
+        v = f.op(f"lshr i8 {v}, {n & 7}")
+    return f.op(f"trunc i8 {v} to i1")
+
+
+def _timer_state(f: Fn, t: Any, pt: Any) -> tuple[int, str, str, str, str, str]:
+    """What every 100 ms timer box starts from: its number, IN, PT (the
+    preset is stored, as the bank does), running, CV and CV advanced by the
+    scan's 100 ms ticks (capped at 32767)."""
+    if not isinstance(t, Addr) or t.area != "T" or resolution_ms(t.offset) != 100:
+        raise NotLowered("only 100 ms timers run natively")
+    n = t.offset
+    en = f.top
+    p = rd(f, pt, "W")
+    f.stmt(f"store i16 {f.op(f'trunc i32 {p} to i16')}, "
+           f"ptr {f.at('T_PRE', 2 * n)}, align 1")
+    run = f.op(f"icmp ne i8 {f.load8('T_RUN', n)}, 0")
+    cv = rd(f, t, "W")
+    d100 = f.op(f"load i32, ptr {f.base('T_D100')}, align 4")
+    adv = f.op(f"add i32 {cv}, {d100}")
+    capped = f.op(f"select i1 {f.op(f'icmp sgt i32 {adv}, {MAX_CV}')}, i32 {MAX_CV}, i32 {adv}")
+    return n, en, p, run, cv, capped
+
+
+def _timer_store(f: Fn, t: Any, n: int, run: str, cv: str, bit: str) -> None:
+    f.store8("T_RUN", n, f.op(f"zext i1 {run} to i8"))
+    wr(f, t, "W", cv, None)
+    wbit_tc(f, "TB", n, bit)
+
+
+@lowers("TONR")
+def _tonr(f: Fn, t: Any, pt: Any) -> None:
+    """TONR of a 100 ms timer (TimerBank.tonr): IN = 0 stops it and keeps
+    value and bit; IN = 1 starts it from its value or adds the ticks."""
+    n, en, p, run, cv, capped = _timer_state(f, t, pt)
+    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
+    cvn = f.op(f"select i1 {en}, i32 {on}, i32 {cv}")
+    old_bit = _tc_bit(f, "TB", n)
+    reached = f.op(f"icmp sge i32 {on}, {p}")
+    bit = f.op(f"select i1 {en}, i1 {reached}, i1 {old_bit}")
+    _timer_store(f, t, n, en, cvn, bit)
+
+
+@lowers("TOF")
+def _tof(f: Fn, t: Any, pt: Any) -> None:
+    """TOF of a 100 ms timer (TimerBank.tof): IN = 1 stops it, value 0, bit
+    1; the falling edge of IN starts it (value 0, bit 1); a running one adds
+    the ticks and, at PT, switches the bit off and stops."""
+    n, en, p, run, cv, capped = _timer_state(f, t, pt)
+    prev = f.op(f"icmp ne i8 {f.load8('T_PREV', n)}, 0")
+    f.store8("T_PREV", n, f.op(f"zext i1 {en} to i8"))
+    old_bit = _tc_bit(f, "TB", n)
+    done = f.op(f"icmp sge i32 {capped}, {p}")
+    not_en = f.op(f"xor i1 {en}, true")
+    not_prev = f.op(f"xor i1 {prev}, true")
+    timing = f.op(f"and i1 {not_en}, {f.op(f'and i1 {not_prev}, {run}')}")
+    starting = f.op(f"or i1 {en}, {prev}")   # IN on, or its falling edge: value 0, bit 1
+    # running on: the ticks added; the bit stays on until PT
+    cv_t = f.op(f"select i1 {timing}, i32 {capped}, i32 {cv}")
+    cvn = f.op(f"select i1 {starting}, i32 0, i32 {cv_t}")
+    going = f.op(f"xor i1 {done}, true")
+    bit_t = f.op(f"select i1 {timing}, i1 {going}, i1 {old_bit}")
+    bit = f.op(f"select i1 {starting}, i1 true, i1 {bit_t}")
+    # running: stopped by IN, started by the falling edge, stopped at PT
+    run_t = f.op(f"select i1 {timing}, i1 {going}, i1 {run}")
+    run_e = f.op(f"select i1 {prev}, i1 true, i1 {run_t}")
+    run_n = f.op(f"select i1 {en}, i1 false, i1 {run_e}")
+    _timer_store(f, t, n, run_n, cvn, bit)
+
+
 def wbit_tc(f: Fn, slot: str, n: int, v: str) -> None:
     """Write a timer or counter bit (bit ``n`` of the TB/CB bitmap)."""
     old = f.load8(slot, n >> 3)

@@ -627,36 +627,6 @@ LOWER["BTI"] = _widen("B", "W")
 LOWER["ITD"] = _widen("W", "D")
 
 
-@lowers("TON")
-def _ton(f: Fn, t: Any, pt: Any) -> None:
-    """TON of a 100 ms timer (engine.timers.TimerBank.ton, its full path).
-
-    IN = 0: stopped, value and bit cleared.  IN = 1: a stopped timer starts
-    from its value; a running one adds the 100 ms ticks of this scan
-    (capped at 32767).  The bit is CV >= PT.  The 1 ms and 10 ms timers
-    are advanced by the engine at the scan start: they stay in Python.
-    """
-    if not isinstance(t, Addr) or t.area != "T" or resolution_ms(t.offset) != 100:
-        raise NotLowered("only 100 ms timers run natively")
-    n = t.offset
-    en = f.top
-    p = rd(f, pt, "W")
-    f.stmt(f"store i16 {f.op(f'trunc i32 {p} to i16')}, "
-           f"ptr {f.at('T_PRE', 2 * n)}, align 1")
-    run_b = f.load8("T_RUN", n)
-    run = f.op(f"icmp ne i8 {run_b}, 0")
-    cv = rd(f, t, "W")
-    d100 = f.op(f"load i32, ptr {f.base('T_D100')}, align 4")
-    adv = f.op(f"add i32 {cv}, {d100}")
-    capped = f.op(f"select i1 {f.op(f'icmp sgt i32 {adv}, {MAX_CV}')}, i32 {MAX_CV}, i32 {adv}")
-    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
-    cvn = f.op(f"select i1 {en}, i32 {on}, i32 0")
-    bit = f.op(f"and i1 {en}, {f.op(f'icmp sge i32 {cvn}, {p}')}")
-    f.store8("T_RUN", n, f.op(f"zext i1 {en} to i8"))
-    wr(f, t, "W", cvn, None)
-    wbit_tc(f, "TB", n, bit)
-
-
 def _tc_bit(f: Fn, slot: str, n: int) -> str:
     """``i1`` of bit ``n`` of the TB/CB bitmap."""
     v = f.load8(slot, n >> 3)
@@ -688,6 +658,22 @@ def _timer_store(f: Fn, t: Any, n: int, run: str, cv: str, bit: str) -> None:
     f.store8("T_RUN", n, f.op(f"zext i1 {run} to i8"))
     wr(f, t, "W", cv, None)
     wbit_tc(f, "TB", n, bit)
+
+
+@lowers("TON")
+def _ton(f: Fn, t: Any, pt: Any) -> None:
+    """TON of a 100 ms timer (engine.timers.TimerBank.ton, its full path).
+
+    IN = 0: stopped, value and bit cleared.  IN = 1: a stopped timer starts
+    from its value; a running one adds the 100 ms ticks of this scan
+    (capped at 32767).  The bit is CV >= PT.  The 1 ms and 10 ms timers
+    are advanced by the engine at the scan start: they stay in Python.
+    """
+    n, en, p, run, cv, capped = _timer_state(f, t, pt)
+    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
+    cvn = f.op(f"select i1 {en}, i32 {on}, i32 0")
+    bit = f.op(f"and i1 {en}, {f.op(f'icmp sge i32 {cvn}, {p}')}")
+    _timer_store(f, t, n, en, cvn, bit)
 
 
 @lowers("TONR")

@@ -266,7 +266,13 @@ class Plc(AddressAccess):
         plan = self.unit.native
         if plan is not None and plan.names:
             from ..compiler.native.jit import NativeCode
-            self._entry.native = NativeCode(plan.ir, plan.names)
+            try:
+                self._entry.native = NativeCode(plan.ir, plan.names)
+            except Exception as e:  # a plcrt bug or a broken llvmlite, never the user's
+                raise PlcConfigError(f"internal error: the native backend cannot compile "
+                                     f"this program ({type(e).__name__}: {str(e)[:200]}); "
+                                     f"load it with backend='python', and please report "
+                                     f"it with the program") from None
             plan.functions = []      # the IR text is compiled (and cached on disk)
 
     def _cached_entry(self, program: ir.Program, auto_diags: list[Diagnostic]) -> Entry:

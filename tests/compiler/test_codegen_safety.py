@@ -86,3 +86,49 @@ def test_hostile_symbol_address_is_rejected_cleanly() -> None:
         assert "<string>:4:8: error:" in text and "bad" in text
     else:  # pragma: no cover - the assertion above is the point
         raise AssertionError("a symbol standing for code must not compile")
+
+
+def test_hostile_text_never_reaches_the_native_backends_ir() -> None:
+    """The LLVM IR of the native backend holds only plcrt's own words and
+    numbers, and its Python runners pass the checks above."""
+    import pytest
+    pytest.importorskip("llvmlite")
+    from plcrt.compiler import compile_program
+    from plcrt.memory.cpu import cpu_model
+    from plcrt.lang.sources import read_program
+    program, symbols, _ = read_program([HOSTILE], parse_symbols(SYMBOLS, "evil.sdf"), None)
+    unit, src, _ = compile_program(program, cpu_model(None), symbols=symbols, native=True)
+    ir_text = unit.native.ir
+    assert unit.native.pieces >= 1 and "evil" not in ir_text and "import" not in ir_text
+    words = set(re.findall(r"[A-Za-z_][A-Za-z_0-9]*",
+                           re.sub(r"[%@](v|b|c|seg)\d+(_\d+)?|%ctx", " ", ir_text)))
+    assert words <= {"define", "internal", "void", "ptr", "noinline", "entry", "ret", "call",
+                     "getelementptr", "load", "store", "align", "select", "icmp", "true",
+                     "false", "to", "trunc", "zext", "sext", "and", "or", "xor", "shl",
+                     "lshr", "add", "sub", "mul", "eq", "ne", "slt", "sle", "sgt", "sge",
+                     "ult", "ule", "ugt", "uge", "i1", "i8", "i16", "i32", "i64"}, words
+    plc = plcrt.load(HOSTILE, symbols=parse_symbols(SYMBOLS, "evil.sdf"), backend="native")
+    for node in ast.walk(ast.parse(plc.source)):
+        if isinstance(node, (ast.Name, ast.arg)):
+            name = node.id if isinstance(node, ast.Name) else node.arg
+            assert NAME_OK.match(name), name
+    plc["I0.0"] = 1
+    plc.scan()
+    assert (plc["Q0.0"], plc["VB0"], plc["VW10"]) == (1, ord("A"), 7)
+
+
+def test_a_native_compile_failure_is_a_clear_error(monkeypatch) -> None:
+    """Should llvmlite refuse the IR (a plcrt bug), the load says so and how
+    to go on, instead of a traceback."""
+    import pytest
+    pytest.importorskip("llvmlite")
+    from plcrt.compiler.cache import programs
+    import plcrt.compiler.native.jit as jit
+
+    def broken(self, ir_text, names):
+        raise RuntimeError("LLVM ERROR: bad IR")
+    monkeypatch.setattr(jit.NativeCode, "__init__", broken)
+    programs.clear()
+    with pytest.raises(plcrt.PlcConfigError, match="backend='python'"):
+        plcrt.load("ORGANIZATION_BLOCK OB1\nBEGIN\nNetwork 1\nLD I0.3\n= Q0.3\n"
+                   "END_ORGANIZATION_BLOCK\n", backend="native")

@@ -196,8 +196,8 @@ def rd(f: Fn, op: Any, kind: str) -> str:
     """Value of an operand as ``WIDE[kind]`` (B, WU, DU unsigned; W, D signed)."""
     ty = WIDE[kind]
     if isinstance(op, Const):
-        if isinstance(op.value, bytes) or op.is_real:
-            raise NotLowered("string and REAL constants are not lowered")
+        # the value the Python code uses (a character constant's code, a
+        # REAL constant's bit pattern in a double word)
         return str(int(const_expr(op, kind)))
     if isinstance(op, Pointer):
         return str(int(op.value))

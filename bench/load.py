@@ -339,11 +339,13 @@ def measure(plcrt_dir: str | None, sizes: list[int], seeds: list[int], shapes: l
                     row[mode] = _run_child(path, mode, plcrt_dir)
                 rows.append(row)
                 print(_line(row), file=sys.stderr)
-    text = _generators()["bool"](1000, 1)
-    fixture = fixture_overhead(text, fixture_tests, plcrt_dir)
-    (workdir / "fixture_1000.awl").write_text(text)
-    fixture["in_process"] = _run_child(workdir / "fixture_1000.awl", "fixture", plcrt_dir)
-    print(f"fixture: {fixture}", file=sys.stderr)
+    fixture: dict[str, Any] = {}
+    if fixture_tests > 0:                      # --fixture-tests 0: loads only
+        text = _generators()["bool"](1000, 1)
+        fixture = fixture_overhead(text, fixture_tests, plcrt_dir)
+        (workdir / "fixture_1000.awl").write_text(text)
+        fixture["in_process"] = _run_child(workdir / "fixture_1000.awl", "fixture", plcrt_dir)
+        print(f"fixture: {fixture}", file=sys.stderr)
     return {"plcrt": plcrt_dir or "this checkout", "loads": rows, "fixture": fixture}
 
 
@@ -364,7 +366,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default="1000,10000,100000")
     ap.add_argument("--seeds", default="1")
     ap.add_argument("--shapes", default="bool,mixed")
-    ap.add_argument("--fixture-tests", type=int, default=300)
+    ap.add_argument("--fixture-tests", type=int, default=300,
+                    help="pytest runs of N and 2N tests for the fixture's cost (0: none)")
     ap.add_argument("--plcrt", default=None, help="measure the plcrt package in this directory")
     ap.add_argument("--compare", default=None,
                     help="also measure the plcrt in this directory (before/after)")

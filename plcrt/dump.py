@@ -1,6 +1,6 @@
 """``plcrt dump``: the generated Python of a program, annotated for reading.
 
-Each network's function gets a banner with its block, network and title,
+Each network's code gets a banner with its block, network and title,
 and each instruction marker of the generated code gets the STL line it
 came from.  This module only formats text for people; nothing here is
 executed or fed back to the compiler.
@@ -19,14 +19,16 @@ from .safetext import printable
 # The marker before each instruction's code (:func:`_with_markers`).
 _INSN_COMMENT_RE = re.compile(r"^(\s*)# \[(\d+)\] line (\d+)\s*$")
 _PIECE_DEF_RE = re.compile(r"^def n_([A-Z]+\d+)_(\d+)")
-_RUNNER_RE = re.compile(r"^(?:def |_pieces_|_costs_)pou_([A-Z]+\d+)")
+#: a function holding several consecutive networks of a block
+_GROUP_DEF_RE = re.compile(r"^def g_([A-Z]+\d+)_")
+_RUNNER_RE = re.compile(r"^(?:def |_pieces_|_costs_)?pou_([A-Z]+\d+)")
 
 
 
 def render_dump(plc: Plc) -> str:
     """The generated source, annotated for reading.
 
-    Before each network's function a banner names the block, network and
+    Before each network's code a banner names the block, network and
     title; each ``# [id] line n`` marker gains the STL text of line ``n``.
     The result is meant for people: the STL text is inserted into comments
     only, and nothing of it is executed.
@@ -42,13 +44,27 @@ def render_dump(plc: Plc) -> str:
            "# shows the STL instruction whose code follows it.", ""]
     out += _backend_lines(plc)
     last_runner = None
+    in_group = False
+    shown: tuple[str, int] | None = None      # the network of the last banner
+
+    def banner(block: str, net: int) -> None:
+        title = titles.get((block, net), "")
+        out.append(printable(f"# ==== {block} network {net}"
+                             + (f": {title}" if title else "") + " ===="))
+
     for i, line in enumerate(lines):
         piece = _PIECE_DEF_RE.match(line)
         if piece:
             block, net = _piece_origin(lines, i, locs) or (piece.group(1), int(piece.group(2)))
-            title = titles.get((block, net), "")
-            out.append(printable(f"# ==== {block} network {net}" + (f": {title}" if title else "")
-                                 + " ===="))
+            banner(block, net)
+            shown, in_group = (block, net), False
+            last_runner = None
+        elif _GROUP_DEF_RE.match(line):
+            # several networks in one function: a banner before it for the
+            # first, and where each of the others begins
+            in_group, shown = True, _piece_origin(lines, i, locs)
+            if shown is not None:
+                banner(*shown)
             last_runner = None
         runner = _RUNNER_RE.match(line)
         if runner and runner.group(1) != last_runner:
@@ -60,6 +76,10 @@ def render_dump(plc: Plc) -> str:
         if m:
             insn_id = int(m.group(2))
             loc = locs[insn_id] if insn_id < len(locs) else None
+            if in_group and loc is not None and loc.block and loc.network is not None \
+                    and (loc.block, loc.network) != shown:
+                shown = (loc.block, loc.network)
+                banner(loc.block, loc.network)
             lineno = loc.line if loc else int(m.group(3))
             stl = _stl_line(texts, loc.file if loc else None, lineno)
             # program text goes into a comment only, with control characters

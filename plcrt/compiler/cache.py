@@ -415,7 +415,7 @@ class Entry:
 
     program: Any
     unit: Any
-    source: str
+    source: bytes                       #: the generated module, zlib-compressed
     line_locs: dict[int, Any]
     codes: list[types.CodeType]
     template: Any                       #: a Plc compiled from it that never runs

@@ -39,6 +39,11 @@ MAX_STACK_LEVELS = 9
 _CUT_BEFORE = {"label"}
 _CUT_AFTER = {"for", "next", "scre"}
 
+#: perf: at most this many pieces, or about this many lines, per function of
+#: a block without jumps (a bound on what one call and one compile chunk hold)
+GROUP_PIECES = 32
+GROUP_LINES = 400
+
 
 @dataclass
 class Piece:
@@ -413,7 +418,40 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
         unit.current = info
         resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars,
                             codepage)
-        fnames: list[str] = []
+
+        def emit_def(name: str, parts: list[tuple[str, list[str], list[str], list]]) -> None:
+            """One function holding the bodies of ``parts`` in order."""
+            used = sorted({n for part in parts for n in part[1]})
+            maybe_cut()
+            out.append(f"def {name}({', '.join(['L'] + [f'{n}={n}' for n in used])}):")
+            for _f, _u, body, line_map in parts:
+                base = len(out)
+                out.extend(body)
+                for rel, insn_id, indent in line_map:
+                    assert insn_id == len(line_locs.starts)   # ids follow the text
+                    line_locs.add(base + 1 + rel, indent)
+            if all(not part[2] for part in parts):
+                # only instructions without code (LBL, SCRE, NOP ...): a
+                # def needs at least one statement
+                out.append("    pass")
+            out.append("")
+
+        records: list[tuple[str, list[str], list[str], list[tuple[int, int, int]]]] = []
+        calls: list[str] | None = None if info.flow else []
+        #: perf: without the native backend a group is emitted as soon as it
+        #: is full, so that the lines of a big block are not all held at once
+        stream = unit.native is None and not info.flow
+
+        def emit_group(group: list[Any]) -> None:
+            """Consecutive Python pieces of a block without jumps as one
+            function (a call and a function object less per network, about
+            550 bytes less per piece)."""
+            assert calls is not None
+            name = group[0][0] if len(group) == 1 else \
+                f"g_{p.ident}_{len(calls)}_{group[0][0].rsplit('_', 1)[1]}"
+            emit_def(name, group)
+            calls.append(f"{name}(L)")
+
         for piece in info.pieces:
             unit.current_piece = piece
             if unit.native is not None:
@@ -434,22 +472,11 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             emit_piece(unit, gen, piece, resolver)
             gen.pending = None  # a value left on the stack at the end is dead
             info.depth_after[piece.index] = gen.depth
-            args = ["L"] + [f"{n}={n}" for n in sorted(gen.used - {"L"})]
-            header = f"def {fname}({', '.join(args)}):"
-            maybe_cut()
-            base = len(out)
-            out.append(header)
-            body = gen.lines
-            if not body:
-                # only instructions without code (LBL, SCRE, NOP ...): a
-                # def needs at least one statement
-                body = ["    pass"]
-            out.extend(body)
-            for rel, insn_id, indent in gen.line_map:
-                assert insn_id == len(line_locs.starts)   # ids follow the text
-                line_locs.add(base + 2 + rel, indent)
-            out.append("")
-            fnames.append(fname)
+            records.append((fname, sorted(gen.used - {"L"}), gen.lines, gen.line_map))
+            if stream and (len(records) >= GROUP_PIECES
+                           or sum(len(r[2]) for r in records) >= GROUP_LINES):
+                emit_group(records)
+                records = []
         segs = None
         if unit.native is not None:
             from .native import plan_pou
@@ -461,8 +488,46 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                              for pc in info.pieces])
             for pc in info.pieces:
                 pc.resolved = None
+
+        fnames: list[str] = []
+        if info.flow:
+            # a jump may land on any piece: one function each; a native
+            # piece runs through a wrapper that falls through
+            for i, rec in enumerate(records):
+                emit_def(rec[0], [rec])
+                seg = segs[i] if segs is not None else None
+                if seg is None:
+                    fnames.append(rec[0])
+                else:
+                    out.extend([f"def _nw{seg}(L, _f=_nseg{seg}):", "    _f()", ""])
+                    fnames.append(f"_nw{seg}")
+        else:
+            # consecutive Python pieces share one function; a native piece
+            # keeps its own, uncalled function for plcrt dump
+            assert calls is not None
+            group: list[Any] = []
+            prev: int | None = None
+            for i, rec in enumerate(records):
+                fnames.append(rec[0])
+                seg = segs[i] if segs is not None else None
+                if seg is not None:
+                    if group:
+                        emit_group(group)
+                        group = []
+                    emit_def(rec[0], [rec])
+                    if seg != prev:
+                        calls.append(f"_nseg{seg}()")
+                else:
+                    group.append(rec)
+                    if len(group) >= GROUP_PIECES or \
+                            sum(len(r[2]) for r in group) >= GROUP_LINES:
+                        emit_group(group)
+                        group = []
+                prev = seg
+            if group:
+                emit_group(group)
         maybe_cut()
-        out.extend(_runner(unit, info, fnames, segs))
+        out.extend(_runner(unit, info, fnames, calls))
         out.append("")
     return "\n".join(out) + "\n", line_locs
 
@@ -534,38 +599,16 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
 
 
 def _runner(unit: Unit, info: PouInfo, fnames: list[str],
-            segs: list[int | None] | None = None) -> list[str]:
-    if info.flow and segs is not None and any(s is not None for s in segs):
-        # native pieces of a block with jumps or loops: each is its own
-        # segment, wrapped as a piece function that falls through
-        wrapped = []
-        lines = []
-        for fname, seg in zip(fnames, segs):
-            if seg is None:
-                wrapped.append(fname)
-            else:
-                lines += [f"def _nw{seg}(L, _f=_nseg{seg}):", "    _f()"]
-                wrapped.append(f"_nw{seg}")
-        return lines + _runner(unit, info, wrapped)
-    if segs is not None and any(s is not None for s in segs):
-        # native segments (plcrt.compiler.native): one call per run of
-        # lowered pieces, the Python piece functions for the others
-        lines = [f"def {info.fname}(L):"]
-        prev: int | None = None
-        for fname, seg in zip(fnames, segs):
-            if seg is None:
-                lines.append(f"    {fname}(L)")
-            elif seg != prev:
-                lines.append(f"    _nseg{seg}()")
-            prev = seg
-        return lines
-    if not info.flow and len(fnames) == 1:
-        # perf: a block of one piece is that piece (one call less per run)
-        return [f"{info.fname} = {fnames[0]}"]
+            calls: list[str] | None = None) -> list[str]:
+    """The block's runner: ``calls`` in order for a block without jumps and
+    loops (grouped piece functions, native segments), else a
+    program-counter loop over the piece functions ``fnames``."""
     if not info.flow:
-        lines = [f"def {info.fname}(L):"]
-        lines += [f"    {f}(L)" for f in fnames] or ["    pass"]
-        return lines
+        assert calls is not None
+        if len(calls) == 1 and calls[0].endswith("(L)"):
+            # perf: a block of one function is that function (one call less)
+            return [f"{info.fname} = {calls[0][:-3]}"]
+        return [f"def {info.fname}(L):"] + [f"    {c}" for c in calls or ["pass"]]
     costs = ", ".join(str(c) for c in info.cost)
     return [
         f"_pieces_{info.fname} = ({', '.join(fnames)},)",

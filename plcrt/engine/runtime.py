@@ -23,6 +23,7 @@ import copy
 import os
 import time as _time
 import types
+import zlib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
@@ -246,12 +247,12 @@ class Plc(AddressAccess):
 
         before, warned = len(self.diagnostics), set(self._warned)
         with gc_paused():
-            self.unit, self.source, self.line_locs = compile_program(
+            self.unit, source, self.line_locs = compile_program(
                 program, self.model, symbols=symbols, system_symbols=system_symbols,
                 setup=setup, probes=self.coverage, library=library,
                 native=self._config["backend"] == "native")
             try:
-                codes = compile_chunks(self.source, self.unit.chunks,
+                codes = compile_chunks(source, self.unit.chunks,
                                        f"<plcrt {program.file}>")
             except SyntaxError as e:  # a plcrt bug, never the user's: say so clearly
                 raise PlcConfigError(f"internal error: generated code does not compile "
@@ -261,7 +262,11 @@ class Plc(AddressAccess):
         # not needed any more; the bindings hold what the code uses
         self.unit.hooks.clear()
         self._bindings = self.unit.bindings
-        self._entry = Entry(program, self.unit, self.source, self.line_locs, codes, self,
+        # the generated text is kept for plcrt dump only: compressed, it
+        # is about a tenth of its size (a 100 000-statement program's 10 MiB)
+        packed = zlib.compress(source.encode("utf-8"), 1)
+        del source
+        self._entry = Entry(program, self.unit, packed, self.line_locs, codes, self,
                             self.diagnostics[before:], self._warned - warned)
         plan = self.unit.native
         if plan is not None and plan.names:
@@ -316,7 +321,7 @@ class Plc(AddressAccess):
         self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
         rebind_per_cpu(template, self, memo)
         self._entry = entry
-        self.unit, self.source, self.line_locs = entry.unit, entry.source, entry.line_locs
+        self.unit, self.line_locs = entry.unit, entry.line_locs
         self.diagnostics = (auto_diags + list(self.unit.diag.items) + self.diagnostics
                             + list(entry.diagnostics))
         self._warned |= entry.warned
@@ -333,6 +338,11 @@ class Plc(AddressAccess):
         for code in entry.codes:
             exec(code, ns)  # noqa: S102 - source built only from validated numbers
         self._ns = ns
+
+    @property
+    def source(self) -> str:
+        """The generated Python module (what ``plcrt dump`` annotates)."""
+        return zlib.decompress(self._entry.source).decode("utf-8")
 
     def _native_buffers(self) -> dict[str, Any]:
         """The buffers the native segments reach (plcrt.compiler.native.lower.SLOTS)."""
@@ -785,7 +795,7 @@ class Plc(AddressAccess):
             raise PlcConfigError("this PLC is linked to others (plcrt.link): going back in time "
                                  "would break what they exchanged; restore before linking, or "
                                  "fork and restore the unlinked twin")
-        if (snapshot.source != self.source or snapshot.model != self.model
+        if (snapshot._entry.source != self._entry.source or snapshot.model != self.model
                 or len(snapshot.devices) != len(self.devices)
                 or (snapshot.coverage is None) != (self.coverage is None)):
             raise PlcConfigError("this snapshot was taken from the same program compiled "

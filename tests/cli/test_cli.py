@@ -386,7 +386,8 @@ def test_dump_shows_networks_and_stl_lines(capsys: pytest.CaptureFixture[str]) -
     assert "# ==== OB1 network 2: Running lamp ====" in lines
     assert "    # [0] line 10: LD     I0.0" in lines
     assert "    # [3] line 13: =      Q0.0" in lines
-    assert any(line.startswith("def pou_OB1(") for line in lines)
+    # the block's runner: here its one function (both networks) under the block's name
+    assert "pou_OB1 = g_OB1_0_0" in lines
     # each marker is followed by that instruction's code (a run of contacts
     # may be folded into one expression after its markers)
     i = lines.index("    # [0] line 10: LD     I0.0")

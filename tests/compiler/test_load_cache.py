@@ -10,7 +10,7 @@ from typing import Any, Iterator
 import pytest
 
 import plcrt
-from plcrt.compiler import cache
+from plcrt.compiler import cache, codegen
 from plcrt.engine import runtime
 from plcrt.engine.runtime import Plc, parse_sources
 
@@ -78,7 +78,7 @@ def test_a_cached_program_runs_like_a_fresh_compile(fresh_cache: cache.ProgramCa
     first = plcrt.load(PROGRAM)
     second = plcrt.load(PROGRAM)              # parsed again: equal text, a cache hit
     assert (fresh_cache.misses, fresh_cache.hits) == (1, 1)
-    assert second.unit is first.unit and second.source is first.source
+    assert second.unit is first.unit and second._entry is first._entry   # one compile, shared
     fresh_cache.max_entries = 0               # caching off: every load compiles
     uncached = plcrt.load(PROGRAM)
     assert uncached.unit is not first.unit
@@ -178,6 +178,7 @@ def test_a_fork_never_compiles_again(fresh_cache: cache.ProgramCache) -> None:
 def test_chunks_keep_the_line_numbers_of_the_whole_module(
         monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
     monkeypatch.setattr(cache, "CHUNK_LINES", 20)
+    monkeypatch.setattr(codegen, "GROUP_PIECES", 1)     # a function per network
     nets = "".join(f"Network {n}\nLD     SM0.0\nMOVW   +{n}, VW{2 * n}\nLD     I0.{n % 8}\n"
                    f"A      M0.{n % 7}\n=      Q{n % 4}.{n % 8}\n" for n in range(1, 60))
     text = f"ORGANIZATION_BLOCK OB1\nBEGIN\n{nets}END_ORGANIZATION_BLOCK\n"
@@ -200,19 +201,21 @@ def test_chunks_keep_the_line_numbers_of_the_whole_module(
 def test_a_fault_in_a_late_chunk_is_located_at_its_instruction(
         monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
     monkeypatch.setattr(cache, "CHUNK_LINES", 10)
+    monkeypatch.setattr(codegen, "GROUP_PIECES", 4)     # networks 1-4, 5-8, ...
     nets = "".join(f"Network {n}\nLD     SM0.0\nMOVW   +{n}, VW{2 * n}\n" for n in range(1, 40))
     text = f"ORGANIZATION_BLOCK OB1\nBEGIN\n{nets}END_ORGANIZATION_BLOCK\n"
     plc = plcrt.load(text)
     assert len(plc.unit.chunks) > 3
-    # network 35's function with its memory buffers taken away fails at
-    # its MOVW: the traceback's generated line leads to the STL line
-    fn = plc._ns["n_OB1_35_34"]
+    # the function of networks 33-36 with its memory buffers taken away
+    # fails at network 33's MOVW: the traceback's generated line leads to
+    # that STL line
+    fn = plc._ns["g_OB1_8_32"]
     broken = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__,
                                 tuple(None for _ in fn.__defaults__ or ()))
     with pytest.raises(TypeError) as err:
         broken(bytearray(64))
     loc = plc._loc_from_tb(err.value)
-    assert loc is not None and loc.line == text.splitlines().index("MOVW   +35, VW70") + 1
+    assert loc is not None and loc.line == text.splitlines().index("MOVW   +33, VW66") + 1
 
 
 def test_the_collector_is_off_while_compiling_and_restored_after(

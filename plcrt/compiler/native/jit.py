@@ -50,9 +50,17 @@ def _llvm() -> Any:
 
 
 def cache_dir() -> Path:
+    """Where machine code is kept: ``$PLCRT_CACHE_DIR/native``, else
+    ``~/.cache/plcrt/native`` (the temporary folder without a home)."""
     base = os.environ.get("PLCRT_CACHE_DIR")
-    root = Path(base) if base else Path.home() / ".cache" / "plcrt"
-    return root / "native"
+    if base:
+        return Path(base) / "native"
+    try:
+        home = Path.home()
+    except RuntimeError:          # no HOME and no password entry (a bare container)
+        import tempfile
+        home = Path(tempfile.gettempdir())
+    return home / ".cache" / "plcrt" / "native"
 
 
 class _ObjectCache:

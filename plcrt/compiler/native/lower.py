@@ -87,6 +87,14 @@ class Fn:
             raise NotLowered("the logic stack overflows (the bottom level is lost)")
         self.stack.append(v)
 
+    def combine(self, how: str, v: str) -> None:
+        """A contact's or a compare's result: ``push`` it, or ``and``/``or``
+        it into the top of the stack."""
+        if how == "push":
+            self.push(v)
+        else:
+            self.stack[-1] = self.op(f"{how} i1 {self.top}, {v}")
+
     @property
     def top(self) -> str:
         if not self.stack:
@@ -149,17 +157,30 @@ def _area(op: Any) -> str:
     return op.area
 
 
-def rbit(f: Fn, op: Any) -> str:
-    """``i1`` value of a bit operand."""
-    area = _area(op)
-    if area in ("T", "C"):
-        slot, byte, bit = ("TB" if area == "T" else "CB"), op.offset >> 3, op.offset & 7
-    else:
-        slot, byte, bit = area, op.offset, op.bit
+def get_bit(f: Fn, slot: str, byte: int, bit: int) -> str:
+    """``i1`` of bit ``bit`` of byte ``byte`` of a buffer."""
     v = f.load8(slot, byte)
     if bit:
         v = f.op(f"lshr i8 {v}, {int(bit)}")
     return f.op(f"trunc i8 {v} to i1")
+
+
+def put_bit(f: Fn, slot: str, byte: int, bit: int, v: str) -> None:
+    """Write ``i1`` ``v`` to bit ``bit`` of byte ``byte`` of a buffer."""
+    old = f.load8(slot, byte)
+    kept = f.op(f"and i8 {old}, {~(1 << bit) & 0xFF}")
+    b = f.op(f"zext i1 {v} to i8")
+    if bit:
+        b = f.op(f"shl i8 {b}, {int(bit)}")
+    f.store8(slot, byte, f.op(f"or i8 {kept}, {b}"))
+
+
+def rbit(f: Fn, op: Any) -> str:
+    """``i1`` value of a bit operand (T/C: the bit of the TB/CB bitmap)."""
+    area = _area(op)
+    if area in ("T", "C"):
+        return get_bit(f, "TB" if area == "T" else "CB", op.offset >> 3, op.offset & 7)
+    return get_bit(f, area, op.offset, op.bit)
 
 
 def wbit(f: Fn, op: Any, v: str) -> None:
@@ -167,12 +188,7 @@ def wbit(f: Fn, op: Any, v: str) -> None:
     area = _area(op)
     if area in ("T", "C"):
         raise NotLowered("timer and counter bits are written by their boxes")
-    old = f.load8(area, op.offset)
-    kept = f.op(f"and i8 {old}, {~(1 << op.bit) & 0xFF}")
-    b = f.op(f"zext i1 {v} to i8")
-    if op.bit:
-        b = f.op(f"shl i8 {b}, {int(op.bit)}")
-    f.store8(area, op.offset, f.op(f"or i8 {kept}, {b}"))
+    put_bit(f, area, op.offset, op.bit, v)
 
 
 def place(op: Any, width: int) -> tuple[str, int]:
@@ -234,10 +250,10 @@ def wr(f: Fn, op: Any, kind: str, v: str, cond: str | None) -> None:
         f.store8(slot, off + i, byte)
 
 
-def set_flags(f: Fn, cond: str, bits: str) -> None:
-    """``SM1 := SM1 & 248 | bits`` where ``cond`` holds (``bits``: i8)."""
+def set_sm1(f: Fn, cond: str, keep: int, bits: str) -> None:
+    """``SM1 := SM1 & keep | bits`` where ``cond`` holds (``bits``: i8)."""
     old = f.load8("SM", 1)
-    new = f.op(f"or i8 {f.op(f'and i8 {old}, 248')}, {bits}")
+    new = f.op(f"or i8 {f.op(f'and i8 {old}, {keep}')}, {bits}")
     f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
 
 
@@ -269,10 +285,7 @@ def _contact(how: str, inverted: bool) -> Lowering:
         v = rbit(f, op)
         if inverted:
             v = f.op(f"xor i1 {v}, true")
-        if how == "push":
-            f.push(v)
-        else:
-            f.stack[-1] = f.op(f"{how} i1 {f.top}, {v}")
+        f.combine(how, v)
     return lower
 
 
@@ -407,14 +420,11 @@ _UNSIGNED = {"<": "ult", "<=": "ule", ">": "ugt", ">=": "uge"}
 def _compare(prefix: str, width: str, rel: str) -> Lowering:
     kind = width
     cond = _REL.get(rel) or (_UNSIGNED if width == "B" else _SIGNED)[rel]
+    how = {"LD": "push", "A": "and", "O": "or"}[prefix]
 
     def lower(f: Fn, a: Any, b: Any) -> None:
         x, y = rd(f, a, kind), rd(f, b, kind)
-        v = f.op(f"icmp {cond} {WIDE[kind]} {x}, {y}")
-        if prefix == "LD":
-            f.push(v)
-        else:
-            f.stack[-1] = f.op(f"{'and' if prefix == 'A' else 'or'} i1 {f.top}, {v}")
+        f.combine(how, f.op(f"icmp {cond} {WIDE[kind]} {x}, {y}"))
     return lower
 
 
@@ -463,7 +473,7 @@ def _binop(kind: str, op: str, rng: tuple[int, int]) -> Lowering:
         ok = f.op(f"and i1 {lo}, {hi}")
         wr(f, out, kind, r, f.op(f"and i1 {top}, {ok}"))
         bits = f.op(f"select i1 {ok}, i8 {zn_bits(f, ty, r)}, i8 2")
-        set_flags(f, top, bits)
+        set_sm1(f, top, 248, bits)
     return lower
 
 
@@ -493,7 +503,7 @@ def _incdec(kind: str, delta: int, lo: int, hi: int) -> Lowering:
         wrapped = f.op(f"{ext} i{width_bits} {low} to {ty}")
         zn = zn_bits(f, ty, wrapped, signed)
         bits = f.op(f"select i1 {ok}, i8 {zn}, i8 {f.op(f'or i8 {zn}, 2')}")
-        set_flags(f, top, bits)
+        set_sm1(f, top, 248, bits)
         wr(f, out, kind, wrapped, top)
     return lower
 
@@ -510,17 +520,6 @@ LOWER["DECD"] = _incdec("D", -1, *D_RANGE)
 _UKIND = {"B": ("B", 8), "W": ("WU", 16), "D": ("DU", 32)}
 
 
-def set_sm1(f: Fn, cond: str, keep: int, bits: str) -> None:
-    """``SM1 := SM1 & keep | bits`` where ``cond`` holds."""
-    old = f.load8("SM", 1)
-    new = f.op(f"or i8 {f.op(f'and i8 {old}, {keep}')}, {bits}")
-    f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
-
-
-def _zero8(f: Fn, ty: str, v: str) -> str:
-    return f.op(f"zext i1 {f.op(f'icmp eq {ty} {v}, 0')} to i8")
-
-
 def _logic(op: str, width: str) -> Lowering:
     kind, _bits = _UKIND[width]
     ty = WIDE[kind]
@@ -529,7 +528,7 @@ def _logic(op: str, width: str) -> Lowering:
         top = f.top
         r = f.op(f"{op} {ty} {rd(f, out, kind)}, {rd(f, a, kind)}")
         wr(f, out, kind, r, top)
-        set_sm1(f, top, 254, _zero8(f, ty, r))
+        set_sm1(f, top, 254, zn_bits(f, ty, r, signed=False))
     return lower
 
 
@@ -541,7 +540,7 @@ def _inv(width: str) -> Lowering:
         top = f.top
         r = f.op(f"xor {ty} {rd(f, out, kind)}, {(1 << bits) - 1}")
         wr(f, out, kind, r, top)
-        set_sm1(f, top, 254, _zero8(f, ty, r))
+        set_sm1(f, top, 254, zn_bits(f, ty, r, signed=False))
     return lower
 
 
@@ -561,7 +560,7 @@ def _shift(stem: str, width: str) -> Lowering:
         top = f.top
         v = rd(f, out, kind)
         if k == 0:
-            set_sm1(f, top, 254, _zero8(f, ty, v))
+            set_sm1(f, top, 254, zn_bits(f, ty, v, signed=False))
             return
         if stem == "SL":
             r = f.op(f"and {ty} {f.op(f'shl {ty} {v}, {k}')}, {mask}") if k < bits else "0"
@@ -578,7 +577,7 @@ def _shift(stem: str, width: str) -> Lowering:
                 f.op(f"lshr {ty} {r}, {bits - 1}")
         wr(f, out, kind, r, top)
         out8 = f.op(f"trunc {ty} {last} to i8")
-        bits8 = f.op(f"or i8 {_zero8(f, ty, r)}, {f.op(f'shl i8 {out8}, 1')}")
+        bits8 = f.op(f"or i8 {zn_bits(f, ty, r, signed=False)}, {f.op(f'shl i8 {out8}, 1')}")
         set_sm1(f, top, 252, bits8)
     return lower
 
@@ -604,10 +603,7 @@ def _narrow(kin: str, kout: str, lo: int, hi: int) -> Lowering:
                   f"{f.op(f'icmp sle {ty} {v}, {hi}')}")
         val = v if WIDE[kout] == ty else f.op(f"trunc {ty} {v} to {WIDE[kout]}")
         wr(f, out, kout, val, f.op(f"and i1 {top}, {ok}"))
-        old = f.load8("SM", 1)
-        new = f.op(f"select i1 {ok}, i8 {f.op(f'and i8 {old}, 253')}, "
-                   f"i8 {f.op(f'or i8 {old}, 2')}")
-        f.store8("SM", 1, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+        set_sm1(f, top, 253, f.op(f"select i1 {ok}, i8 0, i8 2"))
     return lower
 
 
@@ -625,14 +621,6 @@ LOWER["ITB"] = _narrow("W", "B", 0, 255)
 LOWER["DTI"] = _narrow("D", "W", -32768, 32767)
 LOWER["BTI"] = _widen("B", "W")
 LOWER["ITD"] = _widen("W", "D")
-
-
-def _tc_bit(f: Fn, slot: str, n: int) -> str:
-    """``i1`` of bit ``n`` of the TB/CB bitmap."""
-    v = f.load8(slot, n >> 3)
-    if n & 7:
-        v = f.op(f"lshr i8 {v}, {n & 7}")
-    return f.op(f"trunc i8 {v} to i1")
 
 
 def _timer_state(f: Fn, t: Any, pt: Any) -> tuple[int, str, str, str, str, str]:
@@ -657,7 +645,7 @@ def _timer_state(f: Fn, t: Any, pt: Any) -> tuple[int, str, str, str, str, str]:
 def _timer_store(f: Fn, t: Any, n: int, run: str, cv: str, bit: str) -> None:
     f.store8("T_RUN", n, f.op(f"zext i1 {run} to i8"))
     wr(f, t, "W", cv, None)
-    wbit_tc(f, "TB", n, bit)
+    put_bit(f, "TB", n >> 3, n & 7, bit)
 
 
 @lowers("TON")
@@ -683,7 +671,7 @@ def _tonr(f: Fn, t: Any, pt: Any) -> None:
     n, en, p, run, cv, capped = _timer_state(f, t, pt)
     on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
     cvn = f.op(f"select i1 {en}, i32 {on}, i32 {cv}")
-    old_bit = _tc_bit(f, "TB", n)
+    old_bit = get_bit(f, "TB", n >> 3, n & 7)
     reached = f.op(f"icmp sge i32 {on}, {p}")
     bit = f.op(f"select i1 {en}, i1 {reached}, i1 {old_bit}")
     _timer_store(f, t, n, en, cvn, bit)
@@ -697,7 +685,7 @@ def _tof(f: Fn, t: Any, pt: Any) -> None:
     n, en, p, run, cv, capped = _timer_state(f, t, pt)
     prev = f.op(f"icmp ne i8 {f.load8('T_PREV', n)}, 0")
     f.store8("T_PREV", n, f.op(f"zext i1 {en} to i8"))
-    old_bit = _tc_bit(f, "TB", n)
+    old_bit = get_bit(f, "TB", n >> 3, n & 7)
     done = f.op(f"icmp sge i32 {capped}, {p}")
     not_en = f.op(f"xor i1 {en}, true")
     not_prev = f.op(f"xor i1 {prev}, true")
@@ -714,16 +702,6 @@ def _tof(f: Fn, t: Any, pt: Any) -> None:
     run_e = f.op(f"select i1 {prev}, i1 true, i1 {run_t}")
     run_n = f.op(f"select i1 {en}, i1 false, i1 {run_e}")
     _timer_store(f, t, n, run_n, cvn, bit)
-
-
-def wbit_tc(f: Fn, slot: str, n: int, v: str) -> None:
-    """Write a timer or counter bit (bit ``n`` of the TB/CB bitmap)."""
-    old = f.load8(slot, n >> 3)
-    kept = f.op(f"and i8 {old}, {~(1 << (n & 7)) & 0xFF}")
-    b = f.op(f"zext i1 {v} to i8")
-    if n & 7:
-        b = f.op(f"shl i8 {b}, {n & 7}")
-    f.store8(slot, n >> 3, f.op(f"or i8 {kept}, {b}"))
 
 
 def lower_piece(f: Fn, insns: list[tuple[str, list[Any], int]]) -> None:

@@ -473,8 +473,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             gen.pending = None  # a value left on the stack at the end is dead
             info.depth_after[piece.index] = gen.depth
             records.append((fname, sorted(gen.used - {"L"}), gen.lines, gen.line_map))
-            if stream and (len(records) >= GROUP_PIECES
-                           or sum(len(r[2]) for r in records) >= GROUP_LINES):
+            if stream and _group_full(records):
                 emit_group(records)
                 records = []
         segs = None
@@ -508,7 +507,6 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             group: list[Any] = []
             prev: int | None = None
             for i, rec in enumerate(records):
-                fnames.append(rec[0])
                 seg = segs[i] if segs is not None else None
                 if seg is not None:
                     if group:
@@ -519,8 +517,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                         calls.append(f"_nseg{seg}()")
                 else:
                     group.append(rec)
-                    if len(group) >= GROUP_PIECES or \
-                            sum(len(r[2]) for r in group) >= GROUP_LINES:
+                    if _group_full(group):
                         emit_group(group)
                         group = []
                 prev = seg
@@ -530,6 +527,12 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
         out.extend(_runner(unit, info, fnames, calls))
         out.append("")
     return "\n".join(out) + "\n", line_locs
+
+
+def _group_full(group: list[Any]) -> bool:
+    """A group of piece records (name, names used, lines, line map) holds
+    :data:`GROUP_PIECES` pieces or :data:`GROUP_LINES` lines."""
+    return len(group) >= GROUP_PIECES or sum(len(r[2]) for r in group) >= GROUP_LINES
 
 
 def _network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:

@@ -86,7 +86,6 @@ class TimerBank:
         """Compute tick deltas and advance running 1 ms / 10 ms timers."""
         if prev_us is None or now_us == prev_us:
             self.d1 = self.d10 = self.d100 = 0
-            self.d100_buf[0] = 0
         else:
             # the 1 ms timers may have been advanced inside the interval already
             self.d1 = now_us // 1000 - (prev_us // 1000 if self.ms1 is None else self.ms1)

@@ -141,11 +141,11 @@ class NativeContext:
         self.code = code
         self.table = (ctypes.c_void_p * len(SLOTS))()
         self._views: list[Any] = []
-        self.calls: list[Callable[[], None]] = []
         self.point(buffers)
         addr = ctypes.addressof(self.table)
         # perf: the table's address is bound once; a call is one ctypes call
-        self.calls = [functools.partial(fn, addr) for fn in code._fns]
+        self.calls: list[Callable[[], None]] = [functools.partial(fn, addr)
+                                                for fn in code._fns]
 
     def point(self, buffers: dict[str, Any]) -> None:
         """(Re)point the table at ``buffers`` (after a restore replaced the

@@ -506,18 +506,32 @@ FND= VW2, 0, VW5
 """)
 
 
+#: cases every backend runs besides the drawn ones (each once found a bug
+#: or pins an edge: data instructions, stack overflow, math limits, timers
+#: and counters, the longest timer at the longest scan)
+REGRESSIONS = (
+    Case(DATA_EDGES, ((0, 0, 3),), initial_v=b"3A\x00\x05B\xf6\xe6\x66\x01\x00\x00\x02"),
+    Case(STACK_OVERFLOW, ((0, 0, 2),)),
+    Case(STACK_LPS_OVERFLOW, ((1, 0, 2), (3, 0, 2), (0, 0, 1))),
+    Case(MATH_EDGES, ((0, 0, 3),), initial_v=bytes([0x80, 0, 0, 0x80, 0, 0, 0, 0,
+                                                    0x80, 0, 0, 0])),
+    Case(TIMER_COUNTER, ((1, 0, 3), (0, 0, 2), (1, 0, 4), (3, 0, 1), (1, 0, 12)), scan_ms=50),
+    Case(_prog("LD I0.0\nTON T37, 32767\nLDW= T37, 32767\n= Q0.0"), ((1, 0, 57),),
+         scan_ms=60000),
+)
+
+
+def with_regressions(test):
+    """The test, with every case of :data:`REGRESSIONS` as an example."""
+    for case in reversed(REGRESSIONS):
+        test = example(case=case)(test)
+    return test
+
+
 @settings(max_examples=400, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(case=cases())
-@example(Case(DATA_EDGES, ((0, 0, 3),), initial_v=b"3A\x00\x05B\xf6\xe6\x66\x01\x00\x00\x02"))
-@example(Case(STACK_OVERFLOW, ((0, 0, 2),)))
-@example(Case(STACK_LPS_OVERFLOW, ((1, 0, 2), (3, 0, 2), (0, 0, 1))))
-@example(Case(MATH_EDGES, ((0, 0, 3),), initial_v=bytes([0x80, 0, 0, 0x80, 0, 0, 0, 0,
-                                                           0x80, 0, 0, 0])))
-@example(Case(TIMER_COUNTER, ((1, 0, 3), (0, 0, 2), (1, 0, 4), (3, 0, 1), (1, 0, 12)),
-              scan_ms=50))
-@example(Case(_prog("LD I0.0\nTON T37, 32767\nLDW= T37, 32767\n= Q0.0"), ((1, 0, 57),),
-              scan_ms=60000))
+@with_regressions
 def test_compiled_engine_matches_reference(case: Case) -> None:
     run_side_by_side(case)
 
@@ -536,13 +550,7 @@ def test_probed_engine_matches_reference(case: Case) -> None:
 @settings(max_examples=300, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(case=cases())
-@example(Case(STACK_OVERFLOW, ((0, 0, 2),)))
-@example(Case(MATH_EDGES, ((0, 0, 3),), initial_v=bytes([0x80, 0, 0, 0x80, 0, 0, 0, 0,
-                                                           0x80, 0, 0, 0])))
-@example(Case(TIMER_COUNTER, ((1, 0, 3), (0, 0, 2), (1, 0, 4), (3, 0, 1), (1, 0, 12)),
-              scan_ms=50))
-@example(Case(_prog("LD I0.0\nTON T37, 32767\nLDW= T37, 32767\n= Q0.0"), ((1, 0, 57),),
-              scan_ms=60000))
+@with_regressions
 def test_native_engine_matches_reference(case: Case) -> None:
     """The native backend (machine code for the pieces it lowers, Python for
     the others, in one scan) computes what the reference does, scan by scan."""

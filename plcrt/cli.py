@@ -43,7 +43,7 @@ from typing import Any, NamedTuple, NoReturn, TextIO
 
 from . import __version__
 from .engine.runtime import Plc, load
-from .engine.values import json_number, parse_number, split_format
+from .engine.values import BACKENDS, json_number, parse_number, split_format
 from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError, capped
 from .dump import render_dump
 from .safetext import printable
@@ -131,7 +131,7 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
                    help="give each symbol that no symbol table defines a free M (bits) or V "
                         "address, reported as warnings (for exports published without "
                         "their symbol table)")
-    p.add_argument("--backend", choices=("python", "native"), default=None,
+    p.add_argument("--backend", choices=BACKENDS, default=None,
                    help="code generator: python (default; or $PLCRT_BACKEND) or native "
                         "(machine code through llvmlite for the pieces it covers, "
                         "pip install 'plcrt[native]'; docs/native.md)")

@@ -20,7 +20,6 @@ wall-clock pace (for demos); it never changes results.
 from __future__ import annotations
 
 import copy
-import os
 import time as _time
 import types
 import zlib
@@ -48,8 +47,8 @@ from .pid import make_loops
 from .pulse import make_outputs
 from .ports import attach_devices, make_ports
 from .netjobs import make_ethernet, netr_netw
-from .values import (BACKENDS, Duration, check_load_options, check_parsed_inputs, scan_number,
-                     scan_total, source_items)
+from .values import (Duration, check_backend, check_load_options, check_parsed_inputs,
+                     scan_number, scan_total, source_items)
 
 if TYPE_CHECKING:
     from ..devices import AxisState, DriveState
@@ -83,16 +82,7 @@ class Plc(AddressAccess):
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
                                  f"got {watchdog_ms!r:.40}")
-        if backend is None:
-            # the environment chooses for programs that do not (a test suite
-            # run on the native backend: PLCRT_BACKEND=native pytest)
-            backend = os.environ.get("PLCRT_BACKEND") or "python"
-            if backend not in BACKENDS:
-                raise PlcConfigError(f"PLCRT_BACKEND must be one of "
-                                     f"{', '.join(BACKENDS)}, got {backend!r:.40}")
-        if backend not in BACKENDS:
-            raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
-                                 f"got {backend!r:.40}")
+        backend = check_backend(backend)
         if backend == "native":
             from ..compiler.native.jit import available
             if not available():

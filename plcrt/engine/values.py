@@ -372,6 +372,22 @@ LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols", 
 #: the code generators a program can be loaded with (plcrt.compiler.native)
 BACKENDS = ("python", "native")
 
+
+def check_backend(backend: Any) -> str:
+    """The code generator to load with: ``backend``, or when it is None the
+    environment's ``PLCRT_BACKEND`` (a test suite run on the native
+    backend: ``PLCRT_BACKEND=native pytest``), else ``"python"``."""
+    if backend is None:
+        import os
+        backend = os.environ.get("PLCRT_BACKEND") or "python"
+        if backend not in BACKENDS:
+            raise PlcConfigError(f"PLCRT_BACKEND must be one of "
+                                 f"{', '.join(BACKENDS)}, got {backend!r:.40}")
+    if backend not in BACKENDS:
+        raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
+                             f"got {backend!r:.40}")
+    return backend
+
 _SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
 
 

@@ -7,6 +7,8 @@ kind and width, addresses where the block writes), then emits::
         r = _blk3(<IN values...>)
         <write r[0], r[1], ... to the OUT / written-back arguments>
 
+(outputs at neighbouring addresses written by one store, Gen.wr_seq).
+
 ``_blk3`` is the per-call-site callable built by the block's factory, so
 each call site has its own state (like the memory a Micro/WIN library
 subroutine gets per instance).  When the block is an object with a Python
@@ -95,16 +97,11 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         # method, rebound for each PLC, is bound to that PLC's block.
         g.unit.bind(block, "blk")
         fn = g.bind(block.__call__, "call")
-    with g.box():
+    with g.box(alone=True):
         r = g.tmp("r")
         g.line(f"{r} = {fn}({', '.join(reads)})")
-        for i, (target, typ) in enumerate(writes):
-            if target is None:
-                continue
-            if typ == "BOOL":
-                g.wbit(target, f"{r}[{i}]")
-            else:
-                g.wr(target, _KIND[typ], f"{r}[{i}]")
+        g.wr_seq([(target, "X" if typ == "BOOL" else _KIND[typ], f"{r}[{i}]")
+                  for i, (target, typ) in enumerate(writes) if target is not None])
     return True
 
 

@@ -22,6 +22,7 @@ from typing import Any, Iterator
 from ..errors import SourceLoc
 from ..safetext import excerpt
 from .operands import Addr, Const, Indirect, Pointer
+from .rt import PACK_CODE, packer
 
 MAX_STACK = 9  #: S7-200 logic stack depth (System Manual, "logic stack")
 
@@ -32,6 +33,7 @@ BUFFER_NAME = {
 }
 
 VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
+_MASK = {"B": 255, "W": 65535, "D": 4294967295}
 
 
 class CodegenError(Exception):
@@ -104,8 +106,17 @@ class Gen:
         self.indent -= 1
 
     @contextmanager
-    def box(self) -> Iterator[None]:
-        """Body of a box instruction: executes only when the top of stack is 1."""
+    def box(self, alone: bool = False) -> Iterator[None]:
+        """Body of a box instruction: executes only when the top of stack is 1.
+
+        ``alone``: no ``else:`` follows the body, so a box whose power is
+        the constant 1 (SM0.0, see :meth:`rbit`) may run without the test.
+        """
+        if alone and self.pending == "1":
+            # perf: a box under SM0.0 runs without a test
+            self.flush()
+            yield
+            return
         with self.block(f"if {self.top}:"):
             yield
 
@@ -200,6 +211,11 @@ class Gen:
         if op.area in ("T", "C"):
             buf = self.use("TB" if op.area == "T" else "CB")
             byte, bit = op.offset >> 3, op.offset & 7
+        elif op.area == "SM" and op.offset == 0 and op.bit == 0:
+            # perf: SM0.0 is on whenever the program runs: the scan sets it
+            # before OB1 runs and the program cannot write it (SMB0 is
+            # read-only, System Manual, "Special memory bits")
+            return "1"
         else:
             buf, byte, bit = self._buf(op.area), op.offset, op.bit
         if bit == 0:
@@ -296,6 +312,54 @@ class Gen:
         else:
             self.line(f"{self.use('_wI')}({buf}, {off}, ({expr}) & 4294967295)")
 
+    def wr_seq(self, items: list[tuple[Any, str, str]]) -> None:
+        """Statements writing several values in the order given: ``(operand,
+        kind, expr)`` each, ``kind`` as for :meth:`wr` or ``"X"`` for a bit
+        (0/1).  Every ``expr`` must be free of side effects.
+
+        perf: writes that follow each other in one buffer become one store:
+        bits of one byte one byte store, values at neighbouring addresses
+        one struct call (a library block's outputs usually lie side by
+        side).  Operands that overlap, indirect ones, constants and the
+        timer, counter, accumulator and HC areas are written one by one.
+        """
+        i = 0
+        while i < len(items):
+            op, kind, expr = items[i]
+            j = i + 1
+            if kind == "X":
+                bits = {op.bit} if isinstance(op, Addr) else set()
+                while bits and j < len(items) and _same_byte(op, items[j]) \
+                        and items[j][0].bit not in bits:
+                    bits.add(items[j][0].bit)
+                    j += 1
+                if j - i == 1:
+                    self.wbit(op, expr)
+                else:
+                    buf = self._buf(op.area)
+                    keep = ~sum(1 << b for b in bits) & 0xFF
+                    parts = " | ".join(f"({e}) << {o.bit}" for o, _, e in items[i:j])
+                    self.line(f"{buf}[{op.offset}] = {buf}[{op.offset}] & {keep} | {parts}")
+            else:
+                end = _packable_end(op, kind, expr)
+                while end is not None and j < len(items):
+                    nxt = _packable_end(*items[j])
+                    if nxt is None or items[j][0].area != op.area \
+                            or items[j][0].offset != end:
+                        break
+                    end = nxt
+                    j += 1
+                if j - i == 1:
+                    self.wr(op, kind, expr)
+                else:
+                    group = items[i:j]
+                    codes = "".join(PACK_CODE[k] for _, k, _ in group)
+                    values = ", ".join(e if k == "R" else f"({e}) & {_MASK[k[0]]}"
+                                       for _, k, e in group)
+                    self.line(f"{self.use(packer(codes))}({self._buf(op.area)}, {op.offset}, "
+                              f"{values})")
+            i = j
+
     def copy(self, src: Any, dst: Any, kind: str) -> None:
         """Move a value; plain byte-slice copy where both are direct (perf)."""
         width = VALUE_WIDTH[kind[0]]
@@ -381,6 +445,25 @@ def _is_atom(expr: str) -> bool:
             if depth == 0:
                 return i == len(expr) - 1
     return False
+
+
+#: areas whose values lie at their own byte offsets in one buffer
+_PLAIN_AREAS = frozenset(BUFFER_NAME) - {"AC", "HC"}
+
+
+def _same_byte(op: Any, item: tuple[Any, str, str]) -> bool:
+    """*item* is a bit write into the byte of bit operand *op*."""
+    o, kind, _ = item
+    return kind == "X" and isinstance(o, Addr) and o.area == op.area and o.offset == op.offset
+
+
+def _packable_end(op: Any, kind: str, expr: str) -> int | None:
+    """The offset after a value write that :meth:`Gen.wr_seq` may join to
+    its neighbours, or None."""
+    if kind == "X" or not isinstance(op, Addr) or op.area not in _PLAIN_AREAS \
+            or _is_int_literal(expr):
+        return None
+    return op.offset + VALUE_WIDTH[kind[0]]
 
 
 def _is_int_literal(expr: str) -> bool:

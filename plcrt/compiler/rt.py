@@ -28,6 +28,23 @@ CODECS: dict[str, Callable] = {
     "_wH": _UH.pack_into, "_wI": _UI.pack_into, "_wf": _F.pack_into,
 }
 
+#: struct format letter of each value kind written in one call (unsigned:
+#: the generated code masks integers to the width first)
+PACK_CODE = {"B": "B", "W": "H", "WU": "H", "D": "I", "DU": "I", "R": "f"}
+
+
+def packer(codes: str) -> str:
+    """The name of a codec writing several big-endian values at once
+    (``"IB"``: a DWORD then a BYTE), added to :data:`CODECS` on first use.
+    Only the letters of :data:`PACK_CODE` are accepted."""
+    if len(codes) < 2 or not set(codes) <= set(PACK_CODE.values()):
+        raise ValueError(f"not a packer format: {codes!r}")
+    name = "_w" + codes
+    if name not in CODECS:
+        CODECS[name] = Struct(">" + codes).pack_into
+    return name
+
+
 F32_MAX = 3.4028234663852886e38
 
 
@@ -51,7 +68,9 @@ def s32(v: int) -> int:
     return v - 0x100000000 if v & 0x80000000 else v
 
 
-def make_indirect(areas: dict[str, bytearray], locs: Sequence[SourceLoc]
+def make_indirect(areas: dict[str, bytearray], locs: Sequence[SourceLoc],
+                  sm_readonly: int = 0,
+                  warn: Callable[[str, SourceLoc, str], None] | None = None
                   ) -> tuple[Callable, Callable, Callable]:
     """Build the ``_ird`` / ``_iwr`` / ``_ptr`` helpers for one memory image.
 
@@ -60,7 +79,13 @@ def make_indirect(areas: dict[str, bytearray], locs: Sequence[SourceLoc]
     access is bounds-checked; a bad pointer is a fatal run-time error naming
     the instruction, as on the S7-200 (non-fatal error 0x0013 territory is
     not modelled: the CPU goes to STOP).
+
+    SMB0 .. SMB(*sm_readonly* - 1) are read-only to the program: a direct
+    write is refused when the program loads, a write through a pointer
+    leaves those bytes as they are (the rest of a wider value is written)
+    and *warn* says so, once per instruction.
     """
+    sm = areas["SM"]
     by_code = {code: areas["TV" if n == "T" else "CV" if n == "C" else n]
                for code, n in POINTER_AREA_NAMES.items()}
     unpack = {1: None, 2: _H.unpack_from, 4: _I.unpack_from}
@@ -88,6 +113,7 @@ def make_indirect(areas: dict[str, bytearray], locs: Sequence[SourceLoc]
 
     def iwr(pbuf: bytearray, poff: int, width: int, value, insn: int) -> None:
         buf, off = target(pbuf, poff, width, insn)
+        kept = sm[off:sm_readonly] if buf is sm and off < sm_readonly else None
         if width == 1:
             buf[off] = value & 0xFF
         elif width == 2:
@@ -96,5 +122,11 @@ def make_indirect(areas: dict[str, bytearray], locs: Sequence[SourceLoc]
             _F.pack_into(buf, off, value)
         else:
             _UI.pack_into(buf, off, value & 0xFFFFFFFF)
+        if kept is not None:
+            sm[off:sm_readonly] = kept
+            if warn is not None:
+                warn(f"a write through a pointer to SMB{off} leaves SMB0..SMB{sm_readonly - 1} "
+                     f"unchanged: they are read-only to the program", locs[insn],
+                     f"sm-readonly-{insn}")
 
     return ird, iwr, target

@@ -24,7 +24,7 @@ import time as _time
 import types
 import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, NoReturn, Sequence
 
 from ..compiler import compile_program
 from ..compiler.cache import (Entry, compile_chunks, gc_paused, needed_paths, pair_objects,
@@ -207,6 +207,8 @@ class Plc(AddressAccess):
             self._adopt(_entry, auto_diags)
         a = self.mem.areas
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
+        self._bufs_begin = self._bufs[:4]   # perf: unpacked once per scan
+        self._bufs_end = (a["PI"], a["Q"], a["PQ"])
         ns = self._ns
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
         self._int_fns = {p.number: ns[f"pou_INT{p.number}"] for p in program.pous
@@ -318,7 +320,8 @@ class Plc(AddressAccess):
         self._filename = f"<plcrt {self.program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)
-        ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs)
+        ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs,
+                                      self.model.sm_readonly, self.warn)
         ns.update(_ird=ird, _iwr=iwr, _ptr=ptr, _LOCS=self.unit.locs, WD=self.wd,
                   _watchdog=self._watchdog, _watchdog_wdr=self._watchdog_wdr)
         ns.update(self._bindings)
@@ -378,15 +381,35 @@ class Plc(AddressAccess):
         if self.network is not None:
             raise PlcConfigError("this PLC is linked to others: run them together with the "
                                  "network's run() (plcrt.link), not scan() or run()")
-        for _ in range(n):
-            if self.mode != "RUN":
-                return
-            t0 = _time.perf_counter() if self.pace == "realtime" else 0.0
-            self._scan_once()
-            if self.pace == "realtime":
+        if self.pace == "realtime":
+            for _ in range(n):
+                if self.mode != "RUN":
+                    return
+                t0 = _time.perf_counter()
+                self._scan_once()
                 left = self.scan_us / 1e6 - (_time.perf_counter() - t0)
                 if left > 0:
                     _time.sleep(left)
+            return
+        # perf: _scan_once and _timeline's device steps inlined, their
+        # methods and objects looked up once
+        begin, timeline, end = self._scan_begin, self._timeline, self._scan_end
+        irq, devices = self.interrupts, self.devices
+        for _ in range(n):
+            if self.mode != "RUN":
+                return
+            now = self._t_us
+            begin()
+            if irq.timed_next or self._sources_on:
+                timeline(now, now + self.scan_us, True)
+            elif devices:
+                t_to = now + self.scan_us
+                try:
+                    for dev in devices:
+                        dev.step(self, now, t_to)
+                except Exception as e:
+                    self._fault(e)
+            end(now)
 
     def run(self, seconds: Duration | None = None, scans: int | None = None) -> None:
         """Run for a simulated duration (``1.5``, ``"1.5s"``, ``"200ms"``,
@@ -411,56 +434,47 @@ class Plc(AddressAccess):
     def _scan_begin(self) -> None:
         """A scan up to and including the main program, at its start instant."""
         # perf: buffers are bound once in __init__ (self._bufs)
-        i_img, pi, sm, l_ob1, q, pq = self._bufs
+        i_img, pi, sm, l_ob1 = self._bufs_begin
         now = self._t_us
-        irq = self.interrupts
         if self._defined:
             for c in self._defined:
                 if c.scan_start(pi, now):
                     self.scheduler.touch()
         pi0 = pi[0] & self._edge_mask
-        if pi0 != self._pi0 or irq.queued:
+        if pi0 != self._pi0 or self.interrupts.queued:
             # input edges from the outside world: their routines run at the
             # scan's start, before the image is read (System Manual: the
             # routine runs when the edge occurs; the image changes next scan)
+            irq = self.interrupts
             self._irq_t = now
             try:
                 self.timers.refresh_1ms(now)
                 irq.edges(self._pi0, pi0, now)
                 self._pi0 = pi0
                 irq.dispatch(now)
-            except PlcError as e:
-                self._fail(e)
             except Exception as e:
-                self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
-                                           self._loc_from_tb(e)), e)
+                self._fault(e)
         i_img[:] = pi
         if self._force_slots:
             self._apply_forces()
         scans = self.scans
-        b0 = 0x81 if scans else 0x8B  # SM0.0 and SM0.7; SM0.1/SM0.3 on the first scan
+        # SM0.0 and SM0.7, SM0.1/SM0.3 on the first scan, SM0.6 on every
+        # other scan (perf: one table lookup, _SMB0)
+        b0 = _SMB0[scans & 1] if scans else 0x8B | 0x40
         if now % 60_000_000 >= 30_000_000:
             b0 |= 0x10
         if now % 1_000_000 >= 500_000:
             b0 |= 0x20
-        if not scans & 1:
-            b0 |= 0x40
         sm[0] = b0
         self.timers.start_scan(self._prev_start, now)
-        self._prev_start = now
+        self._prev_start = self._irq_t = now
         wd = self.wd
-        wd[0] = 0
-        wd[2] = 0
-        wd[3] = 0
-        self._irq_t = now
+        wd[0] = wd[2] = wd[3] = 0
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
-        except PlcError as e:
-            self._fail(e)
-        except Exception as e:  # an internal fault: map it to the program location
-            self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
-                                       self._loc_from_tb(e)), e)
+        except Exception as e:
+            self._fault(e)
 
     def _timeline(self, t_from: int, t_to: int, first: bool) -> None:
         """The scan's time line over (t_from, t_to]: events, routines, devices
@@ -475,22 +489,20 @@ class Plc(AddressAccess):
             elif self.devices:
                 for dev in self.devices:
                     dev.step(self, t_from, t_to)
-        except PlcError as e:
-            self._fail(e)
-        except Exception as e:  # an internal fault: map it to the program location
-            self._fail(PlcRuntimeError(f"internal error while executing: {e!r}",
-                                       self._loc_from_tb(e)), e)
+        except Exception as e:
+            self._fault(e)
 
     def _scan_end(self, now: int) -> None:
         """The scan's end: forces, outputs, the plant's wires, time."""
-        pi, q, pq = self._bufs[1], self._bufs[4], self._bufs[5]
-        scans = self.scans
+        pi, q, pq = self._bufs_end
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
         p0, p1 = self.pulse
-        # perf: the generators' own fields, not their `running` property
-        if p0.trains or p1.trains or p0.mode == "PWM" or p1.mode == "PWM":
+        # perf: the generators' own fields, not their `running` property,
+        # and only once a PLS has run (_sources_on)
+        if self._sources_on and (p0.trains or p1.trains or p0.mode == "PWM"
+                                 or p1.mode == "PWM"):
             # a running generator drives its terminal, not the image bit
             t_end = now + self.scan_us
             for po in self.pulse:
@@ -507,7 +519,7 @@ class Plc(AddressAccess):
         if self.wiring:
             for inp, out in self.wiring.items():      # the plant's wires: output -> input
                 _put_bit(pi, inp, pq[out // 8] >> (out % 8) & 1)
-        self.scans = scans + 1
+        self.scans += 1
         self._t_us = now + self.scan_us
         if self.stop_requested:
             # STOP instruction: the scan completes, then the CPU switches to
@@ -604,7 +616,16 @@ class Plc(AddressAccess):
     def _irq_enable(self) -> None:
         self.interrupts.enable(self._irq_t)
 
-    def _fail(self, err: PlcError, cause: BaseException | None = None) -> None:
+    def _fault(self, exc: Exception) -> NoReturn:
+        """Stop on an exception raised while executing: a PlcError as it is,
+        anything else as an internal error at the program location it came
+        from."""
+        if isinstance(exc, PlcError):
+            self._fail(exc)
+        self._fail(PlcRuntimeError(f"internal error while executing: {exc!r}",
+                                   self._loc_from_tb(exc)), exc)
+
+    def _fail(self, err: PlcError, cause: BaseException | None = None) -> NoReturn:
         self.mode = "STOP"
         self.fault = err
         m = self.mem.areas
@@ -876,6 +897,11 @@ class Plc(AddressAccess):
         dst._force_slots = []
         for key, value in self.forces.items():
             dst.force(key, value)
+
+#: SMB0 of every scan but the first, by the scan count's parity: SM0.0
+#: (always on), SM0.7 (RUN switch position), SM0.6 (on every other scan)
+_SMB0 = (0x81 | 0x40, 0x81)
+
 
 def _put_bit(buf: bytearray, n: int, level: int) -> None:
     """Bit *n* of *buf* (byte n // 8, bit n % 8) := *level*."""

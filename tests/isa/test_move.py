@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 import plcrt
-from stl_helpers import load_ob1 as _load
+from stl_helpers import load_ob1 as _load, ob1_text
 from plcrt.errors import PlcCompileError, PlcRuntimeError
 
 
@@ -269,3 +269,23 @@ def test_move_operand_misuse_is_a_compile_error(body: str) -> None:
     """BIR needs IB, BIW needs QB; constants, AIW and SMB0-29 cannot be written."""
     with pytest.raises(PlcCompileError):
         _load("LD SM0.0\n" + body)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_writes_through_pointers_leave_the_read_only_sm_bytes(backend: str) -> None:
+    """SMB0..SMB29 are read-only to the program: a write through a pointer
+    keeps them (the writable bytes of a wider value are written) and says so
+    once per instruction; SM0.0 stays on for the rest of the scan."""
+    if backend == "native":
+        pytest.importorskip("llvmlite")
+    p = plcrt.load(ob1_text("LD SM0.0\nMOVD &SMB0, VD100\nMOVB 0, *VD100\n"
+                            "MOVD &SMB28, VD104\nMOVD 16#11223344, *VD104\nMOVD &SMB30, VD108\n"
+                            "MOVB 16#5A, *VD108",
+                            "LD SM0.0\n= Q0.0\nLD SM0.0\nMOVB SMB0, VB0"), backend=backend)
+    p.scan(2)
+    sm = p.mem.areas["SM"]
+    assert p["Q0.0"] == 1 and p["VB0"] & 1 == 1
+    # SMB28/29 kept, SMB30/31 from the double word, then SMB30 by the byte
+    assert bytes(sm[28:32]) == b"\x00\x00\x5a\x44"
+    messages = [d.message for d in p.diagnostics if "read-only" in d.message]
+    assert len(messages) == 2 and "SMB0" in messages[0] and "SMB28" in messages[1]

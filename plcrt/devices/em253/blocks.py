@@ -106,12 +106,10 @@ class GetAbsPos(MotionBlock):
     last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
-        mod = self.module
         plc = self.plc
         # perf: the usual case: the module and axis of the last call, enabled
         # in this scan; the time read from the PLC's field, not its property
-        if mod is not None and mod.enabled_scan == plc.scans and mod.slot == em_no \
-                and self._axis_no == axis_no:
+        if (em_no, axis_no) == self._site and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
             return out
         return self.call_exact(em_no, axis_no)
@@ -132,9 +130,8 @@ class SetAbsPos(MotionBlock):
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
         # perf: Start = 0 with the module and axis of the last call, enabled
         # in this scan: nothing to do
-        mod = self.module
-        if not start and mod is not None and mod.enabled_scan == self.plc.scans \
-                and mod.slot == em_no and self._axis_no == axis_no:
+        if not start and (em_no, axis_no) == self._site \
+                and self.module.enabled_scan == self.plc.scans:  # type: ignore[union-attr]
             return 0, self.status
         return self.call_exact(em_no, axis_no, pos, start)
 
@@ -162,9 +159,8 @@ class SpdCtrl(MotionBlock):
         # nothing to start (no move of this block, no Run edge): command()
         # has nothing to do, only C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if not e_stop and not update and inner == INNER_OK and ax is not None \
-                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
+        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+                and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     self.last_spd = spd = ax.speed(plc._t_us)
@@ -268,9 +264,8 @@ class PosGotoR(MotionBlock):
         # to start (no move of this block, no Run edge): command() has
         # nothing to do, only C_Pos, C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if not e_stop and not update and inner == INNER_OK and ax is not None \
-                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
+        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+                and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
@@ -393,10 +388,9 @@ class Homing(MotionBlock):
         # report) with Run held or no homing active, or no homing active
         # and the axis not moving for it: only C_Spd and C_Status to report
         ax, seq, plc = self.axis, self.seq, self.plc
-        if not e_stop and inner == INNER_OK and ax is not None \
-                and (self.prev_run or not run) and self.module.enabled_scan == plc.scans \
-                and self.module.slot == em_no and self._axis_no == axis_no \
-                and self.initialised:
+        if (em_no, axis_no, inner) == self._ready and not e_stop \
+                and (self.prev_run or not run) \
+                and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
                 if run or not active:

@@ -35,9 +35,8 @@ class PosRun(MotionBlock):
         # no Run edge): command() has nothing to do, only C_Step, C_Pos,
         # C_Spd and C_Status to report
         ax, plc = self.axis, self.plc
-        if not e_stop and not update and inner == INNER_OK and ax is not None \
-                and self.module.enabled_scan == plc.scans and self.module.slot == em_no \
-                and self._axis_no == axis_no and self.initialised:
+        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+                and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us

@@ -113,6 +113,9 @@ class Unit:
         self.nest_check = False
         #: (caller, callee) pairs inside a call cycle
         self.recursive_sites: set[tuple[str, str]] = set()
+        #: some generated code counts on the watchdog words WD (loops,
+        #: WDR, call nesting): the scan must clear them at its start
+        self.uses_wd = False
         #: (first line, character offset) of each piece of the generated
         #: module that is compiled on its own (cut between top-level
         #: statements every :data:`~plcrt.compiler.cache.CHUNK_LINES` lines)
@@ -473,6 +476,8 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             gen.pending = None  # a value left on the stack at the end is dead
             info.depth_after[piece.index] = gen.depth
             records.append((fname, sorted(gen.used - {"L"}), gen.lines, gen.line_map))
+            if "WD" in gen.used or info.flow:
+                unit.uses_wd = True
             if stream and _group_full(records):
                 emit_group(records)
                 records = []

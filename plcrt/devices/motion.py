@@ -75,7 +75,7 @@ class Seg:
     # perf: plain integer arithmetic; called every scan for moving axes
     def pulses(self, t: int) -> int:
         """Whole pulses travelled at integer time ``t`` (inside the segment)."""
-        return (self.A * t * t + self.B * t + self.C) // self.D
+        return ((self.A * t + self.B) * t + self.C) // self.D
 
     def hz(self, t: int) -> int:
         """Speed in whole Hz at integer time ``t`` (integer arithmetic)."""

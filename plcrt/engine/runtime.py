@@ -208,6 +208,8 @@ class Plc(AddressAccess):
         a = self.mem.areas
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
         self._bufs_begin = self._bufs[:4]   # perf: unpacked once per scan
+        self._clk = self._clk_lo = self._clk_hi = 0   # SM0.4/SM0.5 and their window
+        self._wd_used = self.unit.uses_wd
         self._bufs_end = (a["PI"], a["Q"], a["PQ"])
         ns = self._ns
         self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
@@ -394,7 +396,7 @@ class Plc(AddressAccess):
         # perf: _scan_once and _timeline's device steps inlined, their
         # methods and objects looked up once
         begin, timeline, end = self._scan_begin, self._timeline, self._scan_end
-        irq, devices = self.interrupts, self.devices
+        irq, steps = self.interrupts, [dev.step for dev in self.devices]
         for _ in range(n):
             if self.mode != "RUN":
                 return
@@ -402,11 +404,11 @@ class Plc(AddressAccess):
             begin()
             if irq.timed_next or self._sources_on:
                 timeline(now, now + self.scan_us, True)
-            elif devices:
+            elif steps:
                 t_to = now + self.scan_us
                 try:
-                    for dev in devices:
-                        dev.step(self, now, t_to)
+                    for step in steps:
+                        step(self, now, t_to)
                 except Exception as e:
                     self._fault(e)
             end(now)
@@ -459,22 +461,34 @@ class Plc(AddressAccess):
             self._apply_forces()
         scans = self.scans
         # SM0.0 and SM0.7, SM0.1/SM0.3 on the first scan, SM0.6 on every
-        # other scan (perf: one table lookup, _SMB0)
-        b0 = _SMB0[scans & 1] if scans else 0x8B | 0x40
-        if now % 60_000_000 >= 30_000_000:
-            b0 |= 0x10
-        if now % 1_000_000 >= 500_000:
-            b0 |= 0x20
-        sm[0] = b0
-        self.timers.start_scan(self._prev_start, now)
+        # other scan (perf: one table lookup, _SMB0), the clocks SM0.4 and
+        # SM0.5 (perf: kept for the half second they hold, _clock)
+        if not self._clk_lo <= now < self._clk_hi:
+            self._clock(now)
+        sm[0] = (_SMB0[scans & 1] if scans else 0x8B | 0x40) | self._clk
+        timers = self.timers
+        if not timers._fast and timers.quiet_lo <= now < timers.quiet_hi:
+            timers.ms1 = now // 1000      # perf: TimerBank.quiet() inline
+        else:
+            timers.start_scan(self._prev_start, now)
         self._prev_start = self._irq_t = now
-        wd = self.wd
-        wd[0] = wd[2] = wd[3] = 0
+        if self._wd_used:   # perf: only code that counts on them reads them
+            wd = self.wd
+            wd[0] = wd[2] = wd[3] = 0
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
         except Exception as e:
             self._fault(e)
+
+    def _clock(self, now: int) -> None:
+        """SM0.4 (on for the second half of every minute) and SM0.5 (on for
+        the second half of every second) at *now*, and the half second
+        (the window _clk_lo .. _clk_hi) over which they hold."""
+        self._clk = (0x10 if now % 60_000_000 >= 30_000_000 else 0) | \
+            (0x20 if now % 1_000_000 >= 500_000 else 0)
+        self._clk_lo = now - now % 500_000
+        self._clk_hi = self._clk_lo + 500_000
 
     def _timeline(self, t_from: int, t_to: int, first: bool) -> None:
         """The scan's time line over (t_from, t_to]: events, routines, devices

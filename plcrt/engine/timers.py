@@ -80,6 +80,10 @@ class TimerBank:
         self.d100_buf = array("i", [0])     #: d100 for the native backend
         self._fast: set[int] = set()        #: running 1 ms / 10 ms timers
         self.ms1: int | None = None         #: the ms the 1 ms timers are advanced to
+        #: perf: scan starts in [quiet_lo, quiet_hi) change nothing but ms1
+        #: while no 1 ms / 10 ms timer runs: d100 is 0 and stays 0 until the
+        #: next 100 ms tick (see quiet())
+        self.quiet_lo = self.quiet_hi = 0
 
     # -- engine side ----------------------------------------------------
     def start_scan(self, prev_us: int | None, now_us: int) -> None:
@@ -101,6 +105,15 @@ class TimerBank:
         if self._fast:
             for n in list(self._fast):
                 self._advance(n, self.d1 if self.res[n] == 1 else self.d10)
+        elif d100 == 0:
+            self.quiet_lo, self.quiet_hi = now_us, (now_us // 100000 + 1) * 100000
+
+    def quiet(self, now_us: int) -> bool:
+        """Whether :meth:`start_scan` at *now_us* has nothing to do but set
+        ``ms1``: no 1 ms or 10 ms timer runs and no 100 ms tick has passed
+        since the last scan start that found d100 = 0 (the engine tests
+        this inline, then sets ``ms1`` itself)."""
+        return not self._fast and self.quiet_lo <= now_us < self.quiet_hi
 
     def refresh_1ms(self, t_us: int) -> None:
         """Advance the running 1 ms timers to *t_us* (an interrupt's time:

@@ -113,7 +113,7 @@ class Axis:
         # polynomial (Seg.pulses) inline; readers ask at every scan start
         if self._w_lo <= t < self._w_hi:
             s = self._w_seg
-            return (s.A * t * t + s.B * t + s.C) // s.D
+            return ((s.A * t + s.B) * t + s.C) // s.D
         if not self.segs:
             return 0
         s = self._seg_at(t)
@@ -126,7 +126,7 @@ class Axis:
         """The module's position counter at time ``t``."""
         if self._w_lo <= t < self._w_hi:   # perf: travel() inline
             s = self._w_seg
-            return self.counter + self.direction * ((s.A * t * t + s.B * t + s.C) // s.D)
+            return self.counter + self.direction * (((s.A * t + s.B) * t + s.C) // s.D)
         return self.counter + self.direction * self.travel(t)
 
     def mechanical(self, t: int) -> int:

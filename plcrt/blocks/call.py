@@ -57,7 +57,7 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         order = ", ".join(p.name for p in itf.params)
         g.fail(f"{itf.name} takes {len(itf.params)} arguments ({order}); "
                f"the call passes {len(args)}")
-    reads: list[str] = []
+    reads: list[Any] = []   # expressions, or bit operands (see _bit_reads)
     writes: list[tuple[Any, str]] = []   # (operand or None, type)
     for p, op_ir in zip(itf.params, args):
         typ = p.type   #: the type the argument is read as
@@ -76,7 +76,8 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
                 g.loc.block, g.loc.network)
             g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}", where)
         if p.dir == "IN":
-            reads.append(g.rbit(op) if typ == "BOOL" else g.rd(op, _KIND[typ]))
+            reads.append(op if typ == "BOOL" and isinstance(op, Addr)
+                         else g.rbit(op) if typ == "BOOL" else g.rd(op, _KIND[typ]))
         if p.dir == "OUT" or p.written:
             target = op if isinstance(op, (Addr, Indirect)) else None
             writes.append((target, p.type))
@@ -99,10 +100,35 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         fn = g.bind(block.__call__, "call")
     with g.box(alone=True):
         r = g.tmp("r")
-        g.line(f"{r} = {fn}({', '.join(reads)})")
+        g.line(f"{r} = {fn}({', '.join(_bit_reads(g, reads))})")
         g.wr_seq([(target, "X" if typ == "BOOL" else _KIND[typ], f"{r}[{i}]")
                   for i, (target, typ) in enumerate(writes) if target is not None])
     return True
+
+
+def _bit_reads(g: Any, reads: list[Any]) -> list[str]:
+    """The argument expressions: bit operands read with :meth:`Gen.rbit`,
+    except that a byte holding several of them is read once into a local
+    first (perf: one load instead of one per bit; reading has no effect,
+    so the order of the reads does not matter)."""
+    bytes_of = [(op.area, op.offset) for op in reads
+                if isinstance(op, Addr) and op.area not in ("T", "C")]
+    shared: dict[tuple[str, int], str] = {}
+    for key in dict.fromkeys(bytes_of):
+        if bytes_of.count(key) > 1:
+            shared[key] = var = g.tmp("b")
+            g.line(f"{var} = {g.rd(Addr(key[0], key[1], 1), 'B')}")
+    out = []
+    for op in reads:
+        if not isinstance(op, Addr):
+            out.append(op)
+            continue
+        var = shared.get((op.area, op.offset))
+        if var is None:
+            out.append(g.rbit(op))
+        else:
+            out.append(f"({var} >> {op.bit} & 1)" if op.bit else f"({var} & 1)")
+    return out
 
 
 #: export block name -> (the interfaces it may stand for, in the order tried;

@@ -417,3 +417,17 @@ def test_two_call_sites_each_report() -> None:
     plc.scan(3)
     lines = sorted(d.loc.line for d in _warnings(plc, "POS_GOTO_R") if d.loc)
     assert lines == [_line_of(text, "POS_GOTO_R", 1), _line_of(text, "POS_GOTO_R", 2)]
+
+
+@pytest.mark.parametrize("mb0,axis", [(0b01000, 0), (0b10000, 1)])
+def test_bit_arguments_of_one_byte_reach_their_own_parameters(mb0: int, axis: int) -> None:
+    """MOTION_EN3's five BOOL inputs all come from MB0 (read once): the CLR
+    bit of one axis starts that axis's CLR pulse only (manual 3.2.1)."""
+    plc, _ = _load(EN3)
+    plc["MB0"] = mb0
+    plc.scan()
+    mod = plc.modules[0]
+    assert [u is not None for u in mod.clr_until] == [axis == 0, axis == 1]
+    assert plc["MB0"] == mb0                   # the pulse holds the bit for 200 ms
+    plc.run(seconds=0.3)
+    assert plc["MB0"] == 0 and mod.clr_until == [None, None]

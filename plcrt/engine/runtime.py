@@ -208,7 +208,8 @@ class Plc(AddressAccess):
         a = self.mem.areas
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
         self._bufs_begin = self._bufs[:4]   # perf: unpacked once per scan
-        self._clk = self._clk_lo = self._clk_hi = 0   # SM0.4/SM0.5 and their window
+        self._clk_lo = self._clk_hi = 0    # the window of SM0.4/SM0.5 in _smb0
+        self._smb0 = _SMB0                  # SMB0 by scan parity (_clock)
         self._wd_used = self.unit.uses_wd
         self._bufs_end = (a["PI"], a["Q"], a["PQ"])
         ns = self._ns
@@ -461,11 +462,11 @@ class Plc(AddressAccess):
             self._apply_forces()
         scans = self.scans
         # SM0.0 and SM0.7, SM0.1/SM0.3 on the first scan, SM0.6 on every
-        # other scan (perf: one table lookup, _SMB0), the clocks SM0.4 and
-        # SM0.5 (perf: kept for the half second they hold, _clock)
+        # other scan, the clocks SM0.4 and SM0.5 (perf: the byte by scan
+        # parity, made by _clock for the half second the clocks hold)
         if not self._clk_lo <= now < self._clk_hi:
             self._clock(now)
-        sm[0] = (_SMB0[scans & 1] if scans else 0x8B | 0x40) | self._clk
+        sm[0] = self._smb0[scans & 1] if scans else 0x8B | 0x40 | self._smb0[0]
         timers = self.timers
         if not timers._fast and timers.quiet_lo <= now < timers.quiet_hi:
             timers.ms1 = now // 1000      # perf: TimerBank.quiet() inline
@@ -482,11 +483,12 @@ class Plc(AddressAccess):
             self._fault(e)
 
     def _clock(self, now: int) -> None:
-        """SM0.4 (on for the second half of every minute) and SM0.5 (on for
-        the second half of every second) at *now*, and the half second
-        (the window _clk_lo .. _clk_hi) over which they hold."""
-        self._clk = (0x10 if now % 60_000_000 >= 30_000_000 else 0) | \
+        """SMB0 by scan parity (_smb0) with SM0.4 (on for the second half of
+        every minute) and SM0.5 (on for the second half of every second) at
+        *now*, and the half second (_clk_lo .. _clk_hi) they hold for."""
+        clk = (0x10 if now % 60_000_000 >= 30_000_000 else 0) | \
             (0x20 if now % 1_000_000 >= 500_000 else 0)
+        self._smb0 = (_SMB0[0] | clk, _SMB0[1] | clk)
         self._clk_lo = now - now % 500_000
         self._clk_hi = self._clk_lo + 500_000
 
@@ -512,11 +514,9 @@ class Plc(AddressAccess):
         if self._force_slots:
             self._apply_forces()
         pq[:] = q
-        p0, p1 = self.pulse
         # perf: the generators' own fields, not their `running` property,
         # and only once a PLS has run (_sources_on)
-        if self._sources_on and (p0.trains or p1.trains or p0.mode == "PWM"
-                                 or p1.mode == "PWM"):
+        if self._sources_on and any(po.trains or po.mode == "PWM" for po in self.pulse):
             # a running generator drives its terminal, not the image bit
             t_end = now + self.scan_us
             for po in self.pulse:

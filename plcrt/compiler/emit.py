@@ -76,11 +76,13 @@ class Gen:
         #: (pending expression, its top-level operator) once combine()
         #: built it: decides which parentheses the next combine() needs
         self._pending_op: tuple[str, str] | None = None
+        #: inside a box under SM0.0: statements do not store a pending "1"
+        self._hold_one = False
 
     # -- source ---------------------------------------------------------
     def line(self, text: str) -> None:
         """Append one statement at the current indentation."""
-        if self.pending is not None:
+        if self.pending is not None and not (self._hold_one and self.pending == "1"):
             self.flush()
         self.lines.append("    " * self.indent + text)
 
@@ -97,6 +99,8 @@ class Gen:
     @contextmanager
     def block(self, header: str) -> Iterator[None]:
         """``with g.block("if s1:"):`` emits an indented suite."""
+        if self.pending is not None:
+            self.flush()    # stored before the suite, never only inside it
         self.line(header)
         self.indent += 1
         n = len(self.lines)
@@ -113,9 +117,13 @@ class Gen:
         the constant 1 (SM0.0, see :meth:`rbit`) may run without the test.
         """
         if alone and self.pending == "1":
-            # perf: a box under SM0.0 runs without a test
-            self.flush()
-            yield
+            # perf: a box under SM0.0 runs without a test, and the constant
+            # is stored only if something after the box reads the stack
+            self._hold_one = True
+            try:
+                yield
+            finally:
+                self._hold_one = False
             return
         with self.block(f"if {self.top}:"):
             yield

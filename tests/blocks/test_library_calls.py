@@ -431,3 +431,14 @@ def test_bit_arguments_of_one_byte_reach_their_own_parameters(mb0: int, axis: in
     assert plc["MB0"] == mb0                   # the pulse holds the bit for 200 ms
     plc.run(seconds=0.3)
     assert plc["MB0"] == 0 and mod.clr_until == [None, None]
+
+
+def test_logic_after_a_library_call_under_sm0_0_sees_the_power() -> None:
+    """A box under SM0.0 runs without a test; the network's logic after it
+    still has SM0.0's 1 on the stack (``= Q0.0``) and can combine it."""
+    plc, _ = _load(EN3 + "\n= Q0.0\nAN M5.0\n= Q0.1")
+    plc.scan()
+    assert (plc["Q0.0"], plc["Q0.1"], plc["VW0"]) == (1, 1, 1)
+    plc["M5.0"] = 1
+    plc.scan()
+    assert (plc["Q0.0"], plc["Q0.1"]) == (1, 0)

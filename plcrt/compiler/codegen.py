@@ -388,8 +388,10 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
 
     The module has no comments: where each instruction's code starts is in
     the returned :class:`LineLocs` (``plcrt dump`` shows it as a marker
-    comment), which keeps the text compiled and kept small."""
-    out: list[str] = []
+    comment), which keeps the text compiled and kept small.  Only the
+    lines of the chunk being written (:attr:`Unit.chunks`) are held as
+    lines; a finished chunk is kept as one text."""
+    out: list[str] = []      # the lines of the chunk being written
     line_locs = LineLocs(unit.locs)
     constants = [op.text for info in unit.pous.values() for net in info.pou.networks
                  for insn in net.insns for op in insn.operands if op.text.startswith('"')]
@@ -401,16 +403,33 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                     f"CP1252: they are stored in {codepage.upper()}, the first ANSI code page "
                     f"that holds them (docs/strings.md)", first, "codepage"))
     from .cache import CHUNK_LINES
-    cut_line, cut_char = 0, 0   # where the last chunk starts (line index, offset)
+    done: list[str] = []     # the text of each finished chunk
+    line0 = 0                # lines in the finished chunks (``out`` follows them)
+    chars = 0                # characters in the finished chunks
+
+    def flush() -> None:
+        """Finish the chunk in ``out``: keep its text, forget its lines."""
+        nonlocal line0, chars
+        # perf: a chunk's lines (about 80 bytes each as str objects) become
+        # one compact text as soon as the chunk is complete, so the whole
+        # module's lines are never held at once.  The chunks are compiled
+        # after generation (compile_chunks), not as each one completes: that
+        # interleaved the long-lived code objects with the generator's
+        # short-lived objects, which left the resident set larger (measured
+        # on 2026-12-02: 70.6 instead of 69.0 MiB for 100 000 mixed
+        # statements) and ran compile() slower
+        text = "\n".join(out) + "\n"
+        done.append(text)
+        line0 += len(out)
+        chars += len(text)
+        out.clear()
 
     def maybe_cut() -> None:
         """Start a new chunk here when the current one is long enough (a
         top-level statement starts here)."""
-        nonlocal cut_line, cut_char
-        if len(out) - cut_line >= CHUNK_LINES:
-            cut_char += sum(len(ln) for ln in out[cut_line:]) + len(out) - cut_line
-            cut_line = len(out)
-            unit.chunks.append((cut_line + 1, cut_char))
+        if len(out) >= CHUNK_LINES:
+            flush()
+            unit.chunks.append((line0 + 1, chars))
 
     unit.chunks = [(1, 0)]
     for info in unit.pous.values():
@@ -425,7 +444,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             maybe_cut()
             out.append(f"def {name}({', '.join(['L'] + [f'{n}={n}' for n in used])}):")
             for _f, _u, body, line_map in parts:
-                base = len(out)
+                base = line0 + len(out)
                 out.extend(body)
                 for rel, insn_id, indent in line_map:
                     assert insn_id == len(line_locs.starts)   # ids follow the text
@@ -526,7 +545,8 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
         maybe_cut()
         out.extend(_runner(unit, info, fnames, calls))
         out.append("")
-    return "\n".join(out) + "\n", line_locs
+    flush()
+    return "".join(done), line_locs
 
 
 def _group_full(group: list[Any]) -> bool:

@@ -45,12 +45,16 @@ GROUP_PIECES = 32
 GROUP_LINES = 400
 
 
-@dataclass
+@dataclass(slots=True)
 class Piece:
+    """Instructions of one network (or of a part of it between cuts) that
+    become one generated function; a program keeps one per network, so
+    slots and a slice of the network's tuple (the tuple itself for a whole
+    network) instead of a list."""
+
     pou: ir.Pou
     network: ir.Network
-    insns: list[ir.Insn]
-    start_depth: int = 0
+    insns: tuple[ir.Insn, ...]
     index: int = 0
     suffix: str = ""
     #: (mnemonic, resolved operands, site) of each instruction, for the
@@ -77,7 +81,7 @@ class PouInfo:
     calls: dict[str, SourceLoc] = field(default_factory=dict)  #: callee -> first CALL
     flow: bool = False
     cost: list[int] = field(default_factory=list)
-    depth_after: dict[int, int] = field(default_factory=dict)  #: piece -> stack depth at its end
+    depth_after: dict[int, int] = field(default_factory=dict)  #: FOR piece -> stack depth at its end
     #: variables of a type plcrt cannot hold (reported at the declaration)
     bad_vars: list[str] = field(default_factory=list)
 
@@ -96,7 +100,6 @@ class Unit:
         self._ids: dict[int, str] = {}
         self._counter = 0
         self.locs = LocTable()                #: instruction id -> location
-        self.texts: list[str] = []            #: instruction id -> mnemonic
         self.pous: dict[str, PouInfo] = {}    #: ident -> info
         self.by_name: dict[str, PouInfo] = {}
         self.timer_use: dict[int, list[tuple[str, SourceLoc]]] = {}
@@ -162,18 +165,19 @@ def split_pieces(info: PouInfo, diag: DiagnosticSink) -> None:
     """Cut a POU into pieces and match labels, loops and SCR segments."""
     pieces: list[Piece] = []
     for net in info.pou.networks:
-        cur = Piece(info.pou, net, [])
-        pieces.append(cur)
-        for insn in net.insns:
+        insns = net.insns
+        start = 0               # where the piece being cut starts in insns
+        for i, insn in enumerate(insns):
             spec = lookup(insn.mnemonic)
             flow = spec.flow if spec else ""
-            if flow in _CUT_BEFORE and cur.insns:
-                cur = Piece(info.pou, net, [])
-                pieces.append(cur)
-            cur.insns.append(insn)
+            if flow in _CUT_BEFORE and i > start:
+                pieces.append(Piece(info.pou, net, insns[start:i]))
+                start = i
             if flow in _CUT_AFTER:
-                cur = Piece(info.pou, net, [])
-                pieces.append(cur)
+                pieces.append(Piece(info.pou, net, insns[start:i + 1]))
+                start = i + 1
+        # perf: insns[0:] is the network's own tuple (no copy)
+        pieces.append(Piece(info.pou, net, insns[start:]))
     # drop empty trailing pieces created by cuts (keep one per network)
     kept: list[Piece] = []
     seen_nets: set[int] = set()
@@ -490,7 +494,9 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                 piece.entry_depth = gen.depth
             emit_piece(unit, gen, piece, resolver)
             gen.pending = None  # a value left on the stack at the end is dead
-            info.depth_after[piece.index] = gen.depth
+            if piece.index in info.loops:
+                # perf: only a FOR's depth is asked for (its loop body's start)
+                info.depth_after[piece.index] = gen.depth
             records.append((fname, sorted(gen.used - {"L"}), gen.lines, gen.line_map))
             if stream and _group_full(records):
                 emit_group(records)
@@ -681,7 +687,6 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             continue
         insn_id = len(unit.locs)
         unit.locs.append(loc)
-        unit.texts.append(insn.mnemonic)
         gen.loc = loc
         gen.insn_id = insn_id
         # where its code starts (the module has no comment lines: they

@@ -17,11 +17,13 @@ default arguments are its own objects.
 
 *Chunks.*  ``compile()`` of one module with a hundred thousand statements
 builds its whole syntax tree first: hundreds of MiB that the allocator
-keeps after they are freed.  The code generator marks cut points between
-top-level statements (:attr:`plcrt.compiler.codegen.Unit.chunks`) and
-:func:`compile_chunks` compiles the pieces one by one, moving each piece's
-line numbers to where the piece is in the whole module, so tracebacks,
-``plcrt dump`` and error locations see one module.
+keeps after they are freed.  The code generator cuts the module between
+top-level statements (:attr:`plcrt.compiler.codegen.Unit.chunks`) and turns
+each piece's lines into one text as soon as the piece is complete, so the
+whole module's lines are never held at once; :func:`compile_chunks`
+compiles the pieces one by one, moving each piece's line numbers to where
+the piece is in the whole module, so tracebacks, ``plcrt dump`` and error
+locations see one module.
 
 *Garbage collector.*  Loading allocates millions of objects and frees
 almost none: every automatic collection during it only walks what is still

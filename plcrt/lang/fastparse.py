@@ -324,14 +324,15 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
             continue
         if net_number < 0:
             return None             # an instruction before the first Network
+        # perf: one location per statement; its operands share it and keep
+        # their own column (ir.Operand)
+        insn_loc = SourceLoc(file, index, m.start(1) + 1, ident, net_number)
         operands: list[Operand] = []
         o = operand_match(line, m.end())
         if o is not None:
             while True:
                 text = o.group(1)
-                operands.append(Operand(
-                    share(text, text),
-                    SourceLoc(file, index, o.start(1) + 1, ident, net_number)))
+                operands.append(Operand(share(text, text), insn_loc, o.start(1) + 1))
                 pos = o.end()
                 c = comma_match(line, pos)
                 if c is None:
@@ -348,8 +349,7 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
         # perf: positional arguments; the dataclass __init__ is the largest
         # cost per statement (Insn(mnemonic, operands, loc, comment))
         append_insn(Insn(
-            mnemonic, tuple(operands),
-            SourceLoc(file, index, m.start(1) + 1, ident, net_number),
+            mnemonic, tuple(operands), insn_loc,
             comment.strip() if comment is not None else ""))
 
     pou = Pou(kind=kind, number=number, name=name, title=title or "",

@@ -4,7 +4,8 @@ A :class:`Program` is a list of :class:`Pou` (OB1, SBRs, INTs) made of
 :class:`Network` s of :class:`Insn` s.  Operands are kept as the text the user
 wrote (``VW100``, ``+10``, ``&VB0``, ``#Start``, ``电机启动``); classifying and
 resolving them is the compiler's job, so the grammar stays generic.  All nodes
-are immutable and carry their :class:`~plcrt.errors.SourceLoc`.
+are immutable and carry their :class:`~plcrt.errors.SourceLoc` (an operand:
+its instruction's, with its own column).
 
 This module holds data only: no parsing and no semantics.
 """
@@ -20,12 +21,33 @@ PouKind = Literal["OB", "SBR", "INT"]
 VarSection = Literal["IN", "IN_OUT", "OUT", "TEMP"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, repr=False)
 class Operand:
-    """One operand exactly as written (stripped of surrounding blanks)."""
+    """One operand exactly as written (stripped of surrounding blanks).
+
+    Its location is a location on its line (the parsers give the operand
+    its instruction's :class:`~plcrt.errors.SourceLoc`, the one object
+    they share) and its own column: a program keeps no location object per
+    operand.  ``Operand(text, loc)`` (no column) has the location ``loc``.
+    """
 
     text: str
-    loc: SourceLoc
+    #: a location on the operand's line: its file, line, block and network
+    at: SourceLoc
+    #: the operand's column, or 0 for the column of ``at``
+    column: int = 0
+
+    @property
+    def loc(self) -> SourceLoc:
+        """Where the operand is (file, line, column, block, network)."""
+        at = self.at
+        if not self.column or self.column == at.column:
+            return at
+        # perf: built when asked (error messages, coverage), not stored
+        return SourceLoc(at.file, at.line, self.column, at.block, at.network)
+
+    def __repr__(self) -> str:
+        return f"Operand(text={self.text!r}, loc={self.loc!r})"
 
 
 @dataclass(frozen=True, slots=True)

@@ -566,14 +566,18 @@ class _Builder:
         children = tree.children
         mnemonic = children[0]
         assert isinstance(mnemonic, Token)
+        loc = self.loc(mnemonic, block, network)
         operands: list[Operand] = []
         comment = ""
         for child in children[1:]:
             assert isinstance(child, Token)
             if child.type == "COMMENT":
                 comment = _comment_text(child)
+            elif (child.line or 1) == loc.line:
+                # the instruction's location and the operand's column, as
+                # the fast parser gives it (ir.Operand)
+                operands.append(Operand(str(child).strip(), loc, child.column or 1))
             else:
-                operands.append(Operand(str(child).strip(),
-                                        self.loc(child, block, network)))
+                operands.append(Operand(str(child).strip(), self.loc(child, block, network)))
         return Insn(mnemonic=str(mnemonic).upper(), operands=tuple(operands),
-                    loc=self.loc(mnemonic, block, network), comment=comment)
+                    loc=loc, comment=comment)

@@ -181,3 +181,37 @@ def test_releasing_free_memory_is_harmless() -> None:
     plc = plcrt.load(LOOP)
     assert cache.release_free_memory() in (True, False)
     assert len(_scan_all(plc)) == 6
+
+
+def test_pieces_are_slices_of_their_networks_instructions() -> None:
+    """A network without cuts is one piece holding the network's own tuple;
+    LBL cuts before itself, FOR and NEXT after themselves, and a network's
+    empty tail after a cut is no piece."""
+    text = """ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1
+LD     I0.0
+=      Q0.0
+Network 2
+LD     SM0.0
+FOR    VW0, +1, +3
++I     +1, VW2
+NEXT
+Network 3
+LBL    4
+LD     I0.1
+=      Q0.1
+Network 4
+END_ORGANIZATION_BLOCK
+"""
+    plc = plcrt.load(text)
+    info = plc.unit.pous["OB1"]
+    nets = info.pou.networks
+    got = [(p.network.number, [i.mnemonic for i in p.insns], p.index, p.suffix)
+           for p in info.pieces]
+    assert got == [(1, ["LD", "="], 0, ""), (2, ["LD", "FOR"], 1, ""),
+                   (2, ["+I", "NEXT"], 2, "_a"), (3, ["LBL", "LD", "="], 3, ""),
+                   (4, [], 4, "")]
+    assert info.pieces[0].insns is nets[0].insns and info.pieces[3].insns is nets[2].insns
+    assert all(isinstance(p.insns, tuple) for p in info.pieces)
+    assert info.cost == [2, 2, 2, 3, 0] and list(info.depth_after) == [1]

@@ -218,6 +218,35 @@ def test_a_fault_in_a_late_chunk_is_located_at_its_instruction(
     assert loc is not None and loc.line == text.splitlines().index("MOVW   +33, VW66") + 1
 
 
+def _sixty_networks() -> str:
+    nets = "".join(f"Network {n}\nLD     SM0.0\nMOVW   +{n}, VW{2 * n}\n" for n in range(1, 60))
+    return f"ORGANIZATION_BLOCK OB1\nBEGIN\n{nets}END_ORGANIZATION_BLOCK\n"
+
+
+def test_chunks_start_at_top_level_statements_where_the_text_says(
+        monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
+    """The generator keeps a finished chunk as one text: each chunk's first
+    line and character offset agree with the whole module's text."""
+    monkeypatch.setattr(cache, "CHUNK_LINES", 20)
+    monkeypatch.setattr(codegen, "GROUP_PIECES", 2)
+    plc = plcrt.load(_sixty_networks())
+    source, chunks = plc.source, plc.unit.chunks
+    assert len(chunks) > 5 and chunks[0] == (1, 0)
+    for line, offset in chunks[1:]:
+        assert source[offset - 1] == "\n" and source[offset:offset + 4] == "def "
+        assert source.count("\n", 0, offset) == line - 1
+    plc.scan()
+    assert plc["VW118"] == 59
+
+
+def test_generated_code_that_does_not_compile_is_an_internal_error(
+        monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
+    monkeypatch.setattr(codegen, "_runner", lambda *a: ["def pou_OB1(L) oops"])
+    with pytest.raises(plcrt.PlcConfigError, match="internal error: generated code does "
+                                                   "not compile"):
+        plcrt.load(PROGRAM)
+
+
 def test_the_collector_is_off_while_compiling_and_restored_after(
         monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
     seen: list[bool] = []

@@ -355,3 +355,35 @@ def test_damaged_texts_declined_or_identical(text: str) -> None:
     """A damaged text is either declined or read exactly as lark reads it;
     the fast path never accepts what lark rejects."""
     assert_declines_or_agrees(text, "damaged.awl")
+
+
+# --------------------------------------------------------------------------
+# Operand locations: the instruction's location and a column
+# --------------------------------------------------------------------------
+
+def test_an_operand_keeps_its_instructions_location_and_its_own_column() -> None:
+    from plcrt.errors import SourceLoc
+    from plcrt.lang.ir import Operand
+    text = ("ORGANIZATION_BLOCK OB1\nBEGIN\nNetwork 3\nLD     SM0.0\n"
+            "MOVW   VW16,  VW200 // copy\nEND_ORGANIZATION_BLOCK\n")
+    for program in (fast_parse(text, "p.awl"), parse_program_lark(text, "p.awl")):
+        assert program is not None
+        movw = program.pous[0].networks[0].insns[1]
+        first, second = movw.operands
+        # no location object per operand: both share the instruction's
+        assert first.at is movw.loc and second.at is movw.loc
+        assert first.loc == SourceLoc("p.awl", 5, 8, "OB1", 3)
+        assert second.loc == SourceLoc("p.awl", 5, 15, "OB1", 3)
+        assert repr(second) == f"Operand(text='VW200', loc={second.loc!r})"
+    assert fast_parse(text, "p.awl") == parse_program_lark(text, "p.awl")
+
+
+def test_an_operand_made_from_a_location_has_that_location() -> None:
+    from plcrt.errors import SourceLoc
+    from plcrt.lang.ir import Operand
+    loc = SourceLoc("q.awl", 9, 12, "SBR2", 4)
+    op = Operand("+7", loc)
+    assert op.loc is loc and op.column == 0
+    assert Operand("+7", loc, 12).loc == loc
+    assert Operand("+7", loc, 20).loc == SourceLoc("q.awl", 9, 20, "SBR2", 4)
+    assert op == Operand("+7", loc) and hash(op) == hash(Operand("+7", loc))

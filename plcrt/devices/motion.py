@@ -54,6 +54,9 @@ class Seg:
     C: int = 0
     D: int = 1
     t1_ceil: Optional[int] = None  #: first integer µs at or after t1
+    #: perf: speed in Hz is (HA t + HB) // D (hz() without its multiplications)
+    HA: int = 0
+    HB: int = 0
 
     def __post_init__(self) -> None:
         if self.t1 is None or self.t1 == self.t0:
@@ -69,6 +72,7 @@ class Seg:
         self.B = c1.numerator * (d // c1.denominator)
         self.C = c0.numerator * (d // c0.denominator)
         self.D = d
+        self.HA, self.HB = 2 * self.A * US, self.B * US
         if self.t1 is not None:
             self.t1_ceil = -((-self.t1.numerator) // self.t1.denominator)
 
@@ -79,7 +83,7 @@ class Seg:
 
     def hz(self, t: int) -> int:
         """Speed in whole Hz at integer time ``t`` (integer arithmetic)."""
-        return (2 * self.A * t + self.B) * US // self.D
+        return (self.HA * t + self.HB) // self.D
 
     def travel(self, t: Fraction | int) -> Fraction:
         """Exact travel at any time inside the segment."""

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable, Optional
 
-from ..motion import US, Seg, cruise, first_time_at, plan_distance, ramp
+from ..motion import Seg, cruise, first_time_at, plan_distance, ramp
 
 F0 = Fraction(0)
 NEVER = 1 << 62   #: a time after every simulated time (µs)
@@ -139,7 +139,7 @@ class Axis:
         """Signed output frequency in Hz (0 when stopped)."""
         if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
             s = self._w_seg
-            return self.direction * ((2 * s.A * t + s.B) * US // s.D)
+            return self.direction * ((s.HA * t + s.HB) // s.D)
         if not self.segs:
             return 0
         s = self._seg_at(t)

@@ -34,6 +34,8 @@ BUFFER_NAME = {
 
 VALUE_WIDTH = {"B": 1, "W": 2, "D": 4, "R": 4}
 _MASK = {"B": 255, "W": 65535, "D": 4294967295}
+#: Gen.wr_seq joins two values at most this many bytes apart
+MAX_GAP = 2
 
 
 class CodegenError(Exception):
@@ -327,8 +329,8 @@ class Gen:
 
         perf: writes that follow each other in one buffer become one store:
         bits of one byte one byte store, values at neighbouring addresses
-        one struct call (a library block's outputs usually lie side by
-        side).  Operands that overlap, indirect ones, constants and the
+        (at most :data:`MAX_GAP` bytes apart, the bytes between kept) one
+        struct call (a library block's outputs usually lie side by side).  Operands that overlap, indirect ones, constants and the
         timer, counter, accumulator and HC areas are written one by one.
         """
         i = 0
@@ -353,19 +355,27 @@ class Gen:
                 while end is not None and j < len(items):
                     nxt = _packable_end(*items[j])
                     if nxt is None or items[j][0].area != op.area \
-                            or items[j][0].offset != end:
+                            or not 0 <= items[j][0].offset - end <= MAX_GAP:
                         break
                     end = nxt
                     j += 1
                 if j - i == 1:
                     self.wr(op, kind, expr)
                 else:
-                    group = items[i:j]
-                    codes = "".join(PACK_CODE[k] for _, k, _ in group)
-                    values = ", ".join(e if k == "R" else f"({e}) & {_MASK[k[0]]}"
-                                       for _, k, e in group)
-                    self.line(f"{self.use(packer(codes))}({self._buf(op.area)}, {op.offset}, "
-                              f"{values})")
+                    # bytes between two values are written again with their
+                    # own value, read in the same statement (perf: a byte
+                    # read is cheaper than a second struct call)
+                    buf = self._buf(op.area)
+                    codes, values, pos = [], [], op.offset
+                    for o, k, e in items[i:j]:
+                        for gap in range(pos, o.offset):
+                            codes.append("B")
+                            values.append(f"{buf}[{gap}]")
+                        codes.append(PACK_CODE[k])
+                        values.append(e if k == "R" else f"({e}) & {_MASK[k[0]]}")
+                        pos = o.offset + VALUE_WIDTH[k[0]]
+                    self.line(f"{self.use(packer(''.join(codes)))}({buf}, {op.offset}, "
+                              f"{', '.join(values)})")
             i = j
 
     def copy(self, src: Any, dst: Any, kind: str) -> None:

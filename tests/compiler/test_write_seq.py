@@ -44,8 +44,9 @@ def writes(draw: Any) -> list[tuple[Addr, str, int]]:
             op = Addr(area, pos, 0, draw(st.integers(0, 7)))
         else:
             op = Addr(area, pos, WIDTH[kind])
-            # usually the next address, sometimes a gap or an overlap
-            pos = max(0, pos + WIDTH[kind] + draw(st.sampled_from((0, 0, 0, 1, -1))))
+            # usually the next address, sometimes a gap (joined up to two
+            # bytes) or an overlap
+            pos = max(0, pos + WIDTH[kind] + draw(st.sampled_from((0, 0, 0, 1, 2, 3, -1))))
         out.append((op, kind, draw(st.integers(0, 1 << 41))))
     return out
 
@@ -74,19 +75,25 @@ def test_joined_writes_leave_memory_as_single_ones(items: list) -> None:
 
 
 def test_neighbouring_outputs_are_one_store() -> None:
-    """SPD_CTRL's outputs VD100, VB104 (gap VB105) VW106, VD108: two struct
-    calls; two bits of MB0: one byte store."""
+    """SPD_CTRL's outputs VD100, VB104, VW106, VD108: one struct call that
+    writes VB105 again with its own value; two bits of MB0: one byte store."""
     g = Gen(_Unit())
     g.wr_seq([(Addr("V", 100, 4), "D", "r[0]"), (Addr("V", 104, 1), "B", "r[1]"),
               (Addr("V", 106, 2), "WU", "r[2]"), (Addr("V", 108, 4), "D", "r[3]"),
               (Addr("M", 0, 0, 3), "X", "r[4]"), (Addr("M", 0, 0, 4), "X", "r[5]")])
     assert [line.strip() for line in g.lines] == [
-        "_wIB(V, 100, (r[0]) & 4294967295, (r[1]) & 255)",
-        "_wHI(V, 106, (r[2]) & 65535, (r[3]) & 4294967295)",
+        "_wIBBHI(V, 100, (r[0]) & 4294967295, (r[1]) & 255, V[105], (r[2]) & 65535, "
+        "(r[3]) & 4294967295)",
         "M[0] = M[0] & 231 | (r[4]) << 3 | (r[5]) << 4"]
 
 
 def test_the_same_bit_twice_is_written_twice() -> None:
     g = Gen(_Unit())
     g.wr_seq([(Addr("M", 0, 0, 3), "X", "r[0]"), (Addr("M", 0, 0, 3), "X", "r[1]")])
+    assert len(g.lines) == 2
+
+
+def test_values_three_bytes_apart_are_two_stores() -> None:
+    g = Gen(_Unit())
+    g.wr_seq([(Addr("V", 0, 2), "W", "r[0]"), (Addr("V", 5, 2), "W", "r[1]")])
     assert len(g.lines) == 2

@@ -54,9 +54,12 @@ class Seg:
     C: int = 0
     D: int = 1
     t1_ceil: Optional[int] = None  #: first integer µs at or after t1
-    #: perf: speed in Hz is (HA t + HB) // D (hz() without its multiplications)
+    #: perf: speed in Hz is (HA t + HB) // HD: hz() without its
+    #: multiplications, over the smallest denominator (a divisor of one
+    #: machine digit divides faster than D, often of two)
     HA: int = 0
     HB: int = 0
+    HD: int = 1
 
     def __post_init__(self) -> None:
         if self.t1 is None or self.t1 == self.t0:
@@ -72,7 +75,9 @@ class Seg:
         self.B = c1.numerator * (d // c1.denominator)
         self.C = c0.numerator * (d // c0.denominator)
         self.D = d
-        self.HA, self.HB = 2 * self.A * US, self.B * US
+        ha, hb = 2 * self.A * US, self.B * US
+        g = gcd(gcd(ha, hb), d)
+        self.HA, self.HB, self.HD = ha // g, hb // g, d // g
         if self.t1 is not None:
             self.t1_ceil = -((-self.t1.numerator) // self.t1.denominator)
 
@@ -83,7 +88,7 @@ class Seg:
 
     def hz(self, t: int) -> int:
         """Speed in whole Hz at integer time ``t`` (integer arithmetic)."""
-        return (self.HA * t + self.HB) // self.D
+        return (self.HA * t + self.HB) // self.HD
 
     def travel(self, t: Fraction | int) -> Fraction:
         """Exact travel at any time inside the segment."""

@@ -139,7 +139,7 @@ class Axis:
         """Signed output frequency in Hz (0 when stopped)."""
         if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
             s = self._w_seg
-            return self.direction * ((s.HA * t + s.HB) // s.D)
+            return self.direction * ((s.HA * t + s.HB) // s.HD)
         if not self.segs:
             return 0
         s = self._seg_at(t)

@@ -49,10 +49,11 @@ class MotionEn3(MotionBlock):
         # perf: nothing to do when the inputs are as last scan and no CLR
         # pulse or emergency stop is pending: the module is enabled for this
         # scan and the outputs are those of the last call
-        # (the key holds EmNo: when it matches, self.module is that slot's)
+        # (the key holds EmNo: when it matches, self.module is that slot's;
+        # there is a key only after a call with Status 1)
         mod = self.module
         if (em_no, p_dor_ccw, sev0, sev1, clr0, clr1) == self._last_key \
-                and not mod.clr_pending and not mod.stf_any and self._last_out[2] == 1:
+                and not mod.clr_pending and not mod.stf_any:
             mod.enabled_scan = self.plc.scans
             return self._last_out
         return self.call_exact(em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
@@ -67,8 +68,7 @@ class MotionEn3(MotionBlock):
         self.module = mod
         mod.enabled_scan = self.plc.scans
         key = (em_no, p_dor_ccw, sev0, sev1, clr0, clr1)
-        if key == self._last_key and not mod.clr_pending and not mod.stf_any \
-                and self._last_out[2] == 1:
+        if key == self._last_key and not mod.clr_pending and not mod.stf_any:
             return self._last_out
         t = self.now()
         lowered = mod.differential and not p_dor_ccw
@@ -96,7 +96,8 @@ class MotionEn3(MotionBlock):
         mod.clr_pending = any(u is not None for u in mod.clr_until)
         mod.stf_any = status == 4
         result = (out[0], out[1], status)
-        self._last_key, self._last_out = (em_no, p_dor_ccw, sev0, sev1, out[0], out[1]), result
+        self._last_out = result
+        self._last_key = (em_no, p_dor_ccw, sev0, sev1, out[0], out[1]) if status == 1 else ()
         return result
 
 

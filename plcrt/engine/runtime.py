@@ -209,6 +209,7 @@ class Plc(AddressAccess):
         self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
         self._bufs_begin = self._bufs[:4]   # perf: unpacked once per scan
         self._clk_lo = self._clk_hi = 0    # the window of SM0.4/SM0.5 in _smb0
+        self._calm_lo = self._calm_hi = 0  # see _calm_start
         self._smb0 = _SMB0                  # SMB0 by scan parity (_clock)
         self._wd_used = self.unit.uses_wd
         self._bufs_end = (a["PI"], a["Q"], a["PQ"])
@@ -400,9 +401,9 @@ class Plc(AddressAccess):
         irq, steps = self.interrupts, [dev.step for dev in self.devices]
         q, pq = self._bufs[4], self._bufs[5]
         plain_end = not (self.encoders or self.wiring)
+        if self.mode != "RUN":
+            return
         for _ in range(n):
-            if self.mode != "RUN":
-                return
             now = self._t_us
             begin()
             if irq.timed_next or self._sources_on:
@@ -415,7 +416,8 @@ class Plc(AddressAccess):
                 except Exception as e:
                     self._fault(e)
             # perf: the usual scan end (_scan_end) inline: no forces, no
-            # pulse generator, no plant wires, no STOP, no observers
+            # pulse generator, no plant wires, no STOP, no observers (only
+            # _scan_end can end RUN mode, else a fault raises)
             if plain_end and not (self._force_slots or self._sources_on or self.stop_requested
                                   or self.observers):
                 pq[:] = q
@@ -423,6 +425,8 @@ class Plc(AddressAccess):
                 self._t_us = now + self.scan_us
             else:
                 end(now)
+                if self.mode != "RUN":
+                    return
 
     def run(self, seconds: Duration | None = None, scans: int | None = None) -> None:
         """Run for a simulated duration (``1.5``, ``"1.5s"``, ``"200ms"``,
@@ -471,17 +475,14 @@ class Plc(AddressAccess):
         if self._force_slots:
             self._apply_forces()
         scans = self.scans
-        # SM0.0 and SM0.7, SM0.1/SM0.3 on the first scan, SM0.6 on every
-        # other scan, the clocks SM0.4 and SM0.5 (perf: the byte by scan
-        # parity, made by _clock for the half second the clocks hold)
-        if not self._clk_lo <= now < self._clk_hi:
-            self._clock(now)
-        sm[0] = self._smb0[scans & 1] if scans else 0x8B | 0x40 | self._smb0[0]
         timers = self.timers
-        if not timers._fast and timers.quiet_lo <= now < timers.quiet_hi:
-            timers.ms1 = now // 1000      # perf: TimerBank.quiet() inline
+        if not timers._fast and self._calm_lo <= now < self._calm_hi:
+            # perf: SMB0 is its byte for this scan's parity, the timer bank
+            # needs only its millisecond (see _calm_start)
+            sm[0] = self._smb0[scans & 1]
+            timers.ms1 = now // 1000
         else:
-            timers.start_scan(self._prev_start, now)
+            self._calm_start(sm, scans, now)
         self._prev_start = self._irq_t = now
         if self._wd_used:   # perf: only code that counts on them reads them
             wd = self.wd
@@ -491,6 +492,25 @@ class Plc(AddressAccess):
                 self._ob1(l_ob1)
         except Exception as e:
             self._fault(e)
+
+    def _calm_start(self, sm: bytearray, scans: int, now: int) -> None:
+        """SMB0 and the timer bank at a scan start, and the window of scan
+        starts (_calm_lo .. _calm_hi) that change neither but SMB0's scan
+        parity bit and the bank's millisecond: inside the half second the
+        clocks SM0.4 and SM0.5 hold (_clock) and the bank's quiet window
+        (TimerBank.quiet), never including the first scan."""
+        # SM0.0 and SM0.7, SM0.1/SM0.3 on the first scan, SM0.6 on every
+        # other scan, the clocks SM0.4 and SM0.5
+        if not self._clk_lo <= now < self._clk_hi:
+            self._clock(now)
+        sm[0] = self._smb0[scans & 1] if scans else 0x8B | 0x40 | self._smb0[0]
+        timers = self.timers
+        if timers.quiet(now):
+            timers.ms1 = now // 1000
+        else:
+            timers.start_scan(self._prev_start, now)
+        self._calm_lo = max(self._clk_lo, timers.quiet_lo)
+        self._calm_hi = min(self._clk_hi, timers.quiet_hi) if scans else 0
 
     def _clock(self, now: int) -> None:
         """SMB0 by scan parity (_smb0) with SM0.4 (on for the second half of
@@ -914,6 +934,7 @@ class Plc(AddressAccess):
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
                      "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))
+        dst._calm_hi = 0   # its timer bank and scan count are ours now
         dst._warned = set(self._warned)
         dst.diagnostics = list(self.diagnostics)
         dst.wd[:] = self.wd

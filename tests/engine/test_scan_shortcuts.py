@@ -2,7 +2,8 @@
 
 plcrt.engine.runtime keeps SM0.4/SM0.5 for the half second they hold and
 skips TimerBank.start_scan inside a window where no 100 ms tick passes and
-no 1 ms / 10 ms timer runs (perf).  These properties run programs at scan
+no 1 ms / 10 ms timer runs; inside both (Plc._calm_start) a scan start
+sets only SMB0's parity byte and the bank's millisecond (perf).  These properties run programs at scan
 times that do and do not divide the clocks' periods, with restores back in
 time, and compare each scan with the closed form (SMB0) or with the same
 PLC made to take the exact path at every scan start (timers).
@@ -74,7 +75,7 @@ def _run_pair(scan_ms: float, steps: list) -> int:
         for _ in range(scans):
             shortcuts += fast.timers.quiet(fast.now_us)
             fast.scan()
-            exact.timers.quiet_hi = 0        # never inside a window
+            exact.timers.quiet_hi = exact._calm_hi = 0   # never inside a window
             exact.scan()
             assert bytes(fast.timers.tv) == bytes(exact.timers.tv), fast.now_us
             assert bytes(fast.timers.tb) == bytes(exact.timers.tb), fast.now_us
@@ -94,3 +95,20 @@ def test_a_fast_timer_started_after_quiet_scans_counts_from_its_scan() -> None:
     start: they count from the scan that started them, not from the last
     exact scan start."""
     assert _run_pair(1, [(0b100, 57), (0b111, 30), (0b100, 40), (0b1011, 90)]) > 50
+
+
+def test_restoring_a_state_ahead_keeps_its_timer_ticks() -> None:
+    """A PLC restored to a snapshot taken ahead of it, inside its own quiet
+    window, counts the 100 ms ticks of the snapshot's history, not its
+    own window's."""
+    p = plcrt.load(TIMERS, scan_ms=10)
+    p["IB0"] = 0b100                         # T37, 100 ms
+    p.run(scans=5)                           # t = 50 ms
+    ahead = p.fork()
+    ahead.run(scans=6)                       # its last scan started at 100 ms: a tick
+    snap = ahead.snapshot()
+    p.run(scans=10)                          # t = 150 ms, quiet since 110 ms
+    p.restore(snap)
+    for plc in (p, ahead):
+        plc.run(scans=25)
+    assert p["T37"] == ahead["T37"] and p.now_us == ahead.now_us

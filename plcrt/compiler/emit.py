@@ -330,8 +330,9 @@ class Gen:
         perf: writes that follow each other in one buffer become one store:
         bits of one byte one byte store, values at neighbouring addresses
         (at most :data:`MAX_GAP` bytes apart, the bytes between kept) one
-        struct call (a library block's outputs usually lie side by side).  Operands that overlap, indirect ones, constants and the
-        timer, counter, accumulator and HC areas are written one by one.
+        struct call (a library block's outputs usually lie side by side).
+        Operands that overlap, indirect ones, constants and the timer,
+        counter, accumulator and HC areas are written one by one.
         """
         i = 0
         while i < len(items):

@@ -206,8 +206,8 @@ class Plc(AddressAccess):
                 _entry = self._cached_entry(program, auto_diags)
             self._adopt(_entry, auto_diags)
         a = self.mem.areas
-        self._bufs = (a["I"], a["PI"], a["SM"], a["L"], a["Q"], a["PQ"])
-        self._bufs_begin = self._bufs[:4]   # perf: unpacked once per scan
+        # perf: the buffers a scan's start and end use, unpacked once each
+        self._bufs_begin = (a["I"], a["PI"], a["SM"], a["L"])
         self._clk_lo = self._clk_hi = 0    # the window of SM0.4/SM0.5 in _smb0
         self._calm_lo = self._calm_hi = 0  # see _calm_start
         self._smb0 = _SMB0                  # SMB0 by scan parity (_clock)
@@ -399,7 +399,7 @@ class Plc(AddressAccess):
         # methods and objects looked up once
         begin, timeline, end = self._scan_begin, self._timeline, self._scan_end
         irq, steps = self.interrupts, [dev.step for dev in self.devices]
-        q, pq = self._bufs[4], self._bufs[5]
+        q, pq = self._bufs_end[1:]
         plain_end = not (self.encoders or self.wiring)
         if self.mode != "RUN":
             return
@@ -450,7 +450,7 @@ class Plc(AddressAccess):
 
     def _scan_begin(self) -> None:
         """A scan up to and including the main program, at its start instant."""
-        # perf: buffers are bound once in __init__ (self._bufs)
+        # perf: buffers are bound once in __init__ (self._bufs_begin)
         i_img, pi, sm, l_ob1 = self._bufs_begin
         now = self._t_us
         if self._defined:
@@ -942,6 +942,7 @@ class Plc(AddressAccess):
         dst._force_slots = []
         for key, value in self.forces.items():
             dst.force(key, value)
+
 
 #: SMB0 of every scan but the first, by the scan count's parity: SM0.0
 #: (always on), SM0.7 (RUN switch position), SM0.6 (on every other scan)

@@ -111,8 +111,9 @@ class TimerBank:
     def quiet(self, now_us: int) -> bool:
         """Whether :meth:`start_scan` at *now_us* has nothing to do but set
         ``ms1``: no 1 ms or 10 ms timer runs and no 100 ms tick has passed
-        since the last scan start that found d100 = 0 (the engine tests
-        this inline, then sets ``ms1`` itself)."""
+        since the last scan start that found d100 = 0 (the engine then sets
+        ``ms1`` itself, and keeps the window to test it inline,
+        ``Plc._calm_start``)."""
         return not self._fast and self.quiet_lo <= now_us < self.quiet_hi
 
     def refresh_1ms(self, t_us: int) -> None:

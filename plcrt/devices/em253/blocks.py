@@ -110,7 +110,8 @@ class GetAbsPos(MotionBlock):
         plc = self.plc
         # perf: the usual case: the module and axis of the last call, enabled
         # in this scan; the time read from the PLC's field, not its property
-        if (em_no, axis_no) == self._site and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+        if (em_no, axis_no) == self._site \
+                and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
             return out
         return self.call_exact(em_no, axis_no)

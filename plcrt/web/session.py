@@ -158,6 +158,7 @@ class PanelSession:
         self._until: tuple[Callable[[], bool], str, int] | None = None
         self._stop_after_scan = False
         self._reset_after_scan = False
+        self._before_pause = "running"
         self.speed = "realtime"
         self.factor = 1.0
         self._anchor: tuple[float, int] | None = None
@@ -339,7 +340,7 @@ class PanelSession:
     def _do_continue(self, client: Client | None, msg: dict[str, Any]) -> None:
         if self.state != "paused":
             raise PlcConfigError("continue: no scan is paused at a breakpoint")
-        self._do_run(client, msg)
+        self.state = self._before_pause   # the step, until or run goes on
 
     def _do_stop(self, client: Client | None, msg: dict[str, Any]) -> None:
         self._left, self._until = None, None
@@ -366,7 +367,7 @@ class PanelSession:
 
     def _go(self, state: str) -> None:
         self.state = state
-        self._anchor = None
+        self._anchor = (self.clock(), self.plc.now_us)
 
     def _do_speed(self, client: Client | None, msg: dict[str, Any]) -> None:
         mode = msg["mode"]
@@ -374,7 +375,7 @@ class PanelSession:
             raise PlcConfigError("speed factor needs a factor (simulated s per wall s)")
         self.speed = mode
         self.factor = msg.get("factor", 1.0) if mode == "factor" else 1.0
-        self._anchor = None
+        self._anchor = (self.clock(), self.plc.now_us)
 
     def _do_reset(self, client: Client | None, msg: dict[str, Any]) -> None:
         if self.state == "paused":
@@ -498,7 +499,6 @@ class PanelSession:
             obs.remove(self._sample)
         if signals:
             obs.append(self._sample)
-            self._sample(self.plc)
         self._broadcast(self._trend_message())
 
     def _clear_trend(self) -> None:
@@ -645,6 +645,7 @@ class PanelSession:
             if net.index not in self.breaks or self._reset_after_scan or self._closed:
                 return
             self.paused_at, before = net, self.state
+            self._before_pause = before
             self.state = "paused"
             self._broadcast({"type": "notice", "level": "info",
                              "message": printable(f"break at {net.name} (t={self.plc.time:g} s,"

@@ -91,7 +91,6 @@ def origin_ok(request: web.Request) -> bool:
 def make_app(panel: Panel) -> web.Application:
     """The aiohttp application serving ``panel``."""
     app = web.Application(client_max_size=MAX_MESSAGE)
-    app["panel"] = panel
 
     async def index(request: web.Request) -> web.StreamResponse:
         return web.FileResponse(STATIC / "index.html", headers=_NO_STORE)

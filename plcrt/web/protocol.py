@@ -30,6 +30,8 @@ MAX_TEXT = 200
 MAX_MESSAGE = 16384
 #: the most signals in one trend
 MAX_TREND = 8
+#: the most networks one ``view`` may name
+MAX_VIEW = 1000
 #: the most scans one ``step`` may ask for
 MAX_STEP = 1_000_000
 
@@ -82,12 +84,15 @@ CLIENT: dict[str, tuple[dict[str, Field], str]] = {
               "stop the run at the start of that network"),
     "unbreak": ({"network": Field("str")}, "remove a breakpoint"),
     "continue": ({}, "leave a breakpoint: the paused scan goes on, and the run with it"),
-    "trend": ({"signals": Field("strs", doc=f"at most {MAX_TREND} addresses or "
-                                            f"device signals (axis0.0.position)")},
+    "trend": ({"signals": Field("strs", hi=MAX_TREND, doc=f"at most {MAX_TREND} addresses or "
+                                                          f"device signals (axis0.0.position)")},
               "record these signals once per scan (an empty list stops the trend)"),
     "history": ({}, "send the whole trend buffer again (after skipped frames)"),
-    "view": ({"block": Field("str", doc="OB1, SBR0, INT0")},
-             "which block's networks this client shows (frames carry their status)"),
+    "view": ({"block": Field("str", doc="OB1, SBR0, INT0"),
+              "networks": Field("strs", False, hi=MAX_VIEW,
+                                doc="the networks on screen (OB1/3 ...); omitted: all of "
+                                    "the block")},
+             "which networks this client shows (frames carry their status only)"),
     "lesson": ({"id": Field("str", doc="a lesson folder name of the course")},
                "load that lesson's program (every client gets a new hello)"),
     "check": ({}, "run the current lesson's tests ('check my program')"),
@@ -166,8 +171,8 @@ def _check(kind: str, name: str, f: Field, v: Any) -> Any:
     if f.kind == "strs":
         if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
             raise ProtocolError(f"{where} must be a list of texts")
-        if len(v) > MAX_TREND:
-            raise ProtocolError(f"{where}: at most {MAX_TREND} signals")
+        if len(v) > f.hi:
+            raise ProtocolError(f"{where}: at most {f.hi:g} items")
         return [_text(where, x) for x in v]
     if not isinstance(v, str):
         raise ProtocolError(f"{where} must be a text")

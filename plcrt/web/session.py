@@ -111,6 +111,8 @@ class Client:
 
     mailbox: Mailbox
     view: str = "OB1"       #: the block whose networks it shows
+    #: the networks on its screen ("OB1/3"), None: every network of the block
+    nets: frozenset[str] | None = None
 
 
 @dataclass
@@ -530,6 +532,8 @@ class PanelSession:
             raise PlcConfigError(f"no block '{msg['block']}' in the program")
         if client is not None:
             client.view = block
+            nets = msg.get("networks")
+            client.nets = None if nets is None else frozenset(nets)
 
     # ------------------------------------------------------------------
     # Running
@@ -692,11 +696,16 @@ class PanelSession:
             self._rate = (sim - s0) / 1e6 / (now - w0) if now > w0 else 0.0
             self._rate_mark = (now, sim)
         with self._lock:
-            views = {c.view for c in self.clients.values()} or {"OB1"}
+            views = {c.view for c in self.clients.values() if c.nets is None} or \
+                ({"OB1"} if not self.clients else set())
+            shown = {n for c in self.clients.values() if c.nets is not None for n in c.nets}
         status = PlcStatus(plc)
-        nets = {f"{b}/{n}": network_state(p, net, status, program=plc.program,
+        nets = {}
+        for (b, n), (p, net, lad) in self._nets.items():
+            key = f"{b}/{n}"
+            if b in views or key in shown:
+                nets[key] = network_state(p, net, status, program=plc.program,
                                           lad=lad).to_dict()
-                for (b, n), (p, net, lad) in self._nets.items() if b in views}
         bits = {}
         for a in self.inputs + self.outputs:
             try:

@@ -42,7 +42,7 @@ BAD = [
     ({"type": "run", "extra": 1}, "run: unknown field 'extra'"),
     ({"type": "run", "id": {"a": 1}}, "id must be a number or a short text"),
     ({"type": "trend", "signals": "I0.0"}, "a list of texts"),
-    ({"type": "trend", "signals": ["I0.0"] * 9}, "at most 8 signals"),
+    ({"type": "trend", "signals": ["I0.0"] * 9}, "at most 8 items"),
     ({"type": "watch", "spec": "VW0", "format": "octal"}, "watch.format must be one of"),
 ]
 

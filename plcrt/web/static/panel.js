@@ -89,8 +89,26 @@ function buildTabs(h) {
   }
 }
 
+// Frames carry the status of the networks on screen only (a long block
+// would cost the scan its time otherwise).
+P.visible = new Set();
+const seen = new IntersectionObserver((entries) => {
+  for (const e of entries) {
+    const id = e.target.dataset.net;
+    if (e.isIntersecting) P.visible.add(id); else P.visible.delete(id);
+  }
+  clearTimeout(P.viewTimer);
+  P.viewTimer = setTimeout(sendView, 50);
+});
+
+function sendView() {
+  send({ type: "view", block: P.block, networks: [...P.visible].slice(0, 1000) });
+}
+
 function showBlock(id) {
   P.block = id;
+  P.visible = new Set();
+  seen.disconnect();
   send({ type: "view", block: id });
   for (const b of $("tabs").children) b.classList.toggle("active", b.dataset.block === id);
   const box = $("networks");
@@ -145,6 +163,7 @@ function buildNetwork(n) {
     div.append(table);
   }
   P.nets[n.id] = entry;
+  seen.observe(div);
   return div;
 }
 

@@ -13,6 +13,9 @@ scan rate).
 
 A measuring tool: it asserts nothing and never fails on slow results
 unless ``--check`` is given (exit 1 below the target of 50 x real time).
+``--no-probes`` loads as ``plcrt serve --no-breakpoints`` does and
+``--backend native`` uses the native code generator (which covers a
+program without probes only).
 All traffic stays on 127.0.0.1 and the run stops by itself.
 """
 
@@ -59,9 +62,10 @@ async def _client(url: str, counts: list[int], i: int, stop: asyncio.Event) -> N
                     counts[i] += 1
 
 
-async def measure(seconds: float, clients: int, scan_ms: float) -> dict[str, Any]:
+async def measure(seconds: float, clients: int, scan_ms: float, *, probes: bool = True,
+                  backend: str | None = None) -> dict[str, Any]:
     text = bool_program()
-    plc = plcrt.load(text, scan_ms=scan_ms, instrument=True)
+    plc = plcrt.load(text, scan_ms=scan_ms, instrument=probes, backend=backend)
     session = PanelSession(plc)
     panel = Panel(session)
     runner = web.AppRunner(make_app(panel))
@@ -92,6 +96,7 @@ async def measure(seconds: float, clients: int, scan_ms: float) -> dict[str, Any
     wall = t1 - t0
     sim = (s1 - s0) / 1e6
     return {"program_insns": plc.program.instruction_count(), "scan_ms": scan_ms,
+            "probes": probes, "backend": plc.backend["name"],
             "clients": clients, "wall_s": round(wall, 3), "simulated_s": round(sim, 3),
             "x_real_time": round(sim / wall, 1), "us_per_scan": round(wall / sim * scan_ms * 1e3, 2)
             if sim else None, "frames_per_client_per_s": [round(f / wall, 1) for f in frames],
@@ -103,15 +108,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seconds", type=float, default=5.0, help="wall seconds measured")
     ap.add_argument("--clients", type=int, default=CLIENTS)
     ap.add_argument("--scan-ms", type=float, default=1.0)
+    ap.add_argument("--no-probes", action="store_true",
+                    help="load as plcrt serve --no-breakpoints does (no network probes)")
+    ap.add_argument("--backend", choices=("python", "native"), default=None)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--check", action="store_true", help=f"exit 1 below {TARGET_X:g} x")
     args = ap.parse_args(argv)
-    r = asyncio.run(measure(args.seconds, args.clients, args.scan_ms))
+    r = asyncio.run(measure(args.seconds, args.clients, args.scan_ms,
+                            probes=not args.no_probes, backend=args.backend))
     if args.json:
         print(json.dumps(r))
     else:
         print(f"panel: {r['program_insns']} instructions, {r['scan_ms']:g} ms scans, "
-              f"{r['clients']} websocket clients, as fast as possible")
+              f"{r['clients']} websocket clients, as fast as possible, backend "
+              f"{r['backend']}, {'with' if r['probes'] else 'without'} breakpoint probes")
         print(f"  {r['x_real_time']:g} x real time ({r['simulated_s']:g} simulated s in "
               f"{r['wall_s']:g} wall s, {r['us_per_scan']} us per scan); target "
               f"{TARGET_X:g} x")

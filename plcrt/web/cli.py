@@ -34,6 +34,9 @@ def register(sub: Any) -> None:
     p.add_argument("--host", default="127.0.0.1", metavar="ADDR",
                    help="address to listen on (default 127.0.0.1, this machine only)")
     p.add_argument("--open", action="store_true", help="open the page in a web browser")
+    p.add_argument("--no-breakpoints", action="store_true",
+                   help="load without the network probes that breakpoints need: scans run "
+                        "faster, and --backend native covers the whole program")
     p.set_defaults(func=cmd_serve)
 
 
@@ -54,7 +57,7 @@ def build_panel(args: argparse.Namespace) -> Any:
         ns.programs = [str(les.program)]
         ns.symbols = str(les.symbols) if les.symbols else args.symbols
         ns.plant = str(les.plant) if les.plant else args.plant
-        plc = load_from_args(ns, args.scan_ms, instrument=True)
+        plc = load_from_args(ns, args.scan_ms, instrument=not args.no_breakpoints)
         print_diagnostics(plc.diagnostics)
         return PanelSession(plc)
 
@@ -63,7 +66,7 @@ def build_panel(args: argparse.Namespace) -> Any:
         les = course.lesson(first)
         return Panel(load_lesson(les), lessons=course.lessons(first.parent), current=les,
                      load_lesson=load_lesson)
-    plc = load_from_args(args, args.scan_ms, instrument=True)
+    plc = load_from_args(args, args.scan_ms, instrument=not args.no_breakpoints)
     print_diagnostics(plc.diagnostics)
     current = None
     if course.is_lesson(first.parent) and first.name == "lesson.awl":

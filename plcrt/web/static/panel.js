@@ -126,6 +126,7 @@ function buildNetwork(n) {
   const div = el("div", { class: "net", "data-net": n.id });
   const head = el("div", { class: "net-head" });
   const bp = el("button", { class: "bp", title: "breakpoint", "aria-label": "breakpoint " + n.id });
+  bp.hidden = !P.hello.breakable;
   bp.addEventListener("click", () => {
     send({ type: bp.classList.contains("set") ? "unbreak" : "break", network: n.id });
   });

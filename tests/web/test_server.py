@@ -40,7 +40,26 @@ def _run(coro_fn):
         finally:
             await client.close()
             panel.session.close()
-    asyncio.run(main())
+    _in_thread(main)
+
+
+def _in_thread(main) -> None:
+    """``asyncio.run`` in a thread of its own: the browser tests' sync
+    Playwright keeps an event loop running in this one."""
+    import threading
+    errors: list[BaseException] = []
+
+    def target() -> None:
+        try:
+            asyncio.run(main())
+        except BaseException as e:  # noqa: BLE001 - re-raised below
+            errors.append(e)
+
+    t = threading.Thread(target=target)
+    t.start()
+    t.join(120)
+    if errors:
+        raise errors[0]
 
 
 def test_index_and_static_files_are_served_with_a_strict_policy() -> None:
@@ -135,3 +154,30 @@ def test_check_without_a_lesson_is_an_error() -> None:
         assert "no lesson" in err["message"]
         await ws.close()
     _run(body)
+
+
+def test_serve_reports_a_bad_program_without_a_traceback(tmp_path, capsys) -> None:
+    from plcrt.cli import main
+    bad = tmp_path / "bad.awl"
+    bad.write_text("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD Q9999.9\n"
+                   "END_ORGANIZATION_BLOCK\n")
+    assert main(["serve", str(bad), "--port", "0"]) == 1
+    err = capsys.readouterr().err
+    assert "bit number must be 0..7" in err and "Traceback" not in err
+    assert main(["serve", str(tmp_path / "missing.awl")]) == 1
+    assert "cannot read file" in capsys.readouterr().err
+
+
+def test_serve_builds_a_lesson_panel_from_a_lesson_folder() -> None:
+    import argparse
+
+    from plcrt.web.cli import build_panel
+    from .conftest import REPO
+    args = argparse.Namespace(
+        programs=[str(REPO / "examples/course/05-jog-and-position")], symbols=None,
+        encoding=None, data=None, cpu=None, plant=None, auto_symbols=False, backend=None,
+        max_file_mb=None, scan_ms=10.0, clock=None, no_breakpoints=False)
+    panel = build_panel(args)
+    hello = panel.hello()
+    assert hello["lesson"]["id"] == "05-jog-and-position" and len(hello["lessons"]) >= 6
+    assert hello["axes"][0]["limit_pos"] == 60000 and hello["breakable"] is True

@@ -199,7 +199,7 @@ function buildIO(h) {
     sw.addEventListener("keyup", (e) => {
       if (e.key === " " || e.key === "Enter") { e.preventDefault(); press(io.addr, false); }
     });
-    wrap.append(sw, el("span", { class: "name" }, io.name ? io.name.split(":")[0] : io.addr),
+    wrap.append(sw, el("span", { class: "name" }, io.name ? io.name.split(":")[0] : ""),
                 el("span", {}, io.addr), kind);
     ins.append(wrap);
   });
@@ -208,7 +208,7 @@ function buildIO(h) {
   for (const io of h.outputs) {
     const wrap = el("div", { class: "io", title: io.comment || io.addr });
     wrap.append(el("div", { class: "lamp", "data-lamp": io.addr }),
-                el("span", { class: "name" }, io.name ? io.name.split(":")[0] : io.addr),
+                el("span", { class: "name" }, io.name ? io.name.split(":")[0] : ""),
                 el("span", {}, io.addr));
     outs.append(wrap);
   }

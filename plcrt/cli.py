@@ -143,7 +143,7 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
 #: Subcommands defined beside the feature they present; each module has
 #: ``register(sub)`` adding its parser with ``func`` set.
 _COMMAND_MODULES = ("plcrt.view.cli", "plcrt.debug.cli", "plcrt.trace.cli",
-                    "plcrt.devices.cia402.cli")
+                    "plcrt.devices.cia402.cli", "plcrt.web.cli")
 
 
 def _build_parser() -> _Parser:

@@ -27,7 +27,8 @@ def _program_commands() -> dict[str, argparse.ArgumentParser]:
 
 
 def test_every_command_that_reads_a_program_is_known() -> None:
-    assert sorted(_program_commands()) == ["check", "debug", "dump", "run", "show", "trace"]
+    assert sorted(_program_commands()) == ["check", "debug", "dump", "run", "serve", "show",
+                                              "trace"]
 
 
 @pytest.mark.parametrize("command", sorted(_program_commands()))

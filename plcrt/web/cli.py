@@ -1,0 +1,150 @@
+"""The ``plcrt serve`` subcommand: the browser panel on a local port.
+
+Registered by :mod:`plcrt.cli` through :func:`register`.  Only argument
+handling, loading and starting the server live here; aiohttp is imported
+when the command runs, so other commands do not need it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ipaddress
+import sys
+from pathlib import Path
+from typing import Any
+
+#: the default port (0: any free one)
+DEFAULT_PORT = 8253
+
+
+def register(sub: Any) -> None:
+    """Add ``serve`` to the subparsers of the ``plcrt`` command."""
+    from ..cli import add_program_args, add_scan_ms_arg
+
+    p = sub.add_parser(
+        "serve", help="open a program in the browser panel (ladder, I/O, axes, trends)",
+        description="Serve a local web page that runs the program scan-exact in simulated "
+                    "time: ladder with live status, inputs as switches and push-buttons, "
+                    "outputs as lamps, watch table, trends and the axes of the plant. "
+                    "PROGRAM may be a lesson folder of the course (examples/course/NN-...).")
+    add_program_args(p)
+    add_scan_ms_arg(p)
+    p.add_argument("--port", type=int, default=DEFAULT_PORT, metavar="N",
+                   help=f"TCP port (default {DEFAULT_PORT}; 0 picks a free one)")
+    p.add_argument("--host", default="127.0.0.1", metavar="ADDR",
+                   help="address to listen on (default 127.0.0.1, this machine only)")
+    p.add_argument("--open", action="store_true", help="open the page in a web browser")
+    p.add_argument("--no-breakpoints", action="store_true",
+                   help="load without the network probes that breakpoints need: scans run "
+                        "faster, and --backend native covers the whole program")
+    p.set_defaults(func=cmd_serve)
+
+
+def build_panel(args: argparse.Namespace) -> Any:
+    """Load the program (or the lesson) of the command line into a
+    :class:`~plcrt.web.server.Panel`.
+
+    Raises:
+        PlcError: the program does not load, or a bad option.
+    """
+    from ..cli import load_from_args, print_diagnostics
+    from . import course
+    from .server import Panel
+    from .session import PanelSession
+
+    def load_lesson(les: course.Lesson) -> PanelSession:
+        ns = argparse.Namespace(**vars(args))
+        ns.programs = [str(les.program)]
+        ns.symbols = str(les.symbols) if les.symbols else args.symbols
+        ns.plant = str(les.plant) if les.plant else args.plant
+        plc = load_from_args(ns, args.scan_ms, instrument=not args.no_breakpoints)
+        print_diagnostics(plc.diagnostics)
+        return PanelSession(plc)
+
+    first = Path(args.programs[0])
+    if len(args.programs) == 1 and first.is_dir():
+        les = course.lesson(first)
+        return Panel(load_lesson(les), lessons=course.lessons(first.parent), current=les,
+                     load_lesson=load_lesson)
+    plc = load_from_args(args, args.scan_ms, instrument=not args.no_breakpoints)
+    print_diagnostics(plc.diagnostics)
+    current = None
+    if course.is_lesson(first.parent) and first.name == "lesson.awl":
+        current = course.lesson(first.parent)
+    lessons = course.lessons(first.parent.parent) if current else []
+    return Panel(PanelSession(plc), lessons=lessons, current=current,
+                 load_lesson=load_lesson if current else None)
+
+
+def _loopback(host: str) -> bool:
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    """``plcrt serve``: 0 after Ctrl-C, 1 a program, option or port error."""
+    from ..cli import EXIT_ERROR, EXIT_OK, print_diagnostics
+    from ..errors import PlcConfigError, PlcError
+    try:
+        if not 0 <= args.port <= 65535:
+            raise PlcConfigError(f"--port must be between 0 and 65535, got {args.port}")
+        try:
+            import aiohttp  # noqa: F401
+        except ImportError:
+            raise PlcConfigError("plcrt serve needs aiohttp: pip install aiohttp") from None
+        panel = build_panel(args)
+    except PlcError as e:
+        print_diagnostics(e.diagnostics)
+        return EXIT_ERROR
+    if not _loopback(args.host):
+        print(f"plcrt serve: warning: listening on {args.host}: anyone who can reach this "
+              f"address can run and force the PLC", file=sys.stderr)
+    return _serve(panel, args.host, args.port, args.open, EXIT_OK, EXIT_ERROR)
+
+
+def _serve(panel: Any, host: str, port: int, open_browser: bool, ok: int, bad: int) -> int:
+    import asyncio
+
+    from aiohttp import web
+
+    from .server import make_app
+
+    async def main() -> None:
+        runner = web.AppRunner(make_app(panel))
+        await runner.setup()
+        site = web.TCPSite(runner, host, port)
+        try:
+            await site.start()
+        except OSError as e:
+            await runner.cleanup()
+            raise SystemExit(f"plcrt serve: cannot listen on {host}:{port}: {e.strerror}")
+        sockets = site._server.sockets if site._server else []  # type: ignore[union-attr]
+        real = sockets[0].getsockname()[1] if sockets else port
+        shown = f"[{host}]" if ":" in host else host
+        url = f"http://{shown}:{real}/"
+        print(f"plcrt panel: {url}  (Ctrl-C stops)", flush=True)
+        if open_browser:
+            import webbrowser
+            webbrowser.open(url)
+        panel.session.start()
+        try:
+            await asyncio.Event().wait()
+        finally:
+            panel.session.close()
+            await runner.cleanup()
+
+    try:
+        asyncio.run(main())
+    except KeyboardInterrupt:
+        return ok
+    except SystemExit as e:
+        print(e.code, file=sys.stderr)
+        return bad
+    return ok
+
+
+__all__ = ["DEFAULT_PORT", "build_panel", "cmd_serve", "register"]

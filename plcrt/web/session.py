@@ -1,0 +1,877 @@
+"""The panel's PLC runner: run modes, speed, breakpoints, watch and force,
+trends and frames.  No web code: the server hands it checked messages
+(:mod:`plcrt.web.protocol`) and carries its frames; tests drive it
+directly.
+
+One thread touches the PLC: :meth:`PanelSession.start` runs
+:meth:`PanelSession.tick` in a loop, and every command a client sends is
+queued (:meth:`submit`) and applied between two chunks of scans.  The scan
+runs in simulated time; a *frame* (time, scans, run state, the status of
+the networks clients look at, inputs and outputs, watch table, forces,
+axes, drives and new trend samples) is sampled at the end of a scan at the
+display rate (:data:`DISPLAY_HZ`), never per scan, and put into every
+client's one-slot :class:`Mailbox`: a slow client skips frames, the scan
+never waits for it.
+
+Speed: ``realtime`` paces simulated time to the wall clock, ``factor``
+runs N simulated seconds per wall second, ``max`` runs as fast as it can
+in chunks of about :data:`CHUNK_S` wall seconds.
+
+Breakpoints stop inside a scan, as the debugger's do (:mod:`plcrt.debug.
+session`): the program is loaded with network probes
+(``instrument=True``) and ``CoverageMap.on_break`` is called before a
+network with a breakpoint.  The handler, in the runner thread, publishes a
+frame of that moment and applies commands until one resumes the scan
+(``continue``, ``run``, ``step``, ``stop``, ``until`` or ``reset``; the
+scan in progress always runs to its end first).
+
+It is not a second engine: scans are :meth:`plcrt.Plc.scan`, conditions
+the test harness's, values go through the PLC's address access and
+``set``/``force`` through the code of ``plcrt run --set``.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..cli import SetItem, apply_sets, parse_sets
+from ..engine.coverage import NetworkRef
+from ..engine.runtime import Plc
+from ..errors import PlcConfigError, PlcError, PlcRuntimeError
+from ..lang import ir
+from ..safetext import printable
+from ..testing.harness import Harness, condition, reader
+from ..view.ladder import Ladder, to_ladder
+from ..view.status import PlcStatus
+from .protocol import finite
+from .svg import network_state, network_svg, stl_lines
+
+#: frames per wall second
+DISPLAY_HZ = 15.0
+#: wall seconds one chunk of scans takes at most in "as fast as possible"
+CHUNK_S = 0.05
+#: trend samples kept (one per scan)
+TREND_MAX = 20000
+#: trend samples one frame carries at most (more are thinned out)
+TREND_TAIL = 2000
+#: real time that may be lost before the pacing starts again from now
+MAX_LAG_S = 0.5
+#: the most inputs and outputs shown as switches and lamps
+MAX_IO = 64
+#: default timeout of ``until`` (simulated seconds)
+UNTIL_TIMEOUT = 10.0
+
+
+class Mailbox:
+    """One client's inbox: a one-slot frame (a newer frame replaces an
+    unread one) and a short queue of messages (errors, notices).
+
+    ``notify`` is called (from any thread) when something arrives; the
+    server wakes its sender task with it."""
+
+    def __init__(self, notify: Callable[[], None] | None = None) -> None:
+        self._lock = threading.Lock()
+        self._frame: dict[str, Any] | None = None
+        self._messages: deque[dict[str, Any]] = deque(maxlen=100)
+        self.notify = notify or (lambda: None)
+        self.skipped = 0        #: frames replaced before they were read
+
+    def put_frame(self, frame: dict[str, Any]) -> None:
+        with self._lock:
+            if self._frame is not None:
+                self.skipped += 1
+            self._frame = frame
+        self.notify()
+
+    def put(self, message: dict[str, Any]) -> None:
+        with self._lock:
+            self._messages.append(message)
+        self.notify()
+
+    def take(self) -> list[dict[str, Any]]:
+        """Everything waiting: the messages in order, then the frame."""
+        with self._lock:
+            out = list(self._messages)
+            self._messages.clear()
+            if self._frame is not None:
+                out.append(self._frame)
+                self._frame = None
+        return out
+
+
+@dataclass
+class Client:
+    """One connected page."""
+
+    mailbox: Mailbox
+    view: str = "OB1"       #: the block whose networks it shows
+    #: the networks on its screen ("OB1/3"), None: every network of the block
+    nets: frozenset[str] | None = None
+
+
+@dataclass
+class _Watch:
+    spec: str
+    format: str
+    read: Callable[[], Any]
+    width: int              #: bytes, 0 for a bit
+
+
+@dataclass
+class _Trend:
+    signals: list[str] = field(default_factory=list)
+    readers: list[Callable[[], Any]] = field(default_factory=list)
+    t: deque[float] = field(default_factory=lambda: deque(maxlen=TREND_MAX))
+    rows: deque[list[Any]] = field(default_factory=lambda: deque(maxlen=TREND_MAX))
+    count: int = 0          #: samples recorded since the trend started
+    sent: int = 0           #: samples already carried by a frame
+
+
+class PanelSession:
+    """The panel's PLC and everything the page can ask of it.
+
+    Args:
+        plc: the loaded PLC; breakpoints need ``instrument=True``.
+        display_hz: frames per wall second.
+        clock, sleep: the wall clock (tests pass their own).
+    """
+
+    def __init__(self, plc: Plc, *, display_hz: float = DISPLAY_HZ,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        self.plc = plc
+        self.harness = Harness(plc)
+        self.display_hz = display_hz
+        self.clock, self.sleep = clock, sleep
+        self.power_up = plc.snapshot()
+        self.clients: dict[int, Client] = {}
+        self._lock = threading.Lock()
+        self._queue: queue.SimpleQueue[tuple[Client | None, dict[str, Any]]] = \
+            queue.SimpleQueue()
+        self.state = "stopped"          #: stopped, running, paused
+        self.paused_at: NetworkRef | None = None
+        self._left: int | None = None   # scans left of a step
+        self._until: tuple[Callable[[], bool], str, int] | None = None
+        self._stop_after_scan = False
+        self._reset_after_scan = False
+        self._before_pause = "running"
+        self.speed = "realtime"
+        self.factor = 1.0
+        self._anchor: tuple[float, int] | None = None
+        self._rate = 0.0
+        self._rate_mark: tuple[float, int] = (clock(), plc.now_us)
+        self.watches: list[_Watch] = []
+        self.breaks: set[int] = set()
+        self.trend = _Trend()
+        self._seq = 0
+        self._last_frame = -1e9
+        self._dirty = True
+        self._closed = False
+        self._thread: threading.Thread | None = None
+        self._chunk = 1
+        prog = plc.program
+        self._nets: dict[tuple[str, int], tuple[ir.Pou, ir.Network, Ladder]] = {
+            (p.ident, n.number): (p, n, to_ladder(n, program=prog))
+            for p in prog.pous for n in p.networks}
+        self._blocks = {p.ident.upper(): p.ident for p in prog.pous}
+        for p in prog.pous:
+            self._blocks.setdefault(p.name.upper(), p.ident)
+        self._names = _symbol_names(plc.symbols)
+        self.inputs, self.outputs = _io_bits(plc)
+        if plc.coverage is not None:
+            plc.coverage.on_break = self._on_break
+        self._hello: dict[str, Any] | None = None
+        #: the error of the last command applied without a client (tests)
+        self.last_error: dict[str, Any] | None = None
+
+    # ------------------------------------------------------------------
+    # Clients
+    # ------------------------------------------------------------------
+    def connect(self, notify: Callable[[], None] | None = None) -> Client:
+        """A new client; its mailbox gets the next frame."""
+        c = Client(Mailbox(notify))
+        with self._lock:
+            self.clients[id(c)] = c
+        self._dirty = True
+        return c
+
+    def disconnect(self, client: Client) -> None:
+        with self._lock:
+            self.clients.pop(id(client), None)
+
+    def submit(self, client: Client | None, msg: dict[str, Any]) -> None:
+        """Queue a checked message (:func:`plcrt.web.protocol.validate`);
+        it is applied in the runner thread between two chunks of scans."""
+        self._queue.put((client, msg))
+
+    # ------------------------------------------------------------------
+    # The program, once
+    # ------------------------------------------------------------------
+    def hello(self) -> dict[str, Any]:
+        """What a page needs to draw the program (sent once per connection)."""
+        if self._hello is None:
+            self._hello = self._make_hello()
+        return self._hello
+
+    def _make_hello(self) -> dict[str, Any]:
+        plc, prog = self.plc, self.plc.program
+        blocks = []
+        for p in prog.pous:
+            nets = []
+            for n in p.networks:
+                lad = self._nets[(p.ident, n.number)][2]
+                svg = network_svg(p, n, program=prog, names=self._names, lad=lad)
+                nets.append({"number": n.number, "id": f"{p.ident}/{n.number}",
+                             "title": n.title, "comment": n.comment, "svg": svg,
+                             "stl": stl_lines(n) if svg is None else None,
+                             "why": lad.reason})
+            blocks.append({"id": p.ident, "name": p.name, "title": p.title,
+                           "comment": p.comment, "networks": nets})
+        symbols = []
+        table = plc.symbols
+        if table is not None:
+            for s in list(table.entries.values())[:5000]:
+                symbols.append({"name": s.name, "address": s.address, "comment": s.comment})
+
+        def io(addr: str) -> dict[str, str]:
+            shown, tip = self._names(addr)
+            return {"addr": addr, "name": shown if shown != addr else "", "comment": tip}
+
+        return {"type": "hello", "files": sorted({p.loc.file for p in prog.pous}),
+                "blocks": blocks, "symbols": symbols,
+                "inputs": [io(a) for a in self.inputs],
+                "outputs": [io(a) for a in self.outputs],
+                "scan_ms": plc.scan_us / 1000, "axes": _axis_marks(plc),
+                "drives": _drive_marks(plc), "breakable": plc.coverage is not None}
+
+    # ------------------------------------------------------------------
+    # The runner thread
+    # ------------------------------------------------------------------
+    def start(self) -> None:
+        """Run :meth:`tick` in a thread of its own until :meth:`close`."""
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._loop, name="plcrt-panel",
+                                            daemon=True)
+            self._thread.start()
+
+    def close(self) -> None:
+        self._closed = True
+        self._queue.put((None, {"type": "_wake"}))
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout=5)
+
+    def _loop(self) -> None:
+        while not self._closed:
+            try:
+                self.tick()
+            except Exception as e:  # noqa: BLE001 - the runner must go on
+                self.state = "stopped"
+                self._broadcast({"type": "notice", "level": "error",
+                                 "message": f"internal error: {type(e).__name__}: {e}"})
+
+    def tick(self, wait: bool = True) -> None:
+        """One round: apply queued commands, run a chunk of scans if a run
+        is on, publish a frame if one is due.  ``wait``: block up to a
+        frame period for a command when nothing runs."""
+        busy = self.state == "running" or self._left is not None or self._until is not None
+        self._drain(block=wait and not busy, timeout=1 / self.display_hz)
+        if self._closed:
+            return
+        if self.state == "running" or self._left is not None or self._until is not None:
+            self._run_chunk()
+        self._maybe_frame()
+
+    def _drain(self, block: bool, timeout: float) -> None:
+        try:
+            item = self._queue.get(timeout=timeout) if block else self._queue.get_nowait()
+        except queue.Empty:
+            return
+        while True:
+            self._apply(*item)
+            try:
+                item = self._queue.get_nowait()
+            except queue.Empty:
+                return
+
+    # ------------------------------------------------------------------
+    # Commands
+    # ------------------------------------------------------------------
+    def _apply(self, client: Client | None, msg: dict[str, Any]) -> None:
+        kind = msg["type"]
+        if kind == "_wake":
+            return
+        try:
+            handler = getattr(self, "_do_" + kind, None)
+            if handler is None:
+                raise PlcConfigError(f"'{kind}' is not handled by the session")
+            handler(client, msg)
+        except PlcError as e:
+            self._reply(client, msg, e.message)
+        self._dirty = True
+
+    def apply(self, msg: dict[str, Any], client: Client | None = None) -> None:
+        """Apply a checked message now (in the calling thread; for tests and
+        for a session without a runner thread)."""
+        self._apply(client, msg)
+
+    def _reply(self, client: Client | None, msg: dict[str, Any], message: str) -> None:
+        err = {"type": "error", "request": msg.get("type"), "message": printable(message)}
+        if "id" in msg:
+            err["id"] = msg["id"]
+        if client is not None:
+            client.mailbox.put(err)
+        else:
+            self.last_error = err
+
+    def _broadcast(self, message: dict[str, Any]) -> None:
+        with self._lock:
+            clients = list(self.clients.values())
+        for c in clients:
+            c.mailbox.put(message)
+
+    def _do_run(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self._left, self._until = None, None
+        self._go("running")
+
+    def _do_continue(self, client: Client | None, msg: dict[str, Any]) -> None:
+        if self.state != "paused":
+            raise PlcConfigError("continue: no scan is paused at a breakpoint")
+        self.state = self._before_pause   # the step, until or run goes on
+
+    def _do_stop(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self._left, self._until = None, None
+        if self.state == "paused":
+            self._stop_after_scan = True
+        self.state = "stopped"
+
+    def _do_step(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self._until = None
+        n = msg.get("scans", 1)
+        if self.state == "paused":   # the paused scan is the first of them
+            self._left = n
+            self.state = "stepping"
+            return
+        self._left = n
+        self._go("stepping")
+
+    def _do_until(self, client: Client | None, msg: dict[str, Any]) -> None:
+        pred, what = condition(self.harness, msg["cond"])
+        timeout = msg.get("timeout", UNTIL_TIMEOUT)
+        self._left = None
+        self._until = (pred, what, self.plc.now_us + round(timeout * 1e6))
+        self._go("until")
+
+    def _go(self, state: str) -> None:
+        self.state = state
+        self._anchor = (self.clock(), self.plc.now_us)
+
+    def _do_speed(self, client: Client | None, msg: dict[str, Any]) -> None:
+        mode = msg["mode"]
+        if mode == "factor" and "factor" not in msg:
+            raise PlcConfigError("speed factor needs a factor (simulated s per wall s)")
+        self.speed = mode
+        self.factor = msg.get("factor", 1.0) if mode == "factor" else 1.0
+        self._anchor = (self.clock(), self.plc.now_us)
+
+    def _do_reset(self, client: Client | None, msg: dict[str, Any]) -> None:
+        if self.state == "paused":
+            self._reset_after_scan = True
+            self._stop_after_scan = True
+            self.state = "stopped"
+            return
+        self._reset()
+
+    def _reset(self) -> None:
+        """Power-up: the state right after loading.  Forces, breakpoints,
+        watches and trend signals stay (as a force stays in the CPU)."""
+        forces = dict(self.plc.forces)
+        self.plc.restore(self.power_up)
+        for k, v in forces.items():
+            self.plc.force(k, v)
+        self._stop_after_scan = False
+        self._apply_breaks()
+        self.state, self._left, self._until = "stopped", None, None
+        self._clear_trend()
+        self._broadcast({"type": "notice", "level": "info", "message": "power-up reset"})
+
+    def _do_set(self, client: Client | None, msg: dict[str, Any]) -> None:
+        apply_sets(self.plc, self._sets(msg))
+
+    def _do_force(self, client: Client | None, msg: dict[str, Any]) -> None:
+        (item,) = self._sets(msg)
+        try:
+            self.plc.force(item.addr, item.value)
+        except PlcError as e:
+            raise PlcConfigError(f"force {printable(item.item)}: {e.message}") from None
+
+    @staticmethod
+    def _sets(msg: dict[str, Any]) -> list[SetItem]:
+        """``addr``/``value`` read as one ``--set ADDR=VALUE``."""
+        try:
+            return parse_sets([f"{msg['addr']}={msg['value']}"])
+        except PlcConfigError as e:
+            raise PlcConfigError(e.message.removeprefix("--")) from None
+
+    def _do_unforce(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self.plc.unforce(msg.get("addr"))
+
+    def _do_watch(self, client: Client | None, msg: dict[str, Any]) -> None:
+        spec, fmt = msg["spec"], msg.get("format", "auto")
+        if any(w.spec == spec and w.format == fmt for w in self.watches):
+            return
+        read, width = self._watch_reader(spec, fmt)
+        self.watches.append(_Watch(spec, fmt, read, width))
+
+    def _watch_reader(self, spec: str, fmt: str) -> tuple[Callable[[], Any], int]:
+        from ..trace.recorder import is_device_signal
+        if is_device_signal(spec):
+            if fmt not in ("auto", "int", "real"):
+                raise PlcConfigError(f"{spec} is a device signal: watch it as auto")
+            return reader(self.plc, spec), 4
+        base = spec.split(":")[0].strip()
+        _, _, width, _, _ = self.plc.locate(spec)
+        if fmt == "real":
+            if width != 4:
+                raise PlcConfigError(f"{spec}: REAL needs a double word (VD, MD, ...)")
+            return reader(self.plc, base + ":REAL"), 4
+        if fmt == "bit":
+            try:
+                return reader(self.plc, base + ":BIT"), 0
+            except PlcError:
+                if width != 0:
+                    raise PlcConfigError(f"{spec} is not a bit") from None
+                return reader(self.plc, base), 0
+        need = {"int": 2, "dint": 4}.get(fmt)
+        if need is not None and width != need:
+            raise PlcConfigError(f"{spec}: {fmt.upper()} needs a "
+                                 f"{'word' if need == 2 else 'double word'}")
+        return reader(self.plc, spec), width
+
+    def _do_unwatch(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self.watches = [w for w in self.watches if w.spec != msg["spec"]]
+
+    def _network(self, text: str) -> NetworkRef:
+        import re
+        cov = self.plc.coverage
+        if cov is None:
+            raise PlcConfigError("breakpoints need the program loaded with network probes")
+        m = re.fullmatch(r"(?:([^/\s]+)\s*/\s*)?(\d+)", text.strip())
+        if m is None:
+            raise PlcConfigError(f"'{text}' is not a network: write OB1/3, SBR0/1 or 3")
+        block = self._blocks.get((m.group(1) or "OB1").upper())
+        if block is None:
+            raise PlcConfigError(f"no block '{m.group(1)}' in the program")
+        net = cov.find(block, int(m.group(2)))
+        if net is None:
+            raise PlcConfigError(f"no network {block}/{m.group(2)} with code to stop in")
+        return net
+
+    def _do_break(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self.breaks.add(self._network(msg["network"]).index)
+        self._apply_breaks()
+
+    def _do_unbreak(self, client: Client | None, msg: dict[str, Any]) -> None:
+        self.breaks.discard(self._network(msg["network"]).index)
+        self._apply_breaks()
+
+    def _apply_breaks(self) -> None:
+        cov = self.plc.coverage
+        if cov is None:
+            return
+        cov.on_break = self._on_break
+        bp = cov.breakpoints
+        bp[:] = bytes(len(bp))
+        if not self._reset_after_scan:
+            for k in self.breaks:
+                bp[k] = 1
+
+    def _do_trend(self, client: Client | None, msg: dict[str, Any]) -> None:
+        signals = list(dict.fromkeys(msg["signals"]))
+        readers = [reader(self.plc, s) for s in signals]   # all checked first
+        self.trend.signals, self.trend.readers = signals, readers
+        self._clear_trend()
+        obs = self.plc.observers
+        if self._sample in obs:
+            obs.remove(self._sample)
+        if signals:
+            obs.append(self._sample)
+        self._broadcast(self._trend_message())
+
+    def _clear_trend(self) -> None:
+        tr = self.trend
+        tr.t.clear()
+        tr.rows.clear()
+        tr.count = tr.sent = 0
+        if tr.signals:
+            self._sample(self.plc)
+
+    def _sample(self, plc: Plc) -> None:
+        tr = self.trend
+        tr.t.append(plc.now_us / 1e6)
+        tr.rows.append([finite(r()) for r in tr.readers])
+        tr.count += 1
+
+    def _trend_message(self) -> dict[str, Any]:
+        tr = self.trend
+        return {"type": "trend", "signals": tr.signals, "end": tr.count,
+                "t": list(tr.t), "v": list(tr.rows)}
+
+    def _do_history(self, client: Client | None, msg: dict[str, Any]) -> None:
+        if client is not None:
+            client.mailbox.put(self._trend_message())
+
+    def _do_view(self, client: Client | None, msg: dict[str, Any]) -> None:
+        block = self._blocks.get(msg["block"].upper())
+        if block is None:
+            raise PlcConfigError(f"no block '{msg['block']}' in the program")
+        if client is not None:
+            client.view = block
+            nets = msg.get("networks")
+            client.nets = None if nets is None else frozenset(nets)
+
+    # ------------------------------------------------------------------
+    # Running
+    # ------------------------------------------------------------------
+    def _run_chunk(self) -> None:
+        """A chunk of scans sized to the speed; stops at a step's end, a
+        condition, a breakpoint's stop, a fault or STOP mode."""
+        plc = self.plc
+        if plc.mode != "RUN":
+            self._finish_run("the CPU is in STOP mode: scans do nothing")
+            return
+        n = self._scans_now()
+        if n <= 0:
+            return
+        per_scan = (self._left is not None or self._until is not None
+                    or bool(self.breaks))
+        t0 = self.clock()
+        try:
+            if per_scan:
+                for _ in range(n):
+                    plc.scan(1)
+                    if self._after_scan():
+                        break
+            else:
+                if self._left is not None:
+                    n = min(n, self._left)
+                plc.scan(n)
+        except PlcRuntimeError as e:
+            self.state, self._left, self._until = "stopped", None, None
+            self._broadcast({"type": "notice", "level": "error",
+                             "message": printable("; ".join(str(d) for d in e.diagnostics)
+                                                  or e.message)})
+            return
+        dt = self.clock() - t0
+        if self.speed == "max" and n > 0:
+            per = dt / n if dt > 0 else 1e-6
+            self._chunk = max(1, min(100000, int(CHUNK_S / per)))
+
+    def _after_scan(self) -> bool:
+        """After one scan of a per-scan run: True ends the chunk."""
+        if self._reset_after_scan:
+            self._reset_after_scan = False
+            self._reset()
+            return True
+        if self._stop_after_scan:
+            self._stop_after_scan = False
+            self.state = "stopped"
+            return True
+        if self._left is not None:
+            self._left -= 1
+            if self._left <= 0:
+                self._left = None
+                self.state = "stopped"
+                return True
+        if self._until is not None:
+            pred, what, deadline = self._until
+            if pred():
+                self._until = None
+                self.state = "stopped"
+                self._broadcast({"type": "notice", "level": "info",
+                                 "message": printable(f"'{what}' is true at "
+                                                      f"t={self.plc.time:g} s")})
+                return True
+            if self.plc.now_us >= deadline:
+                self._until = None
+                self.state = "stopped"
+                self._broadcast({"type": "notice", "level": "warning",
+                                 "message": printable(f"'{what}' still false at the "
+                                                      f"timeout (t={self.plc.time:g} s)")})
+                return True
+        if self.state not in ("running", "stepping", "until"):
+            return True
+        return self.plc.mode != "RUN"
+
+    def _scans_now(self) -> int:
+        """How many scans this chunk runs."""
+        scan_us = self.plc.scan_us
+        if self.state == "stepping" or self._left is not None:
+            if self.speed == "max":
+                return min(self._left or 1, self._chunk)
+        if self.speed == "max":
+            return self._chunk
+        now = self.clock()
+        sim = self.plc.now_us
+        if self._anchor is None:
+            self._anchor = (now, sim)
+        w0, s0 = self._anchor
+        factor = self.factor if self.speed == "factor" else 1.0
+        target = s0 + (now - w0) * factor * 1e6
+        lag = (target - sim) / 1e6 / factor
+        if lag > MAX_LAG_S:   # too far behind: pace from here on
+            self._anchor = (now, sim)
+            target = sim + scan_us
+        n = int((target - sim) // scan_us)
+        if n <= 0:
+            wait = (sim + scan_us - target) / 1e6 / factor
+            self.sleep(min(wait, 1 / self.display_hz, 0.02))
+            return 0
+        cap = max(1, int(factor * 1e6 / self.display_hz / scan_us) + 1)
+        return min(n, cap)
+
+    def _finish_run(self, message: str) -> None:
+        self.state, self._left, self._until = "stopped", None, None
+        self._broadcast({"type": "notice", "level": "warning", "message": message})
+
+    # ------------------------------------------------------------------
+    # Breakpoints (inside a scan)
+    # ------------------------------------------------------------------
+    def _on_break(self, net: NetworkRef) -> None:
+        """Called by the program's code before a network with a breakpoint;
+        must never raise (it would fault the PLC)."""
+        try:
+            if net.index not in self.breaks or self._reset_after_scan or self._closed:
+                return
+            self.paused_at, before = net, self.state
+            self._before_pause = before
+            self.state = "paused"
+            self._broadcast({"type": "notice", "level": "info",
+                             "message": printable(f"break at {net.name} (t={self.plc.time:g} s,"
+                                                  f" scan {self.plc.scans + 1})")})
+            self._publish()
+            while self.state == "paused" and not self._closed:
+                self._drain(block=True, timeout=1 / self.display_hz)
+                if self._dirty and self.state == "paused":
+                    self._publish()
+            if before == "until" and self.state == "stepping":
+                self._until = None
+        except Exception as e:  # noqa: BLE001 - see above
+            self.state = "stopped"
+            self._broadcast({"type": "notice", "level": "error",
+                             "message": f"internal error while paused: {e}"})
+        finally:
+            self.paused_at = None
+
+    # ------------------------------------------------------------------
+    # Frames
+    # ------------------------------------------------------------------
+    def _maybe_frame(self) -> None:
+        now = self.clock()
+        if now - self._last_frame >= 1 / self.display_hz or \
+                (self._dirty and self.state in ("stopped", "paused")):
+            self._publish()
+
+    def _publish(self) -> None:
+        frame = self.frame()
+        with self._lock:
+            clients = list(self.clients.values())
+        for c in clients:
+            c.mailbox.put_frame(frame)
+        self._last_frame = self.clock()
+        self._dirty = False
+
+    def frame(self) -> dict[str, Any]:
+        """The state now, as the ``frame`` message."""
+        plc = self.plc
+        self._seq += 1
+        now, sim = self.clock(), plc.now_us
+        w0, s0 = self._rate_mark
+        if now - w0 >= 0.5:
+            self._rate = (sim - s0) / 1e6 / (now - w0) if now > w0 else 0.0
+            self._rate_mark = (now, sim)
+        with self._lock:
+            views = {c.view for c in self.clients.values() if c.nets is None} or \
+                ({"OB1"} if not self.clients else set())
+            shown = {n for c in self.clients.values() if c.nets is not None for n in c.nets}
+        status = PlcStatus(plc)
+        nets = {}
+        for (b, n), (p, net, lad) in self._nets.items():
+            key = f"{b}/{n}"
+            if b in views or key in shown:
+                nets[key] = network_state(p, net, status, program=plc.program,
+                                          lad=lad).to_dict()
+        bits = {}
+        for a in self.inputs + self.outputs:
+            try:
+                bits[a] = plc.read(a)
+            except PlcError:
+                pass
+        mode = plc.mode if plc.mode == "RUN" else \
+            ("STOP (fault)" if plc.fault is not None else "STOP")
+        tr = self.trend
+        new = min(tr.count - tr.sent, len(tr.t))
+        tail_t, tail_v = list(tr.t)[len(tr.t) - new:], list(tr.rows)[len(tr.rows) - new:]
+        if new > TREND_TAIL:
+            step = -(-new // TREND_TAIL)
+            tail_t, tail_v = tail_t[::step] + tail_t[-1:], tail_v[::step] + tail_v[-1:]
+        start = tr.count - new
+        tr.sent = tr.count
+        run = self.state if self.state in ("stopped", "paused") else "running"
+        cov = plc.coverage
+        return {
+            "type": "frame", "seq": self._seq, "t": plc.now_us / 1e6, "scans": plc.scans,
+            "mode": mode, "run": run,
+            "paused_at": self.paused_at.name if self.paused_at else None,
+            "speed": {"mode": self.speed, "factor": self.factor},
+            "rate": round(self._rate, 3), "io": bits, "nets": nets,
+            "watch": [self._watch_row(w) for w in self.watches],
+            "forces": {k: finite(v) for k, v in plc.forces.items()},
+            "breaks": sorted(cov.networks[k].name for k in self.breaks) if cov else [],
+            "axes": [dict(a.to_dict()) for a in plc.axes()],
+            "drives": [dict(d.to_dict()) for d in plc.drives()],
+            "trend": {"signals": tr.signals, "start": start, "end": tr.count,
+                      "t": tail_t, "v": tail_v},
+            "until": self._until[1] if self._until else None,
+        }
+
+    def _watch_row(self, w: _Watch) -> dict[str, Any]:
+        try:
+            v = w.read()
+            text = _format(v, w.format, w.width)
+        except PlcError as e:
+            text = f"error: {e.message}"
+        return {"spec": w.spec, "format": w.format, "value": text,
+                "forced": self._is_forced(w.spec)}
+
+    def _is_forced(self, spec: str) -> bool:
+        """Whether a force overlaps ``spec`` (forcing Q0.0 marks QB0 too)."""
+        plc = self.plc
+        if not plc.forces:
+            return False
+        try:
+            buf, off, width, bit = plc.locate(spec)[:4]
+        except PlcError:
+            return False
+        for key in plc.forces:
+            fbuf, foff, fwidth, fbit = plc.locate(key)[:4]
+            if fbuf is not buf:
+                continue
+            if width == 0 and fwidth == 0:
+                if off == foff and bit == fbit:
+                    return True
+            elif off < foff + max(fwidth, 1) and foff < off + max(width, 1):
+                return True
+        return False
+
+
+# ---------------------------------------------------------------------------
+# Helpers
+# ---------------------------------------------------------------------------
+
+def _format(v: Any, fmt: str, width: int) -> str:
+    """A watch value in its format: bits 0/1, INT/DINT signed, REAL to 7
+    digits, hex as Micro/WIN writes it (16#00FF)."""
+    if isinstance(v, bool):
+        v = int(v)
+    if isinstance(v, float):
+        import math
+        return f"{v:.7g}" if math.isfinite(v) else str(finite(v))
+    if fmt == "hex":
+        digits = max(2, 2 * (width or 1))
+        return f"16#{int(v) & ((1 << (4 * digits)) - 1):0{digits}X}"
+    return str(v)
+
+
+def _symbol_names(table: Any) -> Callable[[str], tuple[str, str]]:
+    """operand text -> (text shown, tooltip): ``name:address`` and the
+    symbol's comment when a symbol is involved."""
+    by_name: dict[str, Any] = dict(getattr(table, "entries", {}) or {})
+    by_addr: dict[str, Any] = {}
+    for s in by_name.values():
+        by_addr.setdefault(s.address.replace(" ", "").upper(), s)
+
+    def names(text: str) -> tuple[str, str]:
+        s = by_name.get(text)
+        if s is not None:
+            return f"{s.name}:{s.address}", f"{s.name} = {s.address}" + \
+                (f": {s.comment}" if s.comment else "")
+        s = by_addr.get(text.replace(" ", "").upper())
+        if s is not None:
+            return f"{s.name}:{text}", f"{s.name} = {s.address}" + \
+                (f": {s.comment}" if s.comment else "")
+        return text, ""
+
+    return names
+
+
+def _io_bits(plc: Plc) -> tuple[list[str], list[str]]:
+    """The input and output bits the program uses (by address or symbol),
+    in address order: the switches and lamps of the page."""
+    areas = plc.mem.areas
+    found: dict[str, set[tuple[int, int]]] = {"I": set(), "Q": set()}
+    seen: set[str] = set()
+    for p in plc.program.pous:
+        for n in p.networks:
+            for insn in n.insns:
+                for o in insn.operands:
+                    t = o.text
+                    if t in seen or not t or t[0] in "#*&\"'0123456789+-":
+                        continue
+                    seen.add(t)
+                    try:
+                        buf, off, width, bit, _ = plc.locate(t)
+                    except PlcError:
+                        continue
+                    if width == 0:
+                        for area in ("I", "Q"):
+                            if buf is areas[area]:
+                                found[area].add((off, bit))
+    ins = [f"I{o}.{b}" for o, b in sorted(found["I"])][:MAX_IO]
+    outs = [f"Q{o}.{b}" for o, b in sorted(found["Q"])][:MAX_IO]
+    return ins, outs
+
+
+def _plant(plc: Plc) -> Any:
+    return getattr(plc, "_config", {}).get("plant")
+
+
+def _axis_marks(plc: Plc) -> list[dict[str, Any]]:
+    """Each axis's reference switch, limits and Z marks from the plant."""
+    plant = _plant(plc)
+    out = []
+    for a in plc.axes():
+        marks: dict[str, Any] = {"slot": a.slot, "axis": a.axis}
+        mod = plant.modules.get(a.slot) if plant is not None else None
+        ap = mod.axes.get(a.axis) if mod is not None else None
+        if ap is not None:
+            marks.update(start=ap.start, rps=list(ap.rps) if ap.rps else None,
+                         limit_neg=ap.limit_neg, limit_pos=ap.limit_pos,
+                         z_period=ap.z_period, z_offset=ap.z_offset)
+        out.append(marks)
+    return out
+
+
+def _drive_marks(plc: Plc) -> list[dict[str, Any]]:
+    """Each drive's limits, home switch, index pulses and hard stops."""
+    plant = _plant(plc)
+    out = []
+    for d in plc.drives():
+        marks: dict[str, Any] = {"slot": d.slot, "node": d.node, "model": d.model}
+        mod = plant.modules.get(d.slot) if plant is not None else None
+        cfg = mod.drives.get(d.node) if mod is not None else None
+        if cfg is not None:
+            for k, v in cfg.plant.items():
+                if k in ("neg_limit", "pos_limit", "home_switch", "index_period",
+                         "index_phase", "neg_stop", "pos_stop", "start"):
+                    marks[k] = list(v) if isinstance(v, tuple) else v
+        out.append(marks)
+    return out
+
+
+__all__ = ["CHUNK_S", "Client", "DISPLAY_HZ", "Mailbox", "PanelSession", "TREND_MAX"]

@@ -1,0 +1,155 @@
+"""Fixtures of the panel's tests: sample programs, a panel server on a free
+loopback port in a thread, and a headless Chromium page.
+
+Browser tests skip when Debian's chromium (``/usr/bin/chromium`` or
+``$PLCRT_CHROMIUM``) or the playwright package is missing, unless
+``PLCRT_REQUIRE_BROWSER=1`` (CI), where they fail instead.  Nothing here
+uses a fixed port or a shared file, so the tests run under pytest-xdist.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import shutil
+import threading
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import plcrt
+
+PROGRAM = """\
+ORGANIZATION_BLOCK MAIN:OB1
+TITLE=Panel sample
+BEGIN
+Network 1 // Seal-in
+// start latches, stop wins
+LD     I0.0
+O      Q0.0
+AN     I0.1
+=      Q0.0
+Network 2 // Timer: 5 s after the motor starts
+LD     Q0.0
+TON    T37, 50
+Network 3 // Lamp after the timer
+LD     T37
+=      Q0.1
+Network 4 // Copy
+LD     SM0.0
+MOVW   VW0, VW2
+END_ORGANIZATION_BLOCK
+"""
+
+SYMBOLS = "Start_PB\tI0.0\tstart push button\nStop_PB\tI0.1\tstop push button\n" \
+          "Motor\tQ0.0\tmotor contactor\n"
+
+CHROME_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+               "--no-first-run", "--disable-background-networking",
+               "--disable-component-update", "--disable-sync"]
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def load_sample(text: str = PROGRAM, symbols: str | None = SYMBOLS, **kw: Any) -> plcrt.Plc:
+    return plcrt.load(text, symbols=symbols, instrument=True, **kw)
+
+
+class Served:
+    """A panel server running in a thread of its own."""
+
+    def __init__(self, panel: Any) -> None:
+        from aiohttp import web
+
+        from plcrt.web.server import make_app
+        self.panel = panel
+        self.loop = asyncio.new_event_loop()
+        self.ready = threading.Event()
+        self.port = 0
+
+        async def start() -> None:
+            self.runner = web.AppRunner(make_app(panel))
+            await self.runner.setup()
+            site = web.TCPSite(self.runner, "127.0.0.1", 0)
+            await site.start()
+            self.port = site._server.sockets[0].getsockname()[1]  # type: ignore[union-attr]
+
+        def run() -> None:
+            asyncio.set_event_loop(self.loop)
+            self.loop.run_until_complete(start())
+            self.ready.set()
+            self.loop.run_forever()
+
+        self.thread = threading.Thread(target=run, daemon=True)
+        self.thread.start()
+        assert self.ready.wait(20), "the panel server did not start"
+        panel.session.start()
+
+    @property
+    def url(self) -> str:
+        return f"http://127.0.0.1:{self.port}/"
+
+    def close(self) -> None:
+        self.panel.session.close()
+        fut = asyncio.run_coroutine_threadsafe(self.runner.cleanup(), self.loop)
+        try:
+            fut.result(10)
+        finally:
+            self.loop.call_soon_threadsafe(self.loop.stop)
+            self.thread.join(10)
+
+
+@pytest.fixture
+def serve() -> Iterator[Callable[..., Served]]:
+    """``serve(plc)`` or ``serve(panel=...)``: a running panel server."""
+    from plcrt.web.server import Panel
+    from plcrt.web.session import PanelSession
+    started: list[Served] = []
+
+    def make(plc: plcrt.Plc | None = None, *, panel: Any = None) -> Served:
+        if panel is None:
+            panel = Panel(PanelSession(plc if plc is not None else load_sample()))
+        s = Served(panel)
+        started.append(s)
+        return s
+
+    yield make
+    for s in started:
+        s.close()
+
+
+def _chromium() -> str | None:
+    path = os.environ.get("PLCRT_CHROMIUM") or "/usr/bin/chromium"
+    return path if shutil.which(path) or os.path.isfile(path) else None
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    required = os.environ.get("PLCRT_REQUIRE_BROWSER") == "1"
+    path = _chromium()
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        sync_playwright = None
+    if path is None or sync_playwright is None:
+        why = "chromium not found" if path is None else "playwright is not installed"
+        if required:
+            pytest.fail(f"PLCRT_REQUIRE_BROWSER=1 but {why}")
+        pytest.skip(why)
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=path, args=CHROME_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser: Any) -> Iterator[Any]:
+    ctx = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+    pg = ctx.new_page()
+    pg.errors = []
+    pg.on("pageerror", lambda e: pg.errors.append(str(e)))
+    pg.set_default_timeout(15000)
+    yield pg
+    ctx.close()

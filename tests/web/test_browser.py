@@ -1,0 +1,167 @@
+"""The panel in a real headless browser: buttons, lamps, coils, forcing,
+stepping, a timer counting, an axis moving, the course's check, and a
+screenshot compared with a stored reference."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from plcrt.web import course
+from plcrt.web.server import Panel
+from plcrt.web.session import PanelSession
+
+from .conftest import REPO, load_sample
+
+GOLDEN = Path(__file__).parent / "golden"
+
+
+def open_panel(page, served) -> None:
+    page.goto(served.url)
+    page.wait_for_selector("svg.rung")
+    page.wait_for_function("() => window.plcrtPanel.frame !== null")
+
+
+def frame(page) -> dict:
+    return page.evaluate("() => window.plcrtPanel.frame")
+
+
+def test_push_button_turns_on_the_coil_and_the_lamp(serve, page) -> None:
+    served = serve()
+    open_panel(page, served)
+    page.click("#run")
+    btn = page.locator('[data-input="I0.0"]')
+    assert "momentary" in btn.get_attribute("class")      # Start_PB: a push-button
+    btn.hover()
+    page.mouse.down()
+    page.wait_for_selector('[data-lamp="Q0.0"].on')
+    page.mouse.up()
+    page.wait_for_function("() => window.plcrtPanel.frame.io['I0.0'] === 0")
+    # sealed in: the lamp stays on, the coil of network 1 is drawn powered
+    assert "on" in page.locator('[data-lamp="Q0.0"]').get_attribute("class")
+    assert page.locator('[data-net="OB1/1"] path.co.on').count() == 1
+    assert page.locator('[data-net="OB1/1"] path.ct.on').count() >= 2
+    assert page.errors == []
+
+
+def test_keyboard_toggles_a_switch(serve, page) -> None:
+    served = serve()
+    open_panel(page, served)
+    page.locator('[data-input="I0.1"] + .name + span + .kind').click()   # push-button -> switch
+    page.evaluate("() => document.activeElement.blur()")
+    page.keyboard.press("2")                                            # the second input
+    page.wait_for_selector('[data-input="I0.1"].on')
+
+
+def test_force_a_value_and_step_one_scan(serve, page) -> None:
+    served = serve()
+    open_panel(page, served)
+    page.fill("#watch-spec", "VW0")
+    page.click('#watch-add button[type="submit"]')
+    row = page.locator('tr[data-watch="VW0"]')
+    row.locator("input").fill("7")
+    row.locator("button[title=force]").click()
+    page.wait_for_selector('tr[data-watch="VW0"].forced')
+    assert row.locator(".value").inner_text() == "7"
+    assert frame(page)["scans"] == 0
+    page.click("#step")
+    page.wait_for_function("() => window.plcrtPanel.frame.scans === 1")
+    # MOVW VW0, VW2 ran once: VW2's value is written beside the box
+    page.wait_for_function(
+        "() => [...document.querySelectorAll('[data-net=\"OB1/4\"] text.val')]"
+        ".some(t => t.textContent === '+7')")
+    # a click on an operand opens it in the watch table
+    page.locator('[data-net="OB1/4"] text[data-op="VW2"]').click()
+    page.wait_for_selector('tr[data-watch="VW2"]')
+    assert page.locator('tr[data-watch="VW2"] .value').inner_text() == "7"
+
+
+def test_timer_counts_in_run_until(serve, page) -> None:
+    served = serve()
+    open_panel(page, served)
+    page.select_option("#speed", "max")
+    page.fill("#watch-spec", "I0.0")
+    page.click('#watch-add button[type="submit"]')
+    row = page.locator('tr[data-watch="I0.0"]')
+    row.locator("input").fill("1")
+    row.locator("button[title=force]").click()
+    page.wait_for_selector('tr[data-watch="I0.0"].forced')
+    page.fill("#cond", "T37 >= 20")
+    page.click("#until")
+    page.wait_for_function("() => window.plcrtPanel.frame.scans > 0 && "
+                           "window.plcrtPanel.frame.run === 'stopped'")
+    f = frame(page)
+    assert f["t"] == pytest.approx(2.01, abs=0.011)
+    assert page.locator('[data-net="OB1/2"] text.val').first.text_content() == "+20"
+    assert "true" in page.locator("#log").inner_text()
+
+
+def test_axis_moves_to_its_target(serve, page) -> None:
+    les = course.lesson(REPO / "examples/course/05-jog-and-position")
+    plc = load_sample(les.program.read_text(), symbols=None, plant=les.plant)
+    served = serve(panel=Panel(PanelSession(plc)))
+    open_panel(page, served)
+    assert page.locator(".axis canvas.slide").count() == 1
+    page.select_option("#speed", "10")
+    page.click("#run")
+    page.locator('[data-input="I0.2"]').hover()
+    page.mouse.down()
+    page.wait_for_timeout(200)
+    page.mouse.up()
+    page.wait_for_function(
+        "() => { const a = window.plcrtPanel.frame.axes[0];"
+        " return a.position === 10000 && a.status === 'stopped'; }", timeout=30000)
+    page.wait_for_selector('.axis[data-position="10000"]')
+    assert "position 10000" in page.locator(".axis .info").inner_text()
+
+
+def test_lesson_text_and_check_my_program(serve, page) -> None:
+    les = course.lesson(REPO / "examples/course/01-seal-in")
+    plc = load_sample(les.program.read_text(), symbols=les.symbols.read_text())
+    panel = Panel(PanelSession(plc), lessons=course.lessons(les.dir.parent), current=les)
+    served = serve(panel=panel)
+    open_panel(page, served)
+    assert page.locator("#lesson-title").inner_text() == "Lesson 1: the seal-in circuit"
+    assert "seal" in page.locator("#lesson-text").inner_text()
+    assert page.locator("#lessons option").count() >= 6
+    page.click("#check")
+    page.wait_for_selector("#check-results li[data-test]", timeout=120000)
+    assert page.locator("#check-results li.passed[data-test]").count() == 5
+    assert "5 passed, 0 failed" in page.locator("#check-results").inner_text()
+
+
+def _image(path: Path) -> np.ndarray:
+    import matplotlib.image as mpimg
+    return mpimg.imread(str(path))[..., :3]
+
+
+def test_screenshot_matches_the_reference(serve, page) -> None:
+    """A fixed program after 3 scans with start pressed, stopped: the
+    ladder column compared with golden/ladder.png (mean absolute
+    difference and the share of differing pixels)."""
+    plc = load_sample()
+    plc.write("I0.0", 1)
+    served = serve(plc)
+    open_panel(page, served)
+    page.click("#stepn")   # 10 scans
+    page.wait_for_function("() => window.plcrtPanel.frame.scans === 10 && "
+                           "window.plcrtPanel.frame.run === 'stopped'")
+    page.wait_for_timeout(200)
+    out = GOLDEN.parent / f"_shot_{os.getpid()}.png"
+    try:
+        page.locator("#networks").screenshot(path=str(out), animations="disabled")
+        ref = GOLDEN / "ladder.png"
+        if os.environ.get("PLCRT_UPDATE_GOLDEN") == "1" or not ref.exists():
+            if os.environ.get("PLCRT_UPDATE_GOLDEN") != "1":
+                pytest.fail(f"{ref} is missing: run with PLCRT_UPDATE_GOLDEN=1")
+            ref.write_bytes(out.read_bytes())
+        a, b = _image(out), _image(ref)
+        assert a.shape == b.shape, f"size {a.shape} != reference {b.shape}"
+        diff = np.abs(a - b)
+        assert diff.mean() < 0.01
+        assert (diff.max(axis=2) > 0.1).mean() < 0.01
+    finally:
+        out.unlink(missing_ok=True)

@@ -1,0 +1,102 @@
+"""Rungs as SVG: the shapes drawn from the view model, the numbering that
+frames use, and escaping of program text."""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+
+import pytest
+
+import plcrt
+from plcrt.view.status import PlcStatus
+from plcrt.web.svg import esc, network_state, network_svg
+
+from .conftest import PROGRAM
+
+NS = "{http://www.w3.org/2000/svg}"
+
+
+def nets(text: str = PROGRAM, symbols: str | None = None):
+    plc = plcrt.load(text, symbols=symbols)
+    pou = plc.program.pous[0]
+    return plc, pou
+
+
+def test_seal_in_rung_has_three_contacts_a_parallel_branch_and_a_coil() -> None:
+    plc, pou = nets()
+    svg = network_svg(pou, pou.networks[0], program=plc.program)
+    root = ET.fromstring(svg)
+    assert root.tag == NS + "svg"
+    paths = root.findall(f".//{NS}path")
+    assert len([p for p in paths if p.get("class") == "ct"]) == 3      # I0.0, Q0.0, I0.1
+    assert len([p for p in paths if p.get("class") == "co"]) == 1      # the coil
+    assert len([p for p in paths if p.get("class") == "nc"]) == 1      # AN I0.1 is NC
+    ops = [t.get("data-op") for t in root.iter(NS + "text") if t.get("data-op")]
+    assert ops == ["I0.0", "Q0.0", "I0.1", "Q0.0"]
+
+
+def test_box_shows_title_pins_and_value_slots() -> None:
+    plc, pou = nets()
+    root = ET.fromstring(network_svg(pou, pou.networks[1], program=plc.program))
+    texts = ["".join(t.itertext()) for t in root.iter(NS + "text")]
+    assert "TON" in texts and "IN" in texts and "PT" in texts and "100 ms" in texts
+    assert len(root.findall(f".//*[@data-v]")) == 2      # T37 above, PT beside
+
+
+def test_state_numbers_match_the_drawing() -> None:
+    plc, pou = nets()
+    plc.write("I0.0", 1)
+    plc.scan()
+    for n in pou.networks:
+        svg = network_svg(pou, n, program=plc.program)
+        st = network_state(pou, n, PlcStatus(plc), program=plc.program)
+        ks = {int(k) for k in re.findall(r'data-k="(\d+)"', svg)}
+        vs = {int(k) for k in re.findall(r'data-v="(\d+)"', svg)}
+        assert ks == set(range(len(st.power))) or ks <= set(range(len(st.power)))
+        assert max(ks) == len(st.power) - 1
+        assert all(v < len(st.values) for v in vs)
+    first = network_state(pou, pou.networks[0], PlcStatus(plc), program=plc.program)
+    assert first.power[0] == "1" and first.power[-1] == "1"    # rail and coil powered
+    timer = network_state(pou, pou.networks[1], PlcStatus(plc), program=plc.program)
+    assert timer.values == ["", "+0", ""]    # T37 counts; a contact and a constant have none
+
+
+def test_without_status_everything_is_unknown() -> None:
+    plc, pou = nets()
+    st = network_state(pou, pou.networks[0], None, program=plc.program)
+    assert set(st.power) == {"?"}
+
+
+def test_a_network_without_lad_has_no_svg_but_a_state_per_operand() -> None:
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\nLPS\nA I0.1\n"
+            "= Q0.0\nEND_ORGANIZATION_BLOCK\n")
+    plc, pou = nets(text)
+    assert network_svg(pou, pou.networks[0], program=plc.program) is None
+    st = network_state(pou, pou.networks[0], PlcStatus(plc), program=plc.program)
+    assert st.values == ["0", "0", "0"]
+
+
+@pytest.mark.parametrize("text", ['<script>alert(1)</script>', '"><img src=x onerror=alert(1)>',
+                                  "a'b&c", "\x1b[2J\u202e"])
+def test_esc_leaves_no_markup_and_no_control_characters(text: str) -> None:
+    out = esc(text)
+    assert "<" not in out and ">" not in out and '"' not in out and "'" not in out
+    assert "\x1b" not in out and "\u202e" not in out
+    ET.fromstring(f'<t a="{out}">{out}</t>')      # well-formed as attribute and text
+
+
+def test_hostile_symbols_and_comments_stay_text_in_the_svg() -> None:
+    from plcrt.web.session import _symbol_names
+    symbols = 'Evil\tI0.0\t"><svg onload=alert(1)><script>x()</script>\n'
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD Evil\n"
+            "= Q0.0\nEND_ORGANIZATION_BLOCK\n")
+    plc, pou = nets(text, symbols)
+    svg = network_svg(pou, pou.networks[0], program=plc.program,
+                      names=_symbol_names(plc.symbols))
+    root = ET.fromstring(svg)
+    tags = {e.tag.removeprefix(NS) for e in root.iter()}
+    assert tags <= {"svg", "g", "line", "path", "rect", "text", "title"}
+    assert all(not a.startswith("on") for e in root.iter() for a in e.attrib)
+    tips = ["".join(t.itertext()) for t in root.iter(NS + "title")]
+    assert any("<script>x()</script>" in t for t in tips)      # shown as text

@@ -2,20 +2,22 @@
 
 Run ``python bench/panel.py`` (``--json`` for one JSON object).  It loads
 the generated boolean program of ``bench/run.py`` (about 1000
-instructions) at 1 ms scans, with the network probes the panel loads for
-breakpoints, serves it with ``plcrt serve``'s application on a free
+instructions) at 1 ms scans as ``plcrt serve`` loads it (no network
+probes until a breakpoint is set; the native backend where llvmlite is
+installed), serves it with ``plcrt serve``'s application on a free
 loopback port, connects 5 websocket clients that each read every frame
 they are sent (each viewing networks 1-10 of OB1, a screenful, as a page
 does), , puts the PLC in "as fast as possible" mode and measures
 simulated seconds per wall second over a fixed wall-clock window.  The
 frames each client received are reported too (the display rate, not the
-scan rate).
+scan rate), and the same PLC's speed without a panel, measured in the same
+run, so the ratio of the two is the panel's cost.
 
 A measuring tool: it asserts nothing and never fails on slow results
 unless ``--check`` is given (exit 1 below the target of 50 x real time).
-``--no-probes`` loads as ``plcrt serve --no-breakpoints`` does and
-``--backend native`` uses the native code generator (which covers a
-program without probes only).
+``--probes`` runs in the build with probes (as while a breakpoint is set
+in a network the scan does not reach) and ``--backend`` chooses the code
+generator.
 All traffic stays on 127.0.0.1 and the run stops by itself.
 """
 
@@ -62,10 +64,30 @@ async def _client(url: str, counts: list[int], i: int, stop: asyncio.Event) -> N
                     counts[i] += 1
 
 
-async def measure(seconds: float, clients: int, scan_ms: float, *, probes: bool = True,
+def default_backend() -> str:
+    """The backend ``plcrt serve`` chooses (plcrt.web.cli)."""
+    from plcrt.compiler.native.jit import available
+    return "native" if available() else "python"
+
+
+def alone(plc: plcrt.Plc, seconds: float) -> float:
+    """Simulated seconds per wall second of ``plc`` on its own (a fork)."""
+    twin = plc.fork()
+    n, t0 = 1, time.perf_counter()
+    while True:
+        twin.scan(n)
+        wall = time.perf_counter() - t0
+        if wall >= seconds:
+            return twin.time / wall
+        n *= 2
+
+
+async def measure(seconds: float, clients: int, scan_ms: float, *, probes: bool = False,
                   backend: str | None = None) -> dict[str, Any]:
     text = bool_program()
-    plc = plcrt.load(text, scan_ms=scan_ms, instrument=probes, backend=backend)
+    plc = plcrt.load(text, scan_ms=scan_ms, instrument=probes,
+                     backend=backend or default_backend())
+    x_alone = alone(plc, min(seconds, 2.0))
     session = PanelSession(plc)
     panel = Panel(session)
     runner = web.AppRunner(make_app(panel))
@@ -83,9 +105,9 @@ async def measure(seconds: float, clients: int, scan_ms: float, *, probes: bool 
         session.submit(None, {"type": "speed", "mode": "max"})
         session.submit(None, {"type": "run"})
         await asyncio.sleep(0.5)   # the chunk size settles
-        t0, s0, c0 = time.perf_counter(), plc.now_us, list(counts)
+        t0, s0, c0 = time.perf_counter(), session.plc.now_us, list(counts)
         await asyncio.sleep(seconds)
-        t1, s1 = time.perf_counter(), plc.now_us
+        t1, s1 = time.perf_counter(), session.plc.now_us
         frames = [c - b for c, b in zip(counts, c0)]
     finally:
         stop.set()
@@ -98,7 +120,8 @@ async def measure(seconds: float, clients: int, scan_ms: float, *, probes: bool 
     return {"program_insns": plc.program.instruction_count(), "scan_ms": scan_ms,
             "probes": probes, "backend": plc.backend["name"],
             "clients": clients, "wall_s": round(wall, 3), "simulated_s": round(sim, 3),
-            "x_real_time": round(sim / wall, 1), "us_per_scan": round(wall / sim * scan_ms * 1e3, 2)
+            "x_real_time": round(sim / wall, 1), "x_alone": round(x_alone, 1),
+            "us_per_scan": round(wall / sim * scan_ms * 1e3, 2)
             if sim else None, "frames_per_client_per_s": [round(f / wall, 1) for f in frames],
             "target_x": TARGET_X, "machine": machine()}
 
@@ -108,14 +131,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seconds", type=float, default=5.0, help="wall seconds measured")
     ap.add_argument("--clients", type=int, default=CLIENTS)
     ap.add_argument("--scan-ms", type=float, default=1.0)
-    ap.add_argument("--no-probes", action="store_true",
-                    help="load as plcrt serve --no-breakpoints does (no network probes)")
+    ap.add_argument("--probes", action="store_true",
+                    help="run in the build with network probes (as while a breakpoint is set)")
     ap.add_argument("--backend", choices=("python", "native"), default=None)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--check", action="store_true", help=f"exit 1 below {TARGET_X:g} x")
     args = ap.parse_args(argv)
     r = asyncio.run(measure(args.seconds, args.clients, args.scan_ms,
-                            probes=not args.no_probes, backend=args.backend))
+                            probes=args.probes, backend=args.backend))
     if args.json:
         print(json.dumps(r))
     else:
@@ -125,6 +148,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  {r['x_real_time']:g} x real time ({r['simulated_s']:g} simulated s in "
               f"{r['wall_s']:g} wall s, {r['us_per_scan']} us per scan); target "
               f"{TARGET_X:g} x")
+        print(f"  the same PLC without a panel: {r['x_alone']:g} x real time")
         print(f"  frames per client per second: {r['frames_per_client_per_s']}")
     return 1 if args.check and r["x_real_time"] < TARGET_X else 0
 

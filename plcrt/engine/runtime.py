@@ -858,7 +858,32 @@ class Plc(AddressAccess):
                                  "restore it into a PLC loaded the same way")
         snapshot._copy_state(self)
 
-    def _copy_state(self, dst: Plc) -> None:
+    def recompiled(self, *, instrument: bool | None = None,
+                   backend: str | None = None) -> Plc:
+        """This PLC's program compiled with other probes or another code
+        generator, in exactly this PLC's state (memory, timers, counters,
+        edges, library blocks, devices, time, forces), as :meth:`fork` gives
+        a twin compiled the same way.  The coverage counts start empty.
+
+        A tool that shows breakpoints only now and then runs the fast
+        build (no probes, the native backend) and moves to an instrumented
+        one while a breakpoint is set, without losing a scan.
+
+        Raises:
+            PlcConfigError: a bad ``backend``, or ``native`` without llvmlite.
+        """
+        cfg = dict(self._config)
+        if instrument is not None:
+            cfg["instrument"] = bool(instrument)
+        if backend is not None:
+            cfg["backend"] = check_backend(backend)
+        if cfg == self._config:
+            return self.fork()
+        twin = Plc(self.program, **cfg)
+        self._copy_state(twin, across=True)
+        return twin
+
+    def _copy_state(self, dst: Plc, across: bool = False) -> None:
         """Make ``dst`` (the same program, compiled the same way) equal to self.
 
         Everything stateful is either a memory buffer (copied in place) or a
@@ -884,8 +909,9 @@ class Plc(AddressAccess):
                                         *zip(self.ports, dst.ports),
                                         (self.ethernet, dst.ethernet)]
         pairs += list(zip(self.devices, dst.devices))
-        for name, obj in self._bindings.items():
-            other = dst._bindings.get(name)
+        for name, obj, other in (_binding_pairs(self, dst) if across else
+                                 ((n, o, dst._bindings.get(n))
+                                  for n, o in self._bindings.items())):
             if other is None or type(other) is not type(obj):
                 raise PlcConfigError("internal error: the twin was compiled differently")
             if isinstance(obj, bytearray):
@@ -942,6 +968,41 @@ class Plc(AddressAccess):
         dst._force_slots = []
         for key, value in self.forces.items():
             dst.force(key, value)
+
+
+def _binding_pairs(src: Plc, dst: Plc) -> list[tuple[str, Any, Any]]:
+    """(name, object, twin's object) for every stateful binding of ``src``,
+    matched with ``dst``, a build of the same program with other probes or
+    another backend.
+
+    Names are numbered in the order the code generator bound its objects,
+    and probes take numbers of their own, so the k-th binding of a kind
+    (``_EM``, ``_blk``, ...) in one build is the k-th of that kind in the
+    other.  The probes' own buffers and methods have no twin: skipped.
+    """
+    def stateful(plc: Plc) -> dict[str, list[tuple[int, str, Any]]]:
+        cov = plc.coverage
+        own = () if cov is None else (cov.hits, cov.power, cov.closed, cov.breakpoints)
+        kinds: dict[str, list[tuple[int, str, Any]]] = {}
+        for name, obj in plc._bindings.items():
+            if isinstance(obj, (types.FunctionType, types.MethodType,
+                                types.BuiltinFunctionType)) or any(obj is b for b in own):
+                continue
+            kind = name.rstrip("0123456789")
+            kinds.setdefault(kind, []).append((int(name[len(kind):] or 0), name, obj))
+        return kinds
+
+    mine, theirs = stateful(src), stateful(dst)
+    pairs = []
+    for kind, objs in mine.items():
+        others = sorted(theirs.get(kind, []))
+        if len(others) != len(objs):
+            raise PlcConfigError("internal error: the two builds bind different state")
+        for (_, name, obj), (_, _, other) in zip(sorted(objs), others):
+            if getattr(obj, "loc", None) != getattr(other, "loc", None):
+                raise PlcConfigError("internal error: the two builds bind different state")
+            pairs.append((name, obj, other))
+    return pairs
 
 
 #: SMB0 of every scan but the first, by the scan count's parity: SM0.0

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import ipaddress
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -35,8 +36,8 @@ def register(sub: Any) -> None:
                    help="address to listen on (default 127.0.0.1, this machine only)")
     p.add_argument("--open", action="store_true", help="open the page in a web browser")
     p.add_argument("--no-breakpoints", action="store_true",
-                   help="load without the network probes that breakpoints need: scans run "
-                        "faster, and --backend native covers the whole program")
+                   help="no breakpoints (scans never move to the build with network probes "
+                        "that a breakpoint needs)")
     p.set_defaults(func=cmd_serve)
 
 
@@ -52,27 +53,33 @@ def build_panel(args: argparse.Namespace) -> Any:
     from .server import Panel
     from .session import PanelSession
 
+    if getattr(args, "backend", None) is None and not os.environ.get("PLCRT_BACKEND"):
+        # scans run without probes until a breakpoint is set: the native
+        # backend where llvmlite is installed (docs/panel.md, "Speed")
+        from ..compiler.native.jit import available
+        args.backend = "native" if available() else None
+
     def load_lesson(les: course.Lesson) -> PanelSession:
         ns = argparse.Namespace(**vars(args))
         ns.programs = [str(les.program)]
         ns.symbols = str(les.symbols) if les.symbols else args.symbols
         ns.plant = str(les.plant) if les.plant else args.plant
-        plc = load_from_args(ns, args.scan_ms, instrument=not args.no_breakpoints)
+        plc = load_from_args(ns, args.scan_ms)
         print_diagnostics(plc.diagnostics)
-        return PanelSession(plc)
+        return PanelSession(plc, breakpoints=not args.no_breakpoints)
 
     first = Path(args.programs[0])
     if len(args.programs) == 1 and first.is_dir():
         les = course.lesson(first)
         return Panel(load_lesson(les), lessons=course.lessons(first.parent), current=les,
                      load_lesson=load_lesson)
-    plc = load_from_args(args, args.scan_ms, instrument=not args.no_breakpoints)
+    plc = load_from_args(args, args.scan_ms)
     print_diagnostics(plc.diagnostics)
     current = None
     if course.is_lesson(first.parent) and first.name == "lesson.awl":
         current = course.lesson(first.parent)
     lessons = course.lessons(first.parent.parent) if current else []
-    return Panel(PanelSession(plc), lessons=lessons, current=current,
+    return Panel(PanelSession(plc, breakpoints=not args.no_breakpoints), lessons=lessons, current=current,
                  load_lesson=load_lesson if current else None)
 
 

@@ -137,19 +137,33 @@ class PanelSession:
     """The panel's PLC and everything the page can ask of it.
 
     Args:
-        plc: the loaded PLC; breakpoints need ``instrument=True``.
+        plc: the loaded PLC, best without probes (it may use the native
+            backend): the session moves to a build with probes while a
+            breakpoint is set and back when the last one is cleared
+            (:meth:`plcrt.Plc.recompiled`), so breakpoints cost nothing until
+            they are used.  A PLC loaded with ``instrument=True`` keeps its
+            probes.
+        breakpoints: whether breakpoints may be set (default: yes).
         display_hz: frames per wall second.
         clock, sleep: the wall clock (tests pass their own).
     """
 
-    def __init__(self, plc: Plc, *, display_hz: float = DISPLAY_HZ,
+    def __init__(self, plc: Plc, *, breakpoints: bool = True,
+                 display_hz: float = DISPLAY_HZ,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
         self.plc = plc
         self.harness = Harness(plc)
         self.display_hz = display_hz
         self.clock, self.sleep = clock, sleep
-        self.power_up = plc.snapshot()
+        #: breakpoints may be set (in the build with probes)
+        self.breakable = breakpoints or plc.coverage is not None
+        #: the build scans run in when no breakpoint is set: with or without
+        #: probes, and its backend
+        self._home = (plc.coverage is not None, plc.backend["name"])
+        #: the state at power-up in each build (with probes: True), for reset
+        self._power_ups: dict[bool, Plc] = {self._home[0]: plc.snapshot()}
+        self._until_cond = ""
         self.clients: dict[int, Client] = {}
         self._lock = threading.Lock()
         self._queue: queue.SimpleQueue[tuple[Client | None, dict[str, Any]]] = \
@@ -248,7 +262,7 @@ class PanelSession:
                 "inputs": [io(a) for a in self.inputs],
                 "outputs": [io(a) for a in self.outputs],
                 "scan_ms": plc.scan_us / 1000, "axes": _axis_marks(plc),
-                "drives": _drive_marks(plc), "breakable": plc.coverage is not None}
+                "drives": _drive_marks(plc), "breakable": self.breakable}
 
     # ------------------------------------------------------------------
     # The runner thread
@@ -283,6 +297,8 @@ class PanelSession:
         self._drain(block=wait and not busy, timeout=1 / self.display_hz)
         if self._closed:
             return
+        if not self.breaks and self.state != "paused":
+            self._use_build(probes=self._home[0])
         if self.state == "running" or self._left is not None or self._until is not None:
             self._run_chunk()
         self._maybe_frame()
@@ -365,6 +381,7 @@ class PanelSession:
         timeout = msg.get("timeout", UNTIL_TIMEOUT)
         self._left = None
         self._until = (pred, what, self.plc.now_us + round(timeout * 1e6))
+        self._until_cond = msg["cond"]
         self._go("until")
 
     def _go(self, state: str) -> None:
@@ -391,7 +408,7 @@ class PanelSession:
         """Power-up: the state right after loading.  Forces, breakpoints,
         watches and trend signals stay (as a force stays in the CPU)."""
         forces = dict(self.plc.forces)
-        self.plc.restore(self.power_up)
+        self.plc.restore(self._power_up())
         for k, v in forces.items():
             self.plc.force(k, v)
         self._stop_after_scan = False
@@ -458,9 +475,11 @@ class PanelSession:
 
     def _network(self, text: str) -> NetworkRef:
         import re
+        if not self.breakable:
+            raise PlcConfigError("breakpoints are off (plcrt serve --no-breakpoints)")
+        self._use_build(probes=True)
         cov = self.plc.coverage
-        if cov is None:
-            raise PlcConfigError("breakpoints need the program loaded with network probes")
+        assert cov is not None
         m = re.fullmatch(r"(?:([^/\s]+)\s*/\s*)?(\d+)", text.strip())
         if m is None:
             raise PlcConfigError(f"'{text}' is not a network: write OB1/3, SBR0/1 or 3")
@@ -477,6 +496,8 @@ class PanelSession:
         self._apply_breaks()
 
     def _do_unbreak(self, client: Client | None, msg: dict[str, Any]) -> None:
+        if not self.breaks:
+            return
         self.breaks.discard(self._network(msg["network"]).index)
         self._apply_breaks()
 
@@ -642,6 +663,40 @@ class PanelSession:
     # ------------------------------------------------------------------
     # Breakpoints (inside a scan)
     # ------------------------------------------------------------------
+    def _use_build(self, probes: bool) -> None:
+        """Scan from now on in the build with (or without) network probes,
+        in exactly the state of the one in use: between scans only (never
+        while paused inside one).  Watches, the trend, a running ``until``
+        and the power-up state follow."""
+        old = self.plc
+        if (old.coverage is not None) == probes:
+            return
+        backend = self._home[1] if probes == self._home[0] else "python"
+        new = old.recompiled(instrument=probes, backend=backend)
+        new.observers[:] = old.observers
+        self.plc = new
+        self.harness = Harness(new)
+        for w in self.watches:
+            w.read, w.width = self._watch_reader(w.spec, w.format)
+        self.trend.readers = [reader(new, s) for s in self.trend.signals]
+        if self._until is not None:
+            pred, what = condition(self.harness, self._until_cond)
+            self._until = (pred, what, self._until[2])
+        if new.coverage is not None:
+            new.coverage.on_break = self._on_break
+        self._apply_breaks()
+
+    def _power_up(self) -> Plc:
+        """The power-up state in the build in use."""
+        probes = self.plc.coverage is not None
+        snap = self._power_ups.get(probes)
+        if snap is None:
+            home = self._power_ups[self._home[0]]
+            backend = self._home[1] if probes == self._home[0] else "python"
+            snap = self._power_ups[probes] = home.recompiled(instrument=probes,
+                                                             backend=backend)
+        return snap
+
     def _on_break(self, net: NetworkRef) -> None:
         """Called by the program's code before a network with a breakpoint;
         must never raise (it would fault the PLC)."""

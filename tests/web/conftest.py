@@ -54,7 +54,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def load_sample(text: str = PROGRAM, symbols: str | None = SYMBOLS, **kw: Any) -> plcrt.Plc:
-    return plcrt.load(text, symbols=symbols, instrument=True, **kw)
+    return plcrt.load(text, symbols=symbols, **kw)
 
 
 class Served:

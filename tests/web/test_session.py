@@ -235,3 +235,56 @@ def test_a_fault_stops_the_run_with_a_notice() -> None:
     notes = [m for m in c.mailbox.take() if m["type"] == "notice"]
     assert notes and notes[0]["level"] == "error"
     assert s.frame()["mode"] == "STOP (fault)"
+
+
+def _state(s: PanelSession) -> tuple:
+    return s.plc.scans, s.plc.now_us, {k: bytes(v) for k, v in s.plc.mem.areas.items()}
+
+
+def test_breakpoints_cost_nothing_until_set_then_the_scan_moves_builds() -> None:
+    """A session starts in the build without probes; the first breakpoint
+    moves it, in exactly its state, to the build with probes; clearing the
+    last one moves it back at the next round.  Watches, the trend and the
+    forces go along: the run ends exactly as in a session that never
+    moved."""
+    def drive(s: PanelSession, breaks: bool) -> None:
+        s.apply({"type": "watch", "spec": "T37"})
+        s.apply({"type": "trend", "signals": ["T37", "Q0.0"]})
+        s.apply({"type": "force", "addr": "I0.0", "value": "1"})
+        s.apply({"type": "step", "scans": 70})
+        finish(s)
+        if breaks:
+            before = _state(s)
+            s.apply({"type": "break", "network": "OB1/4"})
+            assert s.plc.coverage is not None and _state(s) == before
+            assert s.frame()["breaks"] == ["OB1/4"]
+            s.apply({"type": "unbreak", "network": "OB1/4"})
+        s.apply({"type": "step", "scans": 130})
+        finish(s)
+
+    s, ref = session(), session()
+    assert s.plc.coverage is None and s.hello()["breakable"]
+    drive(s, True)
+    drive(ref, False)
+    assert s.plc.coverage is None                     # back without probes
+    assert s.plc.forces == {"I0.0": 1}
+    assert _state(s) == _state(ref) and s.plc.read("T37") == 19   # 1.9 s of 100 ms ticks
+    assert s._watch_row(s.watches[0]) == ref._watch_row(ref.watches[0])
+    assert s._trend_message() == ref._trend_message()
+
+
+def test_reset_in_the_probe_build_is_power_up() -> None:
+    s = session()
+    s.apply({"type": "step", "scans": 4})
+    finish(s)
+    s.apply({"type": "break", "network": "OB1/2"})
+    s.apply({"type": "reset"})
+    assert s.plc.coverage is not None and s.plc.scans == 0 and s.plc.time == 0
+    assert s.frame()["breaks"] == ["OB1/2"]
+
+
+def test_no_breakpoints_refuses_a_break() -> None:
+    s = PanelSession(load_sample(), breakpoints=False)
+    s.apply({"type": "break", "network": "OB1/2"})
+    assert "breakpoints are off" in s.last_error["message"]
+    assert s.plc.coverage is None and not s.hello()["breakable"]

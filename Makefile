@@ -1,11 +1,12 @@
 # Two commands on a fresh machine (python3 + make):
 #   make demo   set up a virtualenv and run a sample program
 #   make test   set up a virtualenv and run the test suite
+#   make panel  set up a virtualenv and serve the course in the browser panel
 PYTHON ?= python3
 VENV   ?= .venv
 BIN     = $(VENV)/bin
 
-.PHONY: demo test bench setup clean
+.PHONY: demo test bench panel setup clean
 
 # pip -qq: only errors, so that `make demo` starts with the demo
 $(BIN)/.installed: pyproject.toml
@@ -33,6 +34,11 @@ demo: setup
 
 test: setup
 	$(BIN)/python -m pytest -q -n auto
+
+# the browser panel on http://127.0.0.1:8253/ (PROGRAM=... serves another program)
+PROGRAM ?= examples/course/01-seal-in
+panel: setup
+	$(BIN)/plcrt serve $(PROGRAM)
 
 bench: setup
 	$(BIN)/python bench/run.py

@@ -36,6 +36,8 @@ from ..view.status import Power, Status, and3, contact_state, eno_power, modifie
 #: width of one character of the 12 px monospace labels
 CH = 7.3
 ROW = 20
+#: the pitch of a box's operand pins: an operand and its live value below it
+PIN_ROW = 26
 
 
 def esc(text: str) -> str:
@@ -237,7 +239,7 @@ class _Walk:
         if not names:
             first, prow = top + ROW, []
         pins0 = (prow[-1] + ROW) if prow else first + ROW
-        note = pins0 + max(len(lefts), len(rights)) * ROW
+        note = pins0 + max(len(lefts), len(rights)) * PIN_ROW
         bottom = note + (ROW if box.note else 0)
         h = bottom + 8
         L, R = lm, lm + inner
@@ -266,13 +268,13 @@ class _Walk:
             if box.next is not None:
                 f.parts.append(self.line(ke, R, prow[0], R + rm, prow[0]))
         for i, pin in enumerate(lefts):
-            r = pins0 + i * ROW
+            r = pins0 + i * PIN_ROW
             f.parts.append(f'<line class="pl" x1="{L - 8:g}" y1="{r:g}" x2="{L:g}" y2="{r:g}"/>')
             f.parts.append(f'<text class="pin" x="{L + 4:g}" y="{r + 4:g}">{esc(pin.name)}</text>')
             f.parts.append(self.label(pin.operand, L - 10, r - 1, "end"))
             f.parts.append(self.value(self.v(pin.operand, pin.kind), L - 10, r + 10, "end"))
         for i, pin in enumerate(rights):
-            r = pins0 + i * ROW
+            r = pins0 + i * PIN_ROW
             f.parts.append(f'<line class="pl" x1="{R:g}" y1="{r:g}" x2="{R + 8:g}" y2="{r:g}"/>')
             f.parts.append(f'<text class="pin" x="{R - 4:g}" y="{r + 4:g}" '
                            f'text-anchor="end">{esc(pin.name)}</text>')

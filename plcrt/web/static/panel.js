@@ -546,8 +546,19 @@ function onCheck(m) {
   $("check-output").hidden = m.ok;
 }
 
+// Inline Markdown as plain text: links keep their words, emphasis and
+// code marks go.
+function inline(text) {
+  return text.replace(/\[([^\]]*)\]\([^)]*\)/g, "$1").replace(/\*\*|`/g, "");
+}
+
+// A table's cells: | a | b | -> ["a", "b"].
+function cells(line) {
+  return line.trim().replace(/^\|/, "").replace(/\|$/, "").split("|").map(c => inline(c.trim()));
+}
+
 // A small Markdown reader: headings, paragraphs, lists, code blocks and
-// tables as text.  Every piece of the lesson goes in with textContent.
+// tables.  Every piece of the lesson goes in with textContent.
 function markdown(text) {
   const out = document.createDocumentFragment();
   const lines = text.split("\n");
@@ -563,18 +574,31 @@ function markdown(text) {
       const code = [];
       for (i++; i < lines.length && !lines[i].startsWith("```"); i++) code.push(lines[i]);
       out.append(el("pre", {}, code.join("\n")));
+    } else if (/^\s*\|/.test(line) && i + 1 < lines.length && /^\s*\|[\s:|-]+\|\s*$/.test(lines[i + 1])) {
+      flush();
+      const table = el("table", { class: "md" });
+      const head = el("tr");
+      for (const c of cells(line)) head.append(el("th", {}, c));
+      table.append(head);
+      for (i += 2; i < lines.length && /^\s*\|/.test(lines[i]); i++) {
+        const tr = el("tr");
+        for (const c of cells(lines[i])) tr.append(el("td", {}, c));
+        table.append(tr);
+      }
+      i--;
+      out.append(table);
     } else if (/^#{1,6} /.test(line)) {
       flush(); out.append(el("h3", {}, line.replace(/^#+ /, "")));
     } else if (/^\s*([*-]|\d+\.) /.test(line)) {
       if (para.length) { out.append(el("p", {}, para.join(" "))); para = []; }
       if (!list) { list = el("ul"); out.append(list); }
-      list.append(el("li", {}, line.replace(/^\s*([*-]|\d+\.) /, "")));
+      list.append(el("li", {}, inline(line.replace(/^\s*([*-]|\d+\.) /, ""))));
     } else if (!line.trim() || line.startsWith("<!--")) {
       flush();
     } else if (list && /^\s+/.test(line)) {
       list.lastChild.textContent += " " + line.trim();
     } else {
-      para.push(line.trim().replace(/\*\*|`/g, ""));
+      para.push(inline(line.trim()));
     }
   }
   flush();

@@ -79,8 +79,8 @@ def build_panel(args: argparse.Namespace) -> Any:
     if course.is_lesson(first.parent) and first.name == "lesson.awl":
         current = course.lesson(first.parent)
     lessons = course.lessons(first.parent.parent) if current else []
-    return Panel(PanelSession(plc, breakpoints=not args.no_breakpoints), lessons=lessons, current=current,
-                 load_lesson=load_lesson if current else None)
+    return Panel(PanelSession(plc, breakpoints=not args.no_breakpoints), lessons=lessons,
+                 current=current, load_lesson=load_lesson if current else None)
 
 
 def _loopback(host: str) -> bool:

@@ -84,7 +84,8 @@ def test_open_hands_the_address_to_the_browser(tmp_path) -> None:
     """--open starts the user's browser ($BROWSER here: a script that
     writes down the address it is given)."""
     got = tmp_path / "url.txt"
-    browser = f"{sys.executable} -c \"import sys; open(sys.argv[2], 'w').write(sys.argv[1])\" %s {got}"
+    script = "import sys; open(sys.argv[2], 'w').write(sys.argv[1])"
+    browser = f'{sys.executable} -c "{script}" %s {got}'
     proc = _start(str(LESSON), "--port", "0", "--open", BROWSER=browser)
     try:
         url = _address(proc)

@@ -49,6 +49,8 @@ from ..safetext import printable
 from ..testing.harness import Harness, condition, reader
 from ..view.ladder import Ladder, to_ladder
 from ..view.status import PlcStatus
+from .mailbox import Client, Mailbox
+from .present import axis_marks, drive_marks, format_value, io_bits, symbol_names
 from .protocol import finite
 from .svg import network_state, network_svg, stl_lines
 
@@ -62,57 +64,8 @@ TREND_MAX = 20000
 TREND_TAIL = 2000
 #: real time that may be lost before the pacing starts again from now
 MAX_LAG_S = 0.5
-#: the most inputs and outputs shown as switches and lamps
-MAX_IO = 64
 #: default timeout of ``until`` (simulated seconds)
 UNTIL_TIMEOUT = 10.0
-
-
-class Mailbox:
-    """One client's inbox: a one-slot frame (a newer frame replaces an
-    unread one) and a short queue of messages (errors, notices).
-
-    ``notify`` is called (from any thread) when something arrives; the
-    server wakes its sender task with it."""
-
-    def __init__(self, notify: Callable[[], None] | None = None) -> None:
-        self._lock = threading.Lock()
-        self._frame: dict[str, Any] | None = None
-        self._messages: deque[dict[str, Any]] = deque(maxlen=100)
-        self.notify = notify or (lambda: None)
-        self.skipped = 0        #: frames replaced before they were read
-
-    def put_frame(self, frame: dict[str, Any]) -> None:
-        with self._lock:
-            if self._frame is not None:
-                self.skipped += 1
-            self._frame = frame
-        self.notify()
-
-    def put(self, message: dict[str, Any]) -> None:
-        with self._lock:
-            self._messages.append(message)
-        self.notify()
-
-    def take(self) -> list[dict[str, Any]]:
-        """Everything waiting: the messages in order, then the frame."""
-        with self._lock:
-            out = list(self._messages)
-            self._messages.clear()
-            if self._frame is not None:
-                out.append(self._frame)
-                self._frame = None
-        return out
-
-
-@dataclass
-class Client:
-    """One connected page."""
-
-    mailbox: Mailbox
-    view: str = "OB1"       #: the block whose networks it shows
-    #: the networks on its screen ("OB1/3"), None: every network of the block
-    nets: frozenset[str] | None = None
 
 
 @dataclass
@@ -196,8 +149,8 @@ class PanelSession:
         self._blocks = {p.ident.upper(): p.ident for p in prog.pous}
         for p in prog.pous:
             self._blocks.setdefault(p.name.upper(), p.ident)
-        self._names = _symbol_names(plc.symbols)
-        self.inputs, self.outputs = _io_bits(plc)
+        self._names = symbol_names(plc.symbols)
+        self.inputs, self.outputs = io_bits(plc)
         if plc.coverage is not None:
             plc.coverage.on_break = self._on_break
         self._hello: dict[str, Any] | None = None
@@ -261,8 +214,8 @@ class PanelSession:
                 "blocks": blocks, "symbols": symbols,
                 "inputs": [io(a) for a in self.inputs],
                 "outputs": [io(a) for a in self.outputs],
-                "scan_ms": plc.scan_us / 1000, "axes": _axis_marks(plc),
-                "drives": _drive_marks(plc), "breakable": self.breakable}
+                "scan_ms": plc.scan_us / 1000, "axes": axis_marks(plc),
+                "drives": drive_marks(plc), "breakable": self.breakable}
 
     # ------------------------------------------------------------------
     # The runner thread
@@ -798,7 +751,7 @@ class PanelSession:
     def _watch_row(self, w: _Watch) -> dict[str, Any]:
         try:
             v = w.read()
-            text = _format(v, w.format, w.width)
+            text = format_value(v, w.format, w.width)
         except PlcError as e:
             text = f"error: {e.message}"
         return {"spec": w.spec, "format": w.format, "value": text,
@@ -823,110 +776,6 @@ class PanelSession:
             elif off < foff + max(fwidth, 1) and foff < off + max(width, 1):
                 return True
         return False
-
-
-# ---------------------------------------------------------------------------
-# Helpers
-# ---------------------------------------------------------------------------
-
-def _format(v: Any, fmt: str, width: int) -> str:
-    """A watch value in its format: bits 0/1, INT/DINT signed, REAL to 7
-    digits, hex as Micro/WIN writes it (16#00FF)."""
-    if isinstance(v, bool):
-        v = int(v)
-    if isinstance(v, float):
-        import math
-        return f"{v:.7g}" if math.isfinite(v) else str(finite(v))
-    if fmt == "hex":
-        digits = max(2, 2 * (width or 1))
-        return f"16#{int(v) & ((1 << (4 * digits)) - 1):0{digits}X}"
-    return str(v)
-
-
-def _symbol_names(table: Any) -> Callable[[str], tuple[str, str]]:
-    """operand text -> (text shown, tooltip): ``name:address`` and the
-    symbol's comment when a symbol is involved."""
-    by_name: dict[str, Any] = dict(getattr(table, "entries", {}) or {})
-    by_addr: dict[str, Any] = {}
-    for s in by_name.values():
-        by_addr.setdefault(s.address.replace(" ", "").upper(), s)
-
-    def names(text: str) -> tuple[str, str]:
-        s = by_name.get(text)
-        if s is not None:
-            return f"{s.name}:{s.address}", f"{s.name} = {s.address}" + \
-                (f": {s.comment}" if s.comment else "")
-        s = by_addr.get(text.replace(" ", "").upper())
-        if s is not None:
-            return f"{s.name}:{text}", f"{s.name} = {s.address}" + \
-                (f": {s.comment}" if s.comment else "")
-        return text, ""
-
-    return names
-
-
-def _io_bits(plc: Plc) -> tuple[list[str], list[str]]:
-    """The input and output bits the program uses (by address or symbol),
-    in address order: the switches and lamps of the page."""
-    areas = plc.mem.areas
-    found: dict[str, set[tuple[int, int]]] = {"I": set(), "Q": set()}
-    seen: set[str] = set()
-    for p in plc.program.pous:
-        for n in p.networks:
-            for insn in n.insns:
-                for o in insn.operands:
-                    t = o.text
-                    if t in seen or not t or t[0] in "#*&\"'0123456789+-":
-                        continue
-                    seen.add(t)
-                    try:
-                        buf, off, width, bit, _ = plc.locate(t)
-                    except PlcError:
-                        continue
-                    if width == 0:
-                        for area in ("I", "Q"):
-                            if buf is areas[area]:
-                                found[area].add((off, bit))
-    ins = [f"I{o}.{b}" for o, b in sorted(found["I"])][:MAX_IO]
-    outs = [f"Q{o}.{b}" for o, b in sorted(found["Q"])][:MAX_IO]
-    return ins, outs
-
-
-def _plant(plc: Plc) -> Any:
-    return getattr(plc, "_config", {}).get("plant")
-
-
-def _axis_marks(plc: Plc) -> list[dict[str, Any]]:
-    """Each axis's reference switch, limits and Z marks from the plant."""
-    plant = _plant(plc)
-    out = []
-    for a in plc.axes():
-        marks: dict[str, Any] = {"slot": a.slot, "axis": a.axis}
-        mod = plant.modules.get(a.slot) if plant is not None else None
-        ap = mod.axes.get(a.axis) if mod is not None else None
-        if ap is not None:
-            marks.update(start=ap.start, rps=list(ap.rps) if ap.rps else None,
-                         limit_neg=ap.limit_neg, limit_pos=ap.limit_pos,
-                         z_period=ap.z_period, z_offset=ap.z_offset)
-        out.append(marks)
-    return out
-
-
-def _drive_marks(plc: Plc) -> list[dict[str, Any]]:
-    """Each drive's limits, home switch, index pulses and hard stops."""
-    plant = _plant(plc)
-    out = []
-    for d in plc.drives():
-        marks: dict[str, Any] = {"slot": d.slot, "node": d.node, "model": d.model}
-        mod = plant.modules.get(d.slot) if plant is not None else None
-        cfg = mod.drives.get(d.node) if mod is not None else None
-        if cfg is not None:
-            for k, v in cfg.plant.items():
-                if k in ("neg_limit", "pos_limit", "home_switch", "index_period",
-                         "index_phase", "neg_stop", "pos_stop", "start"):
-                    marks[k] = list(v) if isinstance(v, tuple) else v
-        out.append(marks)
-    return out
 
 
 __all__ = ["CHUNK_S", "Client", "DISPLAY_HZ", "Mailbox", "PanelSession", "TREND_MAX"]

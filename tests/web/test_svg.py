@@ -87,13 +87,13 @@ def test_esc_leaves_no_markup_and_no_control_characters(text: str) -> None:
 
 
 def test_hostile_symbols_and_comments_stay_text_in_the_svg() -> None:
-    from plcrt.web.session import _symbol_names
+    from plcrt.web.present import symbol_names
     symbols = 'Evil\tI0.0\t"><svg onload=alert(1)><script>x()</script>\n'
     text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD Evil\n"
             "= Q0.0\nEND_ORGANIZATION_BLOCK\n")
     plc, pou = nets(text, symbols)
     svg = network_svg(pou, pou.networks[0], program=plc.program,
-                      names=_symbol_names(plc.symbols))
+                      names=symbol_names(plc.symbols))
     root = ET.fromstring(svg)
     tags = {e.tag.removeprefix(NS) for e in root.iter()}
     assert tags <= {"svg", "g", "line", "path", "rect", "text", "title"}

@@ -165,3 +165,56 @@ def test_screenshot_matches_the_reference(serve, page) -> None:
         assert (diff.max(axis=2) > 0.1).mean() < 0.01
     finally:
         out.unlink(missing_ok=True)
+
+
+def test_trend_exports_csv_and_png(serve, page, tmp_path) -> None:
+    """A trend of a bit and a timer over 30 scans: the CSV holds one row per
+    scan with the simulated time, the PNG is the plotted picture."""
+    plc = load_sample()
+    plc.force("I0.0", 1)
+    served = serve(plc)
+    open_panel(page, served)
+    page.fill("#trend-signals", "Q0.0 T37")
+    page.click("#trend-form button")
+    page.fill("#nscans", "30")
+    page.click("#stepn")
+    page.wait_for_function("() => window.plcrtPanel.frame.scans === 30"
+                           " && window.plcrtPanel.trend.t.length === 31")
+    with page.expect_download() as dl:
+        page.click("#trend-csv")
+    csv = tmp_path / "trend.csv"
+    dl.value.save_as(csv)
+    rows = [r.split(",") for r in csv.read_text().splitlines()]
+    assert rows[0] == ["t", "Q0.0", "T37"]
+    assert len(rows) == 32 and float(rows[-1][0]) == pytest.approx(0.3)
+    assert rows[1][1:] == ["0", "0"] and rows[-1][1] == "1" and int(rows[-1][2]) == 2
+    with page.expect_download() as dl:
+        page.click("#trend-png")
+    png = tmp_path / "trend.png"
+    dl.value.save_as(png)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 1000
+
+
+def test_a_breakpoint_set_in_the_page_pauses_before_its_network(serve, page) -> None:
+    """The circle of network 3 sets a breakpoint (the runner moves to the
+    build with probes); a scan stops before network 3 and the bar says so;
+    continue finishes the scan; clearing it moves back."""
+    served = serve()
+    open_panel(page, served)
+    page.click('[data-net="OB1/3"] button.bp')
+    page.wait_for_selector('[data-net="OB1/3"] button.bp.set')
+    page.click("#step")
+    page.wait_for_function("() => window.plcrtPanel.frame.run === 'paused'")
+    assert frame(page)["paused_at"] == "OB1/3" and frame(page)["scans"] == 0
+    assert "paused" in page.locator("#runstate").inner_text()
+    page.click('[data-net="OB1/3"] button.bp')      # clear it while paused
+    page.wait_for_selector('[data-net="OB1/3"] button.bp:not(.set)')
+    page.click("#run")                               # continues the paused scan
+    page.wait_for_function("() => window.plcrtPanel.frame.scans >= 1")
+    page.click("#stop")
+    page.wait_for_function("() => window.plcrtPanel.frame.run === 'stopped'")
+    for _ in range(50):
+        if served.panel.session.plc.coverage is None:
+            break
+        page.wait_for_timeout(100)
+    assert served.panel.session.plc.coverage is None

@@ -457,6 +457,18 @@ class Harness:
         self.forks.append(h)
         return h
 
+    def recompiled(self, *, instrument: bool | None = None,
+                   backend: str | None = None) -> Harness:
+        """A copy in the same state, its program compiled with other probes
+        or another backend (:meth:`plcrt.Plc.recompiled`): e.g. warm up on
+        the native backend, then look at coverage from there on."""
+        h = Harness(self.plc.recompiled(instrument=instrument, backend=backend),
+                    watch=self.watched, history=self.history.maxlen or 20,
+                    name=self.name, max_time=self.max_time)
+        h.history.extend(self.history)
+        self.forks.append(h)
+        return h
+
     # -- motion -----------------------------------------------------------
     def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
         """State of one EM253 axis (needs a plant): ``a.position`` or

@@ -116,3 +116,15 @@ def test_same_options_give_a_fork() -> None:
 def test_bad_backend_is_a_config_error() -> None:
     with pytest.raises(PlcConfigError):
         plcrt.load(STATEFUL).recompiled(backend="fortran")
+
+
+def test_the_harness_recompiles_too() -> None:
+    """The test harness (the ``plc`` fixture) has the same method: a new
+    harness over the other build, in the same state, history included."""
+    from plcrt.testing import Harness
+    h = Harness(plcrt.load(STATEFUL), watch=["VW0"])
+    h.run(scans=4)
+    h2 = h.recompiled(instrument=True)
+    assert h2.coverage is not None and h2["VW0"] == 4 and list(h2.history) == list(h.history)
+    h2.run(scans=1)
+    assert h2["VW0"] == 5 and h["VW0"] == 4

@@ -59,7 +59,10 @@ class EM253Module:
         self._q = plc.mem.areas["Q"]
         self._di2 = slice(self.di, self.di + 2)
         self._do2 = slice(self.do, self.do + 2)
-        self._in2 = self._out2 = b"\0\0"   #: the terminal bytes last written
+        #: the terminal bytes last written (perf: bytearrays, never handed
+        #: out: a slice store from a bytearray copies its bytes at once,
+        #: one from bytes first makes a bytearray of them)
+        self._in2, self._out2 = bytearray(2), bytearray(2)
         self._plant_next = NEVER   #: time of the next scripted input (STF) event
         self._clr_shown = False    #: a CLR output bit is on in the bytes last written
         self._write_terminals(0)
@@ -129,8 +132,8 @@ class EM253Module:
                 cache[i] = self._bytes(ax, t, clr)
                 ax.wake = ax.next_change(t)
         (b0, o0), (b1, o1) = cache  # type: ignore[misc]
-        self._in2 = self._pi[self._di2] = bytes((b0, b1))
-        self._out2 = self._q[self._do2] = bytes((o0, o1))
+        self._in2 = self._pi[self._di2] = bytearray((b0, b1))
+        self._out2 = self._q[self._do2] = bytearray((o0, o1))
         # a CLR bit on: the next step must see MOTION_EN3 end the pulse
         self._clr_shown = bool((o0 | o1) & 2)
 

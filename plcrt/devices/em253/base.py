@@ -28,6 +28,11 @@ class MotionBlock:
     """Shared per-call-site logic: module lookup, InnerState, diagnostics."""
 
     name = ""
+    #: perf: the results every call returns exactly, in the interface's
+    #: order, and those of them always within their parameter's type: the
+    #: call site unpacks them and writes those without a mask
+    #: (plcrt.blocks.call)
+    exact_results: tuple[str, ...] = ()
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         self.plc = plc

@@ -38,6 +38,8 @@ from . import pos_run  # noqa: F401  (registers POS_RUN)
 @register_block("MOTION_EN3")
 class MotionEn3(MotionBlock):
     name = "MOTION_EN3"
+    #: the Clr bits are the inputs' 0/1 (or 0), Status 1 or 4
+    exact_results = ("Clr0", "Clr1", "Status")
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         super().__init__(plc, loc, itf)
@@ -104,6 +106,9 @@ class MotionEn3(MotionBlock):
 @register_block("GET_AbsPos")
 class GetAbsPos(MotionBlock):
     name = "GET_AbsPos"
+    #: C_Pos is the counter, which a long enough run takes beyond a DINT:
+    #: it is masked (wraps) as the module's 32-bit counter does
+    exact_results = ("C_Status",)
     last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
@@ -128,6 +133,7 @@ class GetAbsPos(MotionBlock):
 @register_block("SET_AbsPos")
 class SetAbsPos(MotionBlock):
     name = "SET_AbsPos"
+    exact_results = ("Start", "C_Status")
 
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
         # perf: Start = 0 with the module and axis of the last call, enabled
@@ -152,6 +158,9 @@ class SetAbsPos(MotionBlock):
 @register_block("SPD_CTRL")
 class SpdCtrl(MotionBlock):
     name = "SPD_CTRL"
+    #: InnerState and Update are 257 and 0 or the inputs as read, C_Spd a
+    #: speed within the output limit (500 kHz at most)
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd")
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
@@ -256,6 +265,8 @@ class SpdCtrl(MotionBlock):
 @register_block("POS_GOTO_R")
 class PosGotoR(MotionBlock):
     name = "POS_GOTO_R"
+    #: C_Pos counts up to |PosSet|, which is 2**31 for PosSet -2**31: masked
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd")
     c_pos = 0   #: the C_Pos last written
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
@@ -377,6 +388,7 @@ class Homing(MotionBlock):
     :mod:`.homing`."""
 
     name = "HOMING"
+    exact_results = ("InnerState", "C_Status", "C_Spd")
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         super().__init__(plc, loc, itf)

@@ -23,6 +23,8 @@ MAX_STEPS = 32
 @register_block("POS_RUN")
 class PosRun(MotionBlock):
     name = "POS_RUN"
+    #: C_Step is 0..32; C_Pos (pulses of a step, up to |PosSet|) is masked
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd", "C_Step")
     mode_in = 0   #: the Mode input of the current call
     _b_of: object = None   #: the bounds list _b_ceil and _b_floor were made from
 

@@ -44,11 +44,14 @@ class MotionBlock:
         self.axis: Optional[Axis] = None
         self.module: Optional[EM253Module] = None
         self._axis_no: Optional[int] = None
-        #: perf: what the instructions' shortcuts compare a call with in one
-        #: test: (EmNo, AxisNo) of the module and axis found by the last
-        #: call, and that plus InnerState 257 once InnerState is initialised
-        self._site: Optional[tuple] = None
-        self._ready: Optional[tuple] = None
+        #: perf: what the instructions' shortcuts compare a call with, one
+        #: integer each (a tuple would be built and compared per call):
+        #: EmNo and AxisNo of the module and axis found by the last call
+        #: (None before), and 257 once InnerState is initialised (None
+        #: before: no argument equals None)
+        self._em: Optional[int] = None
+        self._axn: Optional[int] = None
+        self._inner: Optional[int] = None
         self.stopping = False
         self.last_pos = 0
         self.last_spd = 0
@@ -84,8 +87,7 @@ class MotionBlock:
         self.module = mod
         self.axis = mod.axes[axis_no] if axis_no is not None else None
         self._axis_no = axis_no
-        self._site = (mod.slot, axis_no)
-        self._ready = (mod.slot, axis_no, INNER_OK) if self.initialised else None
+        self._em, self._axn = mod.slot, axis_no
         return True
 
     def inner(self, value: int) -> bool:
@@ -98,8 +100,7 @@ class MotionBlock:
                           f"the instruction does not run until it is cleared", "inner0")
                 return False
             self.initialised = True
-            if self._site is not None:
-                self._ready = (*self._site, INNER_OK)
+            self._inner = INNER_OK
             return True
         if value != INNER_OK:
             moving = self.axis is not None and self.axis.moving and self.owns()

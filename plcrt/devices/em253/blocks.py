@@ -115,9 +115,17 @@ class GetAbsPos(MotionBlock):
         plc = self.plc
         # perf: the usual case: the module and axis of the last call, enabled
         # in this scan; the time read from the PLC's field, not its property
-        if (em_no, axis_no) == self._site \
+        if em_no == self._em and axis_no == self._axn \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
-            self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
+            ax, t = self.axis, plc._t_us
+            if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
+                # perf: Axis.position inline (its window test and formula)
+                s = ax._w_seg  # type: ignore[union-attr]
+                pos = ax.counter + ax.direction * (  # type: ignore[union-attr]
+                    ((s.A * t + s.B) * t + s.C) // s.D)
+            else:
+                pos = ax.position(t)  # type: ignore[union-attr]
+            self.last_out = out = (pos, 1)
             return out
         return self.call_exact(em_no, axis_no)
 
@@ -138,7 +146,7 @@ class SetAbsPos(MotionBlock):
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
         # perf: Start = 0 with the module and axis of the last call, enabled
         # in this scan: nothing to do
-        if not start and (em_no, axis_no) == self._site \
+        if not start and em_no == self._em and axis_no == self._axn \
                 and self.module.enabled_scan == self.plc.scans:  # type: ignore[union-attr]
             return 0, self.status
         return self.call_exact(em_no, axis_no, pos, start)
@@ -169,12 +177,21 @@ class SpdCtrl(MotionBlock):
         # running (the block's own move, Run held, nothing to update) or
         # nothing to start (no move of this block, no Run edge): command()
         # has nothing to do, only C_Spd and C_Status to report
-        ax, plc = self.axis, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+        plc = self.plc
+        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+                and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax = self.axis
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
-                    self.last_spd = spd = ax.speed(plc._t_us)
+                    t = plc._t_us
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed inline (its window test and formula)
+                        s = ax._w_seg
+                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                    else:
+                        spd = ax.speed(t)
+                    self.last_spd = spd
                     return INNER_OK, 0, self.status, spd
             elif self.prev_run or not run:
                 self.prev_run = run
@@ -276,14 +293,23 @@ class PosGotoR(MotionBlock):
         # this block running with Run held and nothing to update, or nothing
         # to start (no move of this block, no Run edge): command() has
         # nothing to do, only C_Pos, C_Spd and C_Status to report
-        ax, plc = self.axis, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+        plc = self.plc
+        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+                and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax = self.axis
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
-                    self.last_spd = spd = ax.speed(t)
-                    self.c_pos = c_pos = ax.travel(t)
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed and Axis.travel inline (their
+                        # window test and formulas)
+                        s = ax._w_seg
+                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        c_pos = ((s.A * t + s.B) * t + s.C) // s.D
+                    else:
+                        spd, c_pos = ax.speed(t), ax.travel(t)
+                    self.last_spd, self.c_pos = spd, c_pos
                     return INNER_OK, 0, self.status, c_pos, spd
             elif self.prev_run or not run:
                 self.prev_run = run
@@ -401,15 +427,23 @@ class Homing(MotionBlock):
         # either the axis moving for this block (poll() has nothing to
         # report) with Run held or no homing active, or no homing active
         # and the axis not moving for it: only C_Spd and C_Status to report
-        ax, seq, plc = self.axis, self.seq, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop \
-                and (self.prev_run or not run) \
+        plc = self.plc
+        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+                and not e_stop and (self.prev_run or not run) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax, seq = self.axis, self.seq
             active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
                 if run or not active:
                     self.prev_run = run
-                    self.last_spd = spd = ax.speed(plc._t_us)
+                    t = plc._t_us
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed inline (its window test and formula)
+                        s = ax._w_seg
+                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                    else:
+                        spd = ax.speed(t)
+                    self.last_spd = spd
                     return INNER_OK, self.status, spd
             elif not active:
                 self.prev_run = run

@@ -260,8 +260,9 @@ class Plc(AddressAccess):
 
         perf: the scan loop tests this one flag, so it is recomputed by
         every change of what it depends on: force/unforce, the
-        ``_sources_on`` and ``stop_requested`` setters, HDEF, ATCH/DTCH,
-        a restore.  The observers are tested at each scan's end."""
+        ``_sources_on`` and ``stop_requested`` setters (HDEF, PLS and the
+        ports set ``_sources_on``), ATCH/DTCH, a restore.  The observers
+        are tested at each scan's end."""
         self._plain = not (self._defined or self._force_slots or self._sources or self._stop
                            or self.interrupts.timed_next or self.encoders or self.wiring
                            or self._wd_used or self._ob1 is None)
@@ -684,7 +685,6 @@ class Plc(AddressAccess):
         if counter.pulse is not None and counter not in self._counted:
             self._counted.append(counter)
             self.scheduler.add(counter)
-        self._replain()
 
     def _hsc(self, number: int) -> None:
         self.hsc[number].hsc(self._irq_t)

@@ -13,7 +13,10 @@ names) promises that every call returns a tuple of exactly its results:
 the call unpacks them into locals, and the results named there are
 always within their parameter's type (BOOL 0/1, BYTE 0..255, WORD and
 DWORD unsigned, INT and DINT signed), so they are written without a mask
-(out of range, the store raises: never a silently wrong value).
+(out of range, the store raises: never a silently wrong value).  A block
+with a ``constant_args`` method is told, once, the names of the IN
+parameters its call site gives as constants: they are the same at every
+call of the site, so a shortcut need not compare them.
 
 ``_blk3`` is the per-call-site callable built by the block's factory, so
 each call site has its own state (like the memory a Micro/WIN library
@@ -65,6 +68,7 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
                f"the call passes {len(args)}")
     reads: list[Any] = []   # expressions, or bit operands (see _bit_reads)
     writes: list[tuple[Any, str]] = []   # (operand or None, type)
+    constants: set[str] = set()   # IN parameters given as constants
     for p, op_ir in zip(itf.params, args):
         typ = p.type   #: the type the argument is read as
         try:
@@ -82,6 +86,8 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
                 g.loc.block, g.loc.network)
             g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}", where)
         if p.dir == "IN":
+            if isinstance(op, Const):
+                constants.add(p.name)
             reads.append(op if typ == "BOOL" and isinstance(op, Addr)
                          else g.rbit(op) if typ == "BOOL" else g.rd(op, _KIND[typ]))
         if p.dir == "OUT" or p.written:
@@ -92,6 +98,9 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
     if at_load is not None:
         at_load(g, itf, plc)          # load-time warnings of the block's family
     block = factory(plc, g.loc, itf)
+    told = getattr(block, "constant_args", None)
+    if told is not None:
+        told(frozenset(constants))     # perf: see the module docstring
     call = getattr(type(block), "__call__", None)
     if not (isinstance(call, FunctionType) and hasattr(block, "__dict__")):
         fn = g.bind(block, "blk")

@@ -52,10 +52,24 @@ class MotionBlock:
         self._em: Optional[int] = None
         self._axn: Optional[int] = None
         self._inner: Optional[int] = None
+        #: perf: the call site gives EmNo and AxisNo as constants
+        #: (:meth:`constant_args`); once a call found them, every call of
+        #: the site names them: then _site_ok is True and _inner_fixed is
+        #: 257 once InnerState is initialised, and a shortcut compares
+        #: InnerState alone
+        self._fixed = False
+        self._site_ok = False
+        self._inner_fixed: Optional[int] = None
         self.stopping = False
         self.last_pos = 0
         self.last_spd = 0
         self.top = 0  #: SpdSet in force (after clamping to the output limit)
+
+    def constant_args(self, names: frozenset[str]) -> None:
+        """The IN parameters the call site gives as constants (the
+        compiler tells each block once, plcrt.blocks.call)."""
+        self._fixed = "EmNo" in names and (
+            "AxisNo" in names or all(p.name != "AxisNo" for p in self.itf.params))
 
     # -- helpers -----------------------------------------------------------
     def warn(self, msg: str, code: str) -> None:
@@ -88,6 +102,9 @@ class MotionBlock:
         self.axis = mod.axes[axis_no] if axis_no is not None else None
         self._axis_no = axis_no
         self._em, self._axn = mod.slot, axis_no
+        if self._fixed:
+            self._site_ok = True
+            self._inner_fixed = self._inner
         return True
 
     def inner(self, value: int) -> bool:
@@ -101,6 +118,8 @@ class MotionBlock:
                 return False
             self.initialised = True
             self._inner = INNER_OK
+            if self._site_ok:
+                self._inner_fixed = INNER_OK
             return True
         if value != INNER_OK:
             moving = self.axis is not None and self.axis.moving and self.owns()

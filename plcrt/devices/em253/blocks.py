@@ -113,9 +113,10 @@ class GetAbsPos(MotionBlock):
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
         plc = self.plc
-        # perf: the usual case: the module and axis of the last call, enabled
-        # in this scan; the time read from the PLC's field, not its property
-        if em_no == self._em and axis_no == self._axn \
+        # perf: the usual case: the module and axis of the last call (always
+        # so at a site that gives them as constants, once found), enabled in
+        # this scan; the time read from the PLC's field, not its property
+        if (self._site_ok or em_no == self._em and axis_no == self._axn) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax, t = self.axis, plc._t_us
             if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
@@ -146,7 +147,7 @@ class SetAbsPos(MotionBlock):
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
         # perf: Start = 0 with the module and axis of the last call, enabled
         # in this scan: nothing to do
-        if not start and em_no == self._em and axis_no == self._axn \
+        if not start and (self._site_ok or em_no == self._em and axis_no == self._axn) \
                 and self.module.enabled_scan == self.plc.scans:  # type: ignore[union-attr]
             return 0, self.status
         return self.call_exact(em_no, axis_no, pos, start)
@@ -173,12 +174,15 @@ class SpdCtrl(MotionBlock):
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
         # perf: no E_Stop, InnerState as the block keeps it, the module and
-        # axis of the last call enabled in this scan, and either steady
-        # running (the block's own move, Run held, nothing to update) or
-        # nothing to start (no move of this block, no Run edge): command()
-        # has nothing to do, only C_Spd and C_Status to report
+        # axis of the last call (at a site with constant EmNo and AxisNo,
+        # InnerState alone tells: MotionBlock._inner_fixed) enabled in this
+        # scan, and either steady running (the block's own move, Run held,
+        # nothing to update) or nothing to start (no move of this block, no
+        # Run edge): command() has nothing to do, only C_Spd and C_Status to
+        # report
         plc = self.plc
-        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
                 and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax = self.axis
@@ -294,7 +298,8 @@ class PosGotoR(MotionBlock):
         # to start (no move of this block, no Run edge): command() has
         # nothing to do, only C_Pos, C_Spd and C_Status to report
         plc = self.plc
-        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
                 and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax = self.axis
@@ -428,7 +433,8 @@ class Homing(MotionBlock):
         # report) with Run held or no homing active, or no homing active
         # and the axis not moving for it: only C_Spd and C_Status to report
         plc = self.plc
-        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
                 and not e_stop and (self.prev_run or not run) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax, seq = self.axis, self.seq

@@ -37,7 +37,8 @@ class PosRun(MotionBlock):
         # no Run edge): command() has nothing to do, only C_Step, C_Pos,
         # C_Spd and C_Status to report
         plc = self.plc
-        if inner == self._inner and em_no == self._em and axis_no == self._axn \
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
                 and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax = self.axis

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 from ..motion import Seg, cruise, first_time_at, plan_distance, ramp
 
@@ -65,13 +65,28 @@ class Axis:
         self._next: Optional[tuple[int, int, Callable]] = None  # (t, pos, handler)
         self.pulses_total = 0       #: statistics: pulses generated
         self.last_travel = 0
-        #: perf: before this time (µs) the module need not look at the axis:
-        #: no watched crossing, no end of the move and no change of an input
-        #: bit (RPS, L+, L-, Z) is due (:meth:`next_change`).  Whatever
-        #: changes the axis sets it to 0, so the next step looks again.
-        self.wake = 0
+        #: the module that steps the axis (its quiet time ends whenever
+        #: :attr:`wake` is set), or None
+        self.module: Optional[Any] = None
+        self._wake = 0              #: see :attr:`wake`
         self._stopped_window()
         self.owner: object = None   #: the block instance that commands the axis
+
+    @property
+    def wake(self) -> int:
+        """perf: before this time (µs) the module need not look at the axis:
+        no watched crossing, no end of the move and no change of an input
+        bit (RPS, L+, L-, Z) is due (:meth:`next_change`).  Whatever changes
+        the axis sets it to 0, so the next step looks again; every setting
+        also ends the module's quiet time (EM253Module.quiet_to), which the
+        module computes again from the new value after its step."""
+        return self._wake
+
+    @wake.setter
+    def wake(self, t: int) -> None:
+        self._wake = t
+        if self.module is not None:
+            self.module.quiet_to = 0
 
     # -- state at a time ----------------------------------------------------
     @property

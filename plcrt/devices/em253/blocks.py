@@ -96,6 +96,8 @@ class MotionEn3(MotionBlock):
             out.append(clr)
         status = 4 if any(a.stf for a in mod.axes) else 1
         mod.clr_pending = any(u is not None for u in mod.clr_until)
+        if mod.clr_pending:
+            mod.quiet_to = 0   # the module's next step ends the pulse
         mod.stf_any = status == 4
         result = (out[0], out[1], status)
         self._last_out = result

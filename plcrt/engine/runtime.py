@@ -476,12 +476,12 @@ class Plc(AddressAccess):
                 ob1(l_ob1)
             except Exception as e:
                 self._fault(e)
+            t_to = now + scan_us
             if self._plain:   # the program can end it (ATCH, PLS, HDEF, STOP...)
                 try:
                     if step1 is not None:
-                        step1(self, now, now + scan_us)
-                    elif steps:
-                        t_to = now + scan_us
+                        step1(self, now, t_to)
+                    else:
                         for step in steps:
                             step(self, now, t_to)
                 except Exception as e:
@@ -489,10 +489,10 @@ class Plc(AddressAccess):
                 if self._plain and not self.observers:
                     pq[:] = q
                     self.scans = scans + 1
-                    self._t_us = now + scan_us
+                    self._t_us = t_to
                     continue
             else:
-                self._timeline(now, now + scan_us, True)
+                self._timeline(now, t_to, True)
             self._scan_end(now)   # only _scan_end can end RUN mode, else a fault raises
             if self.mode != "RUN":
                 return

@@ -95,7 +95,7 @@ class Axis:
 
     def _stopped_window(self) -> None:
         """perf: the window of a stopped axis covers all time (travel 0)."""
-        self._w_lo, self._w_hi, self._w_seg = -NEVER, NEVER, _STOPPED
+        self._w_lo, self._w_hi, self._w_seg, self._w_hz = -NEVER, NEVER, _STOPPED, 0
 
     def _seg_at(self, t: int) -> Seg:
         """The segment of the current move that holds time ``t``; it and its
@@ -120,6 +120,10 @@ class Axis:
         self._w_seg = s
         self._w_lo = (segs[i - 1].t1_ceil or 0) if i else -NEVER
         self._w_hi = NEVER if s.t1_ceil is None else s.t1_ceil
+        # perf: a segment at constant speed (a cruise: HA 0) has its signed
+        # speed computed once for the window (the direction is only set by
+        # start(), which empties the window); None: compute it per time
+        self._w_hz = self.direction * (s.HB // s.HD) if s.HA == 0 else None
         return s
 
     def travel(self, t: int) -> int:
@@ -153,8 +157,11 @@ class Axis:
     def speed(self, t: int) -> int:
         """Signed output frequency in Hz (0 when stopped)."""
         if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
-            s = self._w_seg
-            return self.direction * ((s.HA * t + s.HB) // s.HD)
+            hz = self._w_hz
+            if hz is None:
+                s = self._w_seg
+                hz = self.direction * ((s.HA * t + s.HB) // s.HD)
+            return hz
         if not self.segs:
             return 0
         s = self._seg_at(t)

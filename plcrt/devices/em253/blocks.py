@@ -193,8 +193,10 @@ class SpdCtrl(MotionBlock):
                     t = plc._t_us
                     if ax._w_lo <= t < ax._w_hi:
                         # perf: Axis.speed inline (its window test and formula)
-                        s = ax._w_seg
-                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        spd = ax._w_hz
+                        if spd is None:
+                            s = ax._w_seg
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
                     else:
                         spd = ax.speed(t)
                     self.last_spd = spd
@@ -312,7 +314,9 @@ class PosGotoR(MotionBlock):
                         # perf: Axis.speed and Axis.travel inline (their
                         # window test and formulas)
                         s = ax._w_seg
-                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        spd = ax._w_hz
+                        if spd is None:
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
                         c_pos = ((s.A * t + s.B) * t + s.C) // s.D
                     else:
                         spd, c_pos = ax.speed(t), ax.travel(t)
@@ -447,8 +451,10 @@ class Homing(MotionBlock):
                     t = plc._t_us
                     if ax._w_lo <= t < ax._w_hi:
                         # perf: Axis.speed inline (its window test and formula)
-                        s = ax._w_seg
-                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        spd = ax._w_hz
+                        if spd is None:
+                            s = ax._w_seg
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
                     else:
                         spd = ax.speed(t)
                     self.last_spd = spd

@@ -51,7 +51,9 @@ class PosRun(MotionBlock):
                         # window test and formulas)
                         s = ax._w_seg
                         x = ((s.A * t + s.B) * t + s.C) // s.D
-                        spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        spd = ax._w_hz
+                        if spd is None:
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
                     else:
                         x, spd = ax.travel(t), ax.speed(t)
                     self.last = (step, c_pos) = self._step_at(x)

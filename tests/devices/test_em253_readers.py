@@ -219,3 +219,28 @@ def test_a_mover_whose_axis_changes_while_it_runs(block: str,
         fast.scan()
         exact.scan()
         assert _memory(fast) == _memory(exact), f"differs after scan {k}"
+
+
+@pytest.mark.parametrize("start,direction", [(2**31 - 30_000, 1), (-2**31 + 30_000, 0),
+                                             (2**30 - 30_000, 1), (-2**30 + 30_000, 0)])
+def test_get_abspos_wraps_the_counter_as_a_dint(start: int, direction: int,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """The counter set near the ends of a DINT (and near 2**30, where the
+    shortcut's one-digit test changes) and run past them: C_Pos holds the
+    counter's low 32 bits, signed, on the fast and the exact path."""
+    text = _ob1("CALL   SET_AbsPos, 0, 0, VD10, M2.0, VW20", GET0,
+                STEEP_SPD.replace("+200000", "+100000"))
+    fast, exact = _load_pair(text, PLANT, None, monkeypatch)
+    for plc in (fast, exact):
+        plc["VD10"], plc["M2.0"] = start, 1
+        plc.scan()
+        plc["M1.1"], plc["M1.0"] = direction, 1
+    seen = set()
+    for k in range(1000):
+        fast.scan()
+        exact.scan()
+        assert _memory(fast) == _memory(exact), f"differs after scan {k}"
+        count = fast.module(0).axes[0].position(fast.now_us - 700)
+        assert fast["VD120"] == (count + 2**31) % 2**32 - 2**31
+        seen.add(count > 2**31 - 1 or count < -2**31)
+    assert seen == {False, True} if abs(start) > 2**30 else seen == {False}

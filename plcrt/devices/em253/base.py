@@ -18,6 +18,12 @@ INNER_OK = 257
 ST_IDLE, ST_RUN, ST_STOPPED = 0, 1, 8
 
 
+def dint(v: int) -> int:
+    """The DINT that holds the low 32 bits of ``v`` (a counter past 2**31
+    wraps, as a masked store of it does)."""
+    return (v + 0x8000_0000) % 0x1_0000_0000 - 0x8000_0000
+
+
 def ramp_rate(v_set: int, v_ss: int, ms: int) -> Fraction:
     """Ramp rate (Hz per µs) from note 3: (SpdSet - SpdSs) / time; a time
     below 1 ms counts as 1 ms."""

@@ -31,7 +31,7 @@ from typing import Any
 
 from ...blocks import register_block
 from .axis import distance_plan, stop_plan, velocity_plan
-from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, ramp_rate
+from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, dint, ramp_rate
 from . import pos_run  # noqa: F401  (registers POS_RUN)
 
 
@@ -108,9 +108,9 @@ class MotionEn3(MotionBlock):
 @register_block("GET_AbsPos")
 class GetAbsPos(MotionBlock):
     name = "GET_AbsPos"
-    #: C_Pos is the counter, which a long enough run takes beyond a DINT:
-    #: it is masked (wraps) as the module's 32-bit counter does
-    exact_results = ("C_Status",)
+    #: C_Pos is the counter's low 32 bits as a DINT (dint(): what a masked
+    #: store of the counter writes, so it is stored without a mask)
+    exact_results = ("C_Pos", "C_Status")
     last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
@@ -128,6 +128,8 @@ class GetAbsPos(MotionBlock):
                     ((s.A * t + s.B) * t + s.C) // s.D)
             else:
                 pos = ax.position(t)  # type: ignore[union-attr]
+            if not -0x3FFFFFFF <= pos <= 0x3FFFFFFF:   # perf: one-digit bounds
+                pos = dint(pos)
             self.last_out = out = (pos, 1)
             return out
         return self.call_exact(em_no, axis_no)
@@ -137,7 +139,7 @@ class GetAbsPos(MotionBlock):
         if not self.find(em_no, axis_no):
             return self.last_out
         assert self.axis is not None
-        self.last_out = (self.axis.position(self.now()), 1)
+        self.last_out = (dint(self.axis.position(self.now())), 1)
         return self.last_out
 
 

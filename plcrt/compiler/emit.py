@@ -359,7 +359,21 @@ class Gen:
                     buf = self._buf(op.area)
                     keep = ~sum(1 << b for b in bits) & 0xFF
                     parts = " | ".join(f"({e}) << {o.bit}" for o, _, e in items[i:j])
-                    self.line(f"{buf}[{op.offset}] = {buf}[{op.offset}] & {keep} | {parts}")
+                    store = f"{buf}[{op.offset}] = {buf}[{op.offset}] & {keep} | {parts}"
+                    if all(e.isidentifier() for _, _, e in items[i:j]):
+                        # perf: the byte is stored only when a bit differs
+                        # from the byte as it is now (storing bits it already
+                        # holds changes nothing), compared through the bit
+                        # table: tuple subscripts and small-integer compares
+                        # instead of the masks, shifts and ors of the store
+                        now = self.tmp("t")
+                        self.line(f"{now} = {self.use('_bits')}[{buf}[{op.offset}]]")
+                        differs = " or ".join(f"{e} != {now}[{o.bit}]"
+                                              for o, _, e in items[i:j])
+                        with self.block(f"if {differs}:"):
+                            self.line(store)
+                    else:
+                        self.line(store)
             else:
                 end = _packable_end(op, kind, expr)
                 while end is not None and j < len(items):

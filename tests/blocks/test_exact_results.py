@@ -258,3 +258,41 @@ def test_full_speed_differential_and_reverse_keep_c_spd_in_range(checked: list[s
         plc["M1.0"] = 0
         plc.run(seconds=0.5)
     assert {"SPD_CTRL", "GET_AbsPos", "MOTION_EN3"} <= set(checked)
+
+
+class _Writer(_Fixed):
+    """A stand-in that stores ``byte`` into MB0 during the call (as a block
+    writing through a pointer may), then returns ``out``."""
+
+    byte = 0
+
+    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
+        super().__init__(plc, loc, itf)
+        self.m = plc.mem.areas["M"]
+
+    def __call__(self, *args: Any) -> tuple:
+        self.m[0] = self.byte
+        return super().__call__(*args)
+
+
+@pytest.mark.parametrize("before,during,clr", [
+    (0b00000, None, (0, 0)), (0b11000, None, (1, 1)), (0b01000, None, (0, 1)),
+    (0b10111, None, (1, 0)), (0b00000, 0b11000, (0, 0)), (0b11000, 0b00111, (1, 1)),
+    (0b11111, 0b10000, (1, 0)), (0b01000, None, (1, 1)), (0b11000, 0b01000, (1, 1)),
+    (0b00000, 0b01000, (1, 0))])
+def test_written_back_bits_of_one_byte_are_those_returned(
+        monkeypatch: pytest.MonkeyPatch, before: int, during: int | None,
+        clr: tuple[int, int]) -> None:
+    """MOTION_EN3's Clr0/Clr1 (M0.3, M0.4) written back: the byte ends with
+    the returned bits and its other bits as they are after the call, also
+    when the call itself changed the byte (the store is skipped only when
+    the byte already holds the returned bits)."""
+    _load_implementations()
+    attrs = {"exact_results": ("Clr0", "Clr1", "Status"), "out": (*clr, 1),
+             "byte": before if during is None else during}
+    monkeypatch.setitem(BLOCK_FACTORIES, "MOTION_EN3", type("W", (_Writer,), attrs))
+    plc = plcrt.load(_program("CALL   MOTION_EN3, 0, M0.0, M0.1, M0.2, M0.3, M0.4, VW0"))
+    plc["MB0"] = before
+    plc.scan()
+    after_call = before if during is None else during
+    assert plc["MB0"] == after_call & 0b11100111 | clr[0] << 3 | clr[1] << 4

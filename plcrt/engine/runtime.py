@@ -184,6 +184,7 @@ class Plc(AddressAccess):
         self._defined: list[Any] = []
         self._sources = False      #: see _sources_on
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
+        self._pi0_raw = 0          #: PIB0 as the plain scan last saw it (perf)
         self._int_l = bytearray(self.model.l_bytes)
         #: the real-time clock (TODR/TODW): from ``clock=``, else the plant
         #: file's ``[cpu] clock``, else the fixed default date
@@ -458,8 +459,12 @@ class Plc(AddressAccess):
                 if self.mode != "RUN":
                     return
                 continue
-            if pi[0] & edge_mask != self._pi0 or irq.queued:
-                self._input_edges(now, pi[0] & edge_mask)
+            # perf: the raw byte against the one last seen here first (any
+            # stale value only costs the exact test below)
+            if pi[0] != self._pi0_raw or irq.queued:
+                self._pi0_raw = pi[0]
+                if pi[0] & edge_mask != self._pi0 or irq.queued:
+                    self._input_edges(now, pi[0] & edge_mask)
             i_img[:] = pi
             scans = self.scans
             # perf: time only moves forward and a restore clears the window,

@@ -8,6 +8,15 @@ kind and width, addresses where the block writes), then emits::
         <write r[0], r[1], ... to the OUT / written-back arguments>
 
 (outputs at neighbouring addresses written by one store, Gen.wr_seq).
+A block class with an ``exact_results`` attribute (a tuple of result
+names) promises that every call returns a tuple of exactly its results:
+the call unpacks them into locals, and the results named there are
+always within their parameter's type (BOOL 0/1, BYTE 0..255, WORD and
+DWORD unsigned, INT and DINT signed), so they are written without a mask
+(out of range, the store raises: never a silently wrong value).  A block
+with a ``constant_args`` method is told, once, the names of the IN
+parameters its call site gives as constants: they are the same at every
+call of the site, so a shortcut need not compare them.
 
 ``_blk3`` is the per-call-site callable built by the block's factory, so
 each call site has its own state (like the memory a Micro/WIN library
@@ -59,6 +68,7 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
                f"the call passes {len(args)}")
     reads: list[Any] = []   # expressions, or bit operands (see _bit_reads)
     writes: list[tuple[Any, str]] = []   # (operand or None, type)
+    constants: set[str] = set()   # IN parameters given as constants
     for p, op_ir in zip(itf.params, args):
         typ = p.type   #: the type the argument is read as
         try:
@@ -76,6 +86,8 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
                 g.loc.block, g.loc.network)
             g.fail(f"{itf.name} argument {p.name} ({p.dir} {p.type}): {e}", where)
         if p.dir == "IN":
+            if isinstance(op, Const):
+                constants.add(p.name)
             reads.append(op if typ == "BOOL" and isinstance(op, Addr)
                          else g.rbit(op) if typ == "BOOL" else g.rd(op, _KIND[typ]))
         if p.dir == "OUT" or p.written:
@@ -86,6 +98,9 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
     if at_load is not None:
         at_load(g, itf, plc)          # load-time warnings of the block's family
     block = factory(plc, g.loc, itf)
+    told = getattr(block, "constant_args", None)
+    if told is not None:
+        told(frozenset(constants))     # perf: see the module docstring
     call = getattr(type(block), "__call__", None)
     if not (isinstance(call, FunctionType) and hasattr(block, "__dict__")):
         fn = g.bind(block, "blk")
@@ -98,36 +113,49 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         # method, rebound for each PLC, is bound to that PLC's block.
         g.unit.bind(block, "blk")
         fn = g.bind(block.__call__, "call")
+    exact = getattr(type(block), "exact_results", None)
     with g.box(alone=True):
-        r = g.tmp("r")
-        g.line(f"{r} = {fn}({', '.join(_bit_reads(g, reads))})")
-        g.wr_seq([(target, "X" if typ == "BOOL" else _KIND[typ], f"{r}[{i}]")
-                  for i, (target, typ) in enumerate(writes) if target is not None])
+        args = ', '.join(_bit_reads(g, reads))
+        if exact is None:
+            r = g.tmp("r")
+            g.line(f"{r} = {fn}({args})")
+            g.wr_seq([(target, "X" if typ == "BOOL" else _KIND[typ], f"{r}[{i}]")
+                      for i, (target, typ) in enumerate(writes) if target is not None])
+        elif writes:
+            # perf: the block returns exactly its results: unpacked into
+            # locals, and those it keeps in range written without a mask
+            rs = [g.tmp("r") for _ in writes]
+            g.line(f"{', '.join(rs)}{',' if len(rs) == 1 else ''} = {fn}({args})")
+            names = [p.name for p in itf.results]
+            g.wr_seq([(target, "X" if typ == "BOOL" else _KIND[typ], r, name in exact)
+                      for r, name, (target, typ) in zip(rs, names, writes)
+                      if target is not None])
+        else:
+            g.line(f"{fn}({args})")
     return True
 
 
 def _bit_reads(g: Any, reads: list[Any]) -> list[str]:
     """The argument expressions: bit operands read with :meth:`Gen.rbit`,
-    except that a byte holding several of them is read once into a local
-    first (perf: one load instead of one per bit; reading has no effect,
-    so the order of the reads does not matter)."""
+    except that a byte holding several of them is read once, as the tuple
+    of its bits (plcrt.compiler.rt.BITS), into a local first (perf: one
+    load instead of one per bit, and a tuple subscript per bit instead of
+    a shift and a mask; reading has no effect, so the order of the reads
+    does not matter)."""
     bytes_of = [(op.area, op.offset) for op in reads
                 if isinstance(op, Addr) and op.area not in ("T", "C")]
     shared: dict[tuple[str, int], str] = {}
     for key in dict.fromkeys(bytes_of):
         if bytes_of.count(key) > 1:
             shared[key] = var = g.tmp("b")
-            g.line(f"{var} = {g.rd(Addr(key[0], key[1], 1), 'B')}")
+            g.line(f"{var} = {g.use('_bits')}[{g.rd(Addr(key[0], key[1], 1), 'B')}]")
     out = []
     for op in reads:
         if not isinstance(op, Addr):
             out.append(op)
             continue
         var = shared.get((op.area, op.offset))
-        if var is None:
-            out.append(g.rbit(op))
-        else:
-            out.append(f"({var} >> {op.bit} & 1)" if op.bit else f"({var} & 1)")
+        out.append(g.rbit(op) if var is None else f"{var}[{op.bit}]")
     return out
 
 

@@ -22,7 +22,7 @@ from typing import Any, Iterator
 from ..errors import SourceLoc
 from ..safetext import excerpt
 from .operands import Addr, Const, Indirect, Pointer
-from .rt import PACK_CODE, packer
+from .rt import EXACT_CODE, PACK_CODE, packer
 
 MAX_STACK = 9  #: S7-200 logic stack depth (System Manual, "logic stack")
 
@@ -296,8 +296,10 @@ class Gen:
 
         Integer values are masked to the width, so callers may pass signed or
         oversized results.  REAL values must already be finite single
-        precision numbers.  ``exact=True`` promises a byte value already in
-        0..255 (no mask needed).
+        precision numbers.  ``exact=True`` promises a value already in the
+        range of ``kind`` (0..255 for ``B``, signed for ``W``/``D``, unsigned
+        for ``WU``/``DU``): no mask is applied, and a word or double word
+        out of that range raises (struct.error) instead of wrapping.
         """
         width = VALUE_WIDTH[kind[0]]
         if isinstance(op, Indirect):
@@ -317,15 +319,19 @@ class Gen:
             self.line(f"{self.use('_wf')}({buf}, {off}, {expr})")
         elif width == 1:
             self.line(f"{buf}[{off}] = {expr}" if exact else f"{buf}[{off}] = ({expr}) & 255")
+        elif exact:
+            self.line(f"{self.use('_w' + EXACT_CODE[kind])}({buf}, {off}, {expr})")
         elif width == 2:
             self.line(f"{self.use('_wH')}({buf}, {off}, ({expr}) & 65535)")
         else:
             self.line(f"{self.use('_wI')}({buf}, {off}, ({expr}) & 4294967295)")
 
-    def wr_seq(self, items: list[tuple[Any, str, str]]) -> None:
+    def wr_seq(self, items: list[tuple[Any, str, str]] | list[tuple[Any, str, str, bool]]
+               ) -> None:
         """Statements writing several values in the order given: ``(operand,
-        kind, expr)`` each, ``kind`` as for :meth:`wr` or ``"X"`` for a bit
-        (0/1).  Every ``expr`` must be free of side effects.
+        kind, expr)`` or ``(operand, kind, expr, exact)`` each, ``kind`` as
+        for :meth:`wr` or ``"X"`` for a bit (0/1), ``exact`` as for
+        :meth:`wr`.  Every ``expr`` must be free of side effects.
 
         perf: writes that follow each other in one buffer become one store:
         bits of one byte one byte store, values at neighbouring addresses
@@ -334,6 +340,9 @@ class Gen:
         Operands that overlap, indirect ones, constants and the timer,
         counter, accumulator and HC areas are written one by one.
         """
+        items4 = [(*it, False) if len(it) == 3 else it for it in items]
+        exacts = [it[3] for it in items4]
+        items = [it[:3] for it in items4]
         i = 0
         while i < len(items):
             op, kind, expr = items[i]
@@ -350,7 +359,21 @@ class Gen:
                     buf = self._buf(op.area)
                     keep = ~sum(1 << b for b in bits) & 0xFF
                     parts = " | ".join(f"({e}) << {o.bit}" for o, _, e in items[i:j])
-                    self.line(f"{buf}[{op.offset}] = {buf}[{op.offset}] & {keep} | {parts}")
+                    store = f"{buf}[{op.offset}] = {buf}[{op.offset}] & {keep} | {parts}"
+                    if all(e.isidentifier() for _, _, e in items[i:j]):
+                        # perf: the byte is stored only when a bit differs
+                        # from the byte as it is now (storing bits it already
+                        # holds changes nothing), compared through the bit
+                        # table: tuple subscripts and small-integer compares
+                        # instead of the masks, shifts and ors of the store
+                        now = self.tmp("t")
+                        self.line(f"{now} = {self.use('_bits')}[{buf}[{op.offset}]]")
+                        differs = " or ".join(f"{e} != {now}[{o.bit}]"
+                                              for o, _, e in items[i:j])
+                        with self.block(f"if {differs}:"):
+                            self.line(store)
+                    else:
+                        self.line(store)
             else:
                 end = _packable_end(op, kind, expr)
                 while end is not None and j < len(items):
@@ -361,19 +384,19 @@ class Gen:
                     end = nxt
                     j += 1
                 if j - i == 1:
-                    self.wr(op, kind, expr)
+                    self.wr(op, kind, expr, exact=exacts[i])
                 else:
                     # bytes between two values are written again with their
                     # own value, read in the same statement (perf: a byte
                     # read is cheaper than a second struct call)
                     buf = self._buf(op.area)
                     codes, values, pos = [], [], op.offset
-                    for o, k, e in items[i:j]:
+                    for (o, k, e), exact in zip(items[i:j], exacts[i:j]):
                         for gap in range(pos, o.offset):
                             codes.append("B")
                             values.append(f"{buf}[{gap}]")
-                        codes.append(PACK_CODE[k])
-                        values.append(e if k == "R" else f"({e}) & {_MASK[k[0]]}")
+                        codes.append((EXACT_CODE if exact else PACK_CODE)[k])
+                        values.append(e if k == "R" or exact else f"({e}) & {_MASK[k[0]]}")
                         pos = o.offset + VALUE_WIDTH[k[0]]
                     self.line(f"{self.use(packer(''.join(codes)))}({buf}, {op.offset}, "
                               f"{', '.join(values)})")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from struct import Struct
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 from ..errors import PlcRuntimeError, SourceLoc
 from .operands import POINTER_AREA_NAMES
@@ -22,22 +22,38 @@ _I = Struct(">i")
 _UI = Struct(">I")
 _F = Struct(">f")
 
-CODECS: dict[str, Callable] = {
+#: perf: the bits of every byte value, ``BITS[v][k] == v >> k & 1``: the
+#: generated code takes the tuple of a byte once, then each of its bits
+#: with one tuple subscript instead of a shift and a mask
+#: (plcrt.blocks.call)
+BITS: tuple[tuple[int, ...], ...] = tuple(tuple(v >> k & 1 for k in range(8))
+                                          for v in range(256))
+
+CODECS: dict[str, Any] = {
     "_rh": _H.unpack_from, "_rH": _UH.unpack_from,
     "_ri": _I.unpack_from, "_rI": _UI.unpack_from, "_rf": _F.unpack_from,
     "_wH": _UH.pack_into, "_wI": _UI.pack_into, "_wf": _F.pack_into,
+    # signed writers: for values known to be in range (no mask; an
+    # out-of-range value raises instead of wrapping)
+    "_wh": _H.pack_into, "_wi": _I.pack_into,
+    "_bits": BITS,
 }
+
 
 #: struct format letter of each value kind written in one call (unsigned:
 #: the generated code masks integers to the width first)
 PACK_CODE = {"B": "B", "W": "H", "WU": "H", "D": "I", "DU": "I", "R": "f"}
+#: struct format letter of a value known to be within its kind's range
+#: (signed kinds signed, nothing masked)
+EXACT_CODE = {"B": "B", "W": "h", "WU": "H", "D": "i", "DU": "I", "R": "f"}
 
 
 def packer(codes: str) -> str:
     """The name of a codec writing several big-endian values at once
     (``"IB"``: a DWORD then a BYTE), added to :data:`CODECS` on first use.
-    Only the letters of :data:`PACK_CODE` are accepted."""
-    if len(codes) < 2 or not set(codes) <= set(PACK_CODE.values()):
+    Only the letters of :data:`PACK_CODE` and :data:`EXACT_CODE` are
+    accepted."""
+    if len(codes) < 2 or not set(codes) <= set(PACK_CODE.values()) | set(EXACT_CODE.values()):
         raise ValueError(f"not a packer format: {codes!r}")
     name = "_w" + codes
     if name not in CODECS:

@@ -171,6 +171,7 @@ class AddressAccess:
         self.forces[check_address(address)] = value
         self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
         self._force_slots.append((buf, off, width, bit, value))
+        self._replain()
         _store(buf, off, width, bit, value)
 
     def unforce(self, address: str | None = None) -> str | None:
@@ -185,6 +186,7 @@ class AddressAccess:
         if address is None:
             self.forces.clear()
             self._force_slots = []
+            self._replain()
             return None
         loc = self._locate(self._addr(address))
         key = self._forced_key(loc)
@@ -192,7 +194,12 @@ class AddressAccess:
             raise PlcAddressError(f"{printable(address.strip())} is not forced")
         del self.forces[key]
         self._force_slots = [s for s in self._force_slots if not _same_loc(s, loc)]
+        self._replain()
         return key
+
+    def _replain(self) -> None:
+        """Called whenever the forces change (the PLC decides from them,
+        among others, whether a scan can take its plain path)."""
 
     def _forced_key(self, loc: tuple[bytearray, int, int, int]) -> str | None:
         """The key of :attr:`forces` that forces location ``loc``, if any."""

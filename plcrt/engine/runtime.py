@@ -129,7 +129,10 @@ class Plc(AddressAccess):
         self.scans = 0
         self._t_us = 0
         self._prev_start: int | None = None
-        self.stop_requested = False
+        self._stop = False         #: see stop_requested
+        #: perf: the scan loop's one test (_replain): False until the end of
+        #: __init__ and whenever a scan needs more than the plain path
+        self._plain = False
         self.timers = TimerBank(self.mem.areas["TV"], self.mem.areas["TB"], self.model.timers)
         self.counters = CounterBank(self.mem.areas["CV"], self.mem.areas["CB"], self.model.counters)
         #: watchdog and nesting state of the scan: instructions in loops,
@@ -179,8 +182,9 @@ class Plc(AddressAccess):
         self._irq_t = 0            #: the time the running code executes at (µs)
         #: the counters an HDEF defined, in HDEF order (perf: the others cost nothing)
         self._defined: list[Any] = []
-        self._sources_on = False   #: a PLS, HDEF or T32/T96 ATCH ran (perf: see _scan_once)
+        self._sources = False      #: see _sources_on
         self._pi0 = 0              #: I0.0–I0.3 as the edge interrupts last saw them
+        self._pi0_raw = 0          #: PIB0 as the plain scan last saw it (perf)
         self._int_l = bytearray(self.model.l_bytes)
         #: the real-time clock (TODR/TODW): from ``clock=``, else the plant
         #: file's ``[cpu] clock``, else the fixed default date
@@ -224,6 +228,45 @@ class Plc(AddressAccess):
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
         self.mem.areas["SM"][22:28] = ms * 3
         attach_devices(self.ports, plant)   # a plant device sends at given times
+        self._replain()
+
+    # -- the plain scan ---------------------------------------------------------
+    @property
+    def stop_requested(self) -> bool:
+        """A STOP instruction ran: the CPU goes to STOP at the scan's end."""
+        return self._stop
+
+    @stop_requested.setter
+    def stop_requested(self, value: bool) -> None:
+        self._stop = value
+        self._replain()
+
+    @property
+    def _sources_on(self) -> bool:
+        """A PLS, HDEF, a T32/T96 or port ATCH or a port's traffic ran: the
+        scan's time line has event sources (perf: see :meth:`_timeline`).
+        Devices and blocks set it; the engine reads ``_sources``."""
+        return self._sources
+
+    @_sources_on.setter
+    def _sources_on(self, value: bool) -> None:
+        self._sources = value
+        self._replain()
+
+    def _replain(self) -> None:
+        """Whether a scan can take the plain path of :meth:`scan`: no HSC
+        defined, no force, no event source on the time line (PLS, HDEF,
+        a timed or port interrupt, port traffic), no STOP requested, no
+        plant wires or encoders, no watchdog counting, and an OB1.
+
+        perf: the scan loop tests this one flag, so it is recomputed by
+        every change of what it depends on: force/unforce, the
+        ``_sources_on`` and ``stop_requested`` setters (HDEF, PLS and the
+        ports set ``_sources_on``), ATCH/DTCH, a restore.  The observers
+        are tested at each scan's end."""
+        self._plain = not (self._defined or self._force_slots or self._sources or self._stop
+                           or self.interrupts.timed_next or self.encoders or self.wiring
+                           or self._wd_used or self._ob1 is None)
 
     # -- compiling and binding ------------------------------------------------
     def _compile_template(self, program: ir.Program, symbols: Any,
@@ -395,38 +438,69 @@ class Plc(AddressAccess):
                 if left > 0:
                     _time.sleep(left)
             return
-        # perf: _scan_once and _timeline's device steps inlined, their
-        # methods and objects looked up once
-        begin, timeline, end = self._scan_begin, self._timeline, self._scan_end
-        irq, steps = self.interrupts, [dev.step for dev in self.devices]
+        # perf: the plain scan (_replain) inline: _scan_begin's work for a
+        # program without forces, HSCs, watchdog counting or event sources,
+        # the devices stepped in place of the time line (_timeline), the
+        # usual scan end (_scan_end: no forces, pulse generator, plant
+        # wires, STOP or observers); the buffers and methods looked up once
+        i_img, pi, sm, l_ob1 = self._bufs_begin
         q, pq = self._bufs_end[1:]
-        plain_end = not (self.encoders or self.wiring)
+        steps = [dev.step for dev in self.devices]
+        # perf: one device (an EM253, a drive...) is called without a loop
+        step1 = steps.pop() if len(steps) == 1 else None
+        irq, timers, ob1 = self.interrupts, self.timers, self._ob1
+        scan_us, edge_mask = self.scan_us, self._edge_mask
         if self.mode != "RUN":
             return
         for _ in range(n):
             now = self._t_us
-            begin()
-            if irq.timed_next or self._sources_on:
-                timeline(now, now + self.scan_us, True)
-            elif steps:
-                t_to = now + self.scan_us
-                try:
-                    for step in steps:
-                        step(self, now, t_to)
-                except Exception as e:
-                    self._fault(e)
-            # perf: the usual scan end (_scan_end) inline: no forces, no
-            # pulse generator, no plant wires, no STOP, no observers (only
-            # _scan_end can end RUN mode, else a fault raises)
-            if plain_end and not (self._force_slots or self._sources_on or self.stop_requested
-                                  or self.observers):
-                pq[:] = q
-                self.scans += 1
-                self._t_us = now + self.scan_us
-            else:
-                end(now)
+            if not self._plain:
+                self._scan_once()
                 if self.mode != "RUN":
                     return
+                continue
+            # perf: the raw byte against the one last seen here first (any
+            # stale value only costs the exact test below)
+            if pi[0] != self._pi0_raw or irq.queued:
+                self._pi0_raw = pi[0]
+                if pi[0] & edge_mask != self._pi0 or irq.queued:
+                    self._input_edges(now, pi[0] & edge_mask)
+            i_img[:] = pi
+            scans = self.scans
+            # perf: time only moves forward and a restore clears the window,
+            # so the window's start (_calm_lo) is never above ``now`` here
+            if now < self._calm_hi and not timers._fast:
+                # perf: SMB0 for this scan's parity, the timer bank's
+                # millisecond (see _calm_start)
+                sm[0] = self._smb0[scans & 1]
+                timers.ms1 = now // 1000
+            else:
+                self._calm_start(sm, scans, now)
+            self._prev_start = self._irq_t = now
+            try:
+                ob1(l_ob1)
+            except Exception as e:
+                self._fault(e)
+            t_to = now + scan_us
+            if self._plain:   # the program can end it (ATCH, PLS, HDEF, STOP...)
+                try:
+                    if step1 is not None:
+                        step1(self, now, t_to)
+                    else:
+                        for step in steps:
+                            step(self, now, t_to)
+                except Exception as e:
+                    self._fault(e)
+                if self._plain and not self.observers:
+                    pq[:] = q
+                    self.scans = scans + 1
+                    self._t_us = t_to
+                    continue
+            else:
+                self._timeline(now, t_to, True)
+            self._scan_end(now)   # only _scan_end can end RUN mode, else a fault raises
+            if self.mode != "RUN":
+                return
 
     def run(self, seconds: Duration | None = None, scans: int | None = None) -> None:
         """Run for a simulated duration (``1.5``, ``"1.5s"``, ``"200ms"``,
@@ -444,7 +518,7 @@ class Plc(AddressAccess):
         # perf: the time line only once a source may have events (a timed
         # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
         # a port's traffic), or a device runs
-        if self.interrupts.timed_next or self._sources_on or self.devices:
+        if self.interrupts.timed_next or self._sources or self.devices:
             self._timeline(now, now + self.scan_us, True)
         self._scan_end(now)
 
@@ -459,18 +533,7 @@ class Plc(AddressAccess):
                     self.scheduler.touch()
         pi0 = pi[0] & self._edge_mask
         if pi0 != self._pi0 or self.interrupts.queued:
-            # input edges from the outside world: their routines run at the
-            # scan's start, before the image is read (System Manual: the
-            # routine runs when the edge occurs; the image changes next scan)
-            irq = self.interrupts
-            self._irq_t = now
-            try:
-                self.timers.refresh_1ms(now)
-                irq.edges(self._pi0, pi0, now)
-                self._pi0 = pi0
-                irq.dispatch(now)
-            except Exception as e:
-                self._fault(e)
+            self._input_edges(now, pi0)
         i_img[:] = pi
         if self._force_slots:
             self._apply_forces()
@@ -490,6 +553,21 @@ class Plc(AddressAccess):
         try:
             if self._ob1 is not None:
                 self._ob1(l_ob1)
+        except Exception as e:
+            self._fault(e)
+
+    def _input_edges(self, now: int, pi0: int) -> None:
+        """Input edges from the outside world (I0.0-I0.3 now ``pi0``) and
+        queued interrupts at a scan's start: their routines run before the
+        image is read (System Manual: the routine runs when the edge occurs;
+        the image changes next scan)."""
+        irq = self.interrupts
+        self._irq_t = now
+        try:
+            self.timers.refresh_1ms(now)
+            irq.edges(self._pi0, pi0, now)
+            self._pi0 = pi0
+            irq.dispatch(now)
         except Exception as e:
             self._fault(e)
 
@@ -530,7 +608,7 @@ class Plc(AddressAccess):
             # perf: the time line only once a source may have events (a timed
             # interrupt attached, or ever a PLS, an HDEF, a CT=PT interrupt or
             # a port's traffic)
-            if self.interrupts.timed_next or self._sources_on:
+            if self.interrupts.timed_next or self._sources:
                 self.scheduler.run(t_from, t_to, first)
             elif self.devices:
                 for dev in self.devices:
@@ -546,7 +624,7 @@ class Plc(AddressAccess):
         pq[:] = q
         # perf: the generators' own fields, not their `running` property,
         # and only once a PLS has run (_sources_on)
-        if self._sources_on and any(po.trains or po.mode == "PWM" for po in self.pulse):
+        if self._sources and any(po.trains or po.mode == "PWM" for po in self.pulse):
             # a running generator drives its terminal, not the image bit
             t_end = now + self.scan_us
             for po in self.pulse:
@@ -565,7 +643,7 @@ class Plc(AddressAccess):
                 _put_bit(pi, inp, pq[out // 8] >> (out % 8) & 1)
         self.scans += 1
         self._t_us = now + self.scan_us
-        if self.stop_requested:
+        if self._stop:
             # STOP instruction: the scan completes, then the CPU switches to
             # STOP and the outputs take their STOP state (off).
             self.mode = "STOP"
@@ -652,10 +730,12 @@ class Plc(AddressAccess):
         if event in (21, 22) or (event < 8 and (self.wiring or self.encoders)):
             self._sources_on = True
         self.scheduler.touch()
+        self._replain()   # a timed interrupt
 
     def _irq_detach(self, event: int) -> None:
         self.interrupts.detach(event)
         self.scheduler.touch()
+        self._replain()
 
     def _irq_enable(self) -> None:
         self.interrupts.enable(self._irq_t)
@@ -968,6 +1048,7 @@ class Plc(AddressAccess):
         dst._force_slots = []
         for key, value in self.forces.items():
             dst.force(key, value)
+        dst._replain()
 
 
 def _binding_pairs(src: Plc, dst: Plc) -> list[tuple[str, Any, Any]]:

@@ -584,6 +584,12 @@ class Harness:
         """``(kind, read)`` of an address spec (see :meth:`Plc.reader`)."""
         return self.plc.reader(spec)
 
+    @property
+    def stop_requested(self) -> bool:
+        """A STOP instruction (or :meth:`request_stop`) ran: the CPU goes to
+        STOP at the end of the scan."""
+        return self.plc.stop_requested
+
     def request_stop(self) -> Harness:
         """Go to STOP at the end of the next scan, as the STOP instruction."""
         self.plc.request_stop()

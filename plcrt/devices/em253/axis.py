@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 from ..motion import Seg, cruise, first_time_at, plan_distance, ramp
 
@@ -65,13 +65,28 @@ class Axis:
         self._next: Optional[tuple[int, int, Callable]] = None  # (t, pos, handler)
         self.pulses_total = 0       #: statistics: pulses generated
         self.last_travel = 0
-        #: perf: before this time (µs) the module need not look at the axis:
-        #: no watched crossing, no end of the move and no change of an input
-        #: bit (RPS, L+, L-, Z) is due (:meth:`next_change`).  Whatever
-        #: changes the axis sets it to 0, so the next step looks again.
-        self.wake = 0
+        #: the module that steps the axis (its quiet time ends whenever
+        #: :attr:`wake` is set), or None
+        self.module: Optional[Any] = None
+        self._wake = 0              #: see :attr:`wake`
         self._stopped_window()
         self.owner: object = None   #: the block instance that commands the axis
+
+    @property
+    def wake(self) -> int:
+        """perf: before this time (µs) the module need not look at the axis:
+        no watched crossing, no end of the move and no change of an input
+        bit (RPS, L+, L-, Z) is due (:meth:`next_change`).  Whatever changes
+        the axis sets it to 0, so the next step looks again; every setting
+        also ends the module's quiet time (EM253Module.quiet_to), which the
+        module computes again from the new value after its step."""
+        return self._wake
+
+    @wake.setter
+    def wake(self, t: int) -> None:
+        self._wake = t
+        if self.module is not None:
+            self.module.quiet_to = 0
 
     # -- state at a time ----------------------------------------------------
     @property
@@ -80,7 +95,7 @@ class Axis:
 
     def _stopped_window(self) -> None:
         """perf: the window of a stopped axis covers all time (travel 0)."""
-        self._w_lo, self._w_hi, self._w_seg = -NEVER, NEVER, _STOPPED
+        self._w_lo, self._w_hi, self._w_seg, self._w_hz = -NEVER, NEVER, _STOPPED, 0
 
     def _seg_at(self, t: int) -> Seg:
         """The segment of the current move that holds time ``t``; it and its
@@ -105,6 +120,10 @@ class Axis:
         self._w_seg = s
         self._w_lo = (segs[i - 1].t1_ceil or 0) if i else -NEVER
         self._w_hi = NEVER if s.t1_ceil is None else s.t1_ceil
+        # perf: a segment at constant speed (a cruise: HA 0) has its signed
+        # speed computed once for the window (the direction is only set by
+        # start(), which empties the window); None: compute it per time
+        self._w_hz = self.direction * (s.HB // s.HD) if s.HA == 0 else None
         return s
 
     def travel(self, t: int) -> int:
@@ -138,8 +157,11 @@ class Axis:
     def speed(self, t: int) -> int:
         """Signed output frequency in Hz (0 when stopped)."""
         if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
-            s = self._w_seg
-            return self.direction * ((s.HA * t + s.HB) // s.HD)
+            hz = self._w_hz
+            if hz is None:
+                s = self._w_seg
+                hz = self.direction * ((s.HA * t + s.HB) // s.HD)
+            return hz
         if not self.segs:
             return 0
         s = self._seg_at(t)

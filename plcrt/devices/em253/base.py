@@ -18,6 +18,12 @@ INNER_OK = 257
 ST_IDLE, ST_RUN, ST_STOPPED = 0, 1, 8
 
 
+def dint(v: int) -> int:
+    """The DINT that holds the low 32 bits of ``v`` (a counter past 2**31
+    wraps, as a masked store of it does)."""
+    return (v + 0x8000_0000) % 0x1_0000_0000 - 0x8000_0000
+
+
 def ramp_rate(v_set: int, v_ss: int, ms: int) -> Fraction:
     """Ramp rate (Hz per µs) from note 3: (SpdSet - SpdSs) / time; a time
     below 1 ms counts as 1 ms."""
@@ -28,6 +34,11 @@ class MotionBlock:
     """Shared per-call-site logic: module lookup, InnerState, diagnostics."""
 
     name = ""
+    #: perf: the results every call returns exactly, in the interface's
+    #: order, and those of them always within their parameter's type: the
+    #: call site unpacks them and writes those without a mask
+    #: (plcrt.blocks.call)
+    exact_results: tuple[str, ...] = ()
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         self.plc = plc
@@ -39,15 +50,32 @@ class MotionBlock:
         self.axis: Optional[Axis] = None
         self.module: Optional[EM253Module] = None
         self._axis_no: Optional[int] = None
-        #: perf: what the instructions' shortcuts compare a call with in one
-        #: test: (EmNo, AxisNo) of the module and axis found by the last
-        #: call, and that plus InnerState 257 once InnerState is initialised
-        self._site: Optional[tuple] = None
-        self._ready: Optional[tuple] = None
+        #: perf: what the instructions' shortcuts compare a call with, one
+        #: integer each (a tuple would be built and compared per call):
+        #: EmNo and AxisNo of the module and axis found by the last call
+        #: (None before), and 257 once InnerState is initialised (None
+        #: before: no argument equals None)
+        self._em: Optional[int] = None
+        self._axn: Optional[int] = None
+        self._inner: Optional[int] = None
+        #: perf: the call site gives EmNo and AxisNo as constants
+        #: (:meth:`constant_args`); once a call found them, every call of
+        #: the site names them: then _site_ok is True and _inner_fixed is
+        #: 257 once InnerState is initialised, and a shortcut compares
+        #: InnerState alone
+        self._fixed = False
+        self._site_ok = False
+        self._inner_fixed: Optional[int] = None
         self.stopping = False
         self.last_pos = 0
         self.last_spd = 0
         self.top = 0  #: SpdSet in force (after clamping to the output limit)
+
+    def constant_args(self, names: frozenset[str]) -> None:
+        """The IN parameters the call site gives as constants (the
+        compiler tells each block once, plcrt.blocks.call)."""
+        self._fixed = "EmNo" in names and (
+            "AxisNo" in names or all(p.name != "AxisNo" for p in self.itf.params))
 
     # -- helpers -----------------------------------------------------------
     def warn(self, msg: str, code: str) -> None:
@@ -79,8 +107,10 @@ class MotionBlock:
         self.module = mod
         self.axis = mod.axes[axis_no] if axis_no is not None else None
         self._axis_no = axis_no
-        self._site = (mod.slot, axis_no)
-        self._ready = (mod.slot, axis_no, INNER_OK) if self.initialised else None
+        self._em, self._axn = mod.slot, axis_no
+        if self._fixed:
+            self._site_ok = True
+            self._inner_fixed = self._inner
         return True
 
     def inner(self, value: int) -> bool:
@@ -93,8 +123,9 @@ class MotionBlock:
                           f"the instruction does not run until it is cleared", "inner0")
                 return False
             self.initialised = True
-            if self._site is not None:
-                self._ready = (*self._site, INNER_OK)
+            self._inner = INNER_OK
+            if self._site_ok:
+                self._inner_fixed = INNER_OK
             return True
         if value != INNER_OK:
             moving = self.axis is not None and self.axis.moving and self.owns()

@@ -31,13 +31,15 @@ from typing import Any
 
 from ...blocks import register_block
 from .axis import distance_plan, stop_plan, velocity_plan
-from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, ramp_rate
+from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, dint, ramp_rate
 from . import pos_run  # noqa: F401  (registers POS_RUN)
 
 
 @register_block("MOTION_EN3")
 class MotionEn3(MotionBlock):
     name = "MOTION_EN3"
+    #: the Clr bits are the inputs' 0/1 (or 0), Status 1 or 4
+    exact_results = ("Clr0", "Clr1", "Status")
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         super().__init__(plc, loc, itf)
@@ -94,6 +96,8 @@ class MotionEn3(MotionBlock):
             out.append(clr)
         status = 4 if any(a.stf for a in mod.axes) else 1
         mod.clr_pending = any(u is not None for u in mod.clr_until)
+        if mod.clr_pending:
+            mod.quiet_to = 0   # the module's next step ends the pulse
         mod.stf_any = status == 4
         result = (out[0], out[1], status)
         self._last_out = result
@@ -104,15 +108,29 @@ class MotionEn3(MotionBlock):
 @register_block("GET_AbsPos")
 class GetAbsPos(MotionBlock):
     name = "GET_AbsPos"
+    #: C_Pos is the counter's low 32 bits as a DINT (dint(): what a masked
+    #: store of the counter writes, so it is stored without a mask)
+    exact_results = ("C_Pos", "C_Status")
     last_out = (0, 0)
 
     def __call__(self, em_no: int, axis_no: int) -> tuple:
         plc = self.plc
-        # perf: the usual case: the module and axis of the last call, enabled
-        # in this scan; the time read from the PLC's field, not its property
-        if (em_no, axis_no) == self._site \
+        # perf: the usual case: the module and axis of the last call (always
+        # so at a site that gives them as constants, once found), enabled in
+        # this scan; the time read from the PLC's field, not its property
+        if (self._site_ok or em_no == self._em and axis_no == self._axn) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
-            self.last_out = out = (self.axis.position(plc._t_us), 1)  # type: ignore[union-attr]
+            ax, t = self.axis, plc._t_us
+            if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
+                # perf: Axis.position inline (its window test and formula)
+                s = ax._w_seg  # type: ignore[union-attr]
+                pos = ax.counter + ax.direction * (  # type: ignore[union-attr]
+                    ((s.A * t + s.B) * t + s.C) // s.D)
+            else:
+                pos = ax.position(t)  # type: ignore[union-attr]
+            if not -0x3FFFFFFF <= pos <= 0x3FFFFFFF:   # perf: one-digit bounds
+                pos = dint(pos)
+            self.last_out = out = (pos, 1)
             return out
         return self.call_exact(em_no, axis_no)
 
@@ -121,18 +139,19 @@ class GetAbsPos(MotionBlock):
         if not self.find(em_no, axis_no):
             return self.last_out
         assert self.axis is not None
-        self.last_out = (self.axis.position(self.now()), 1)
+        self.last_out = (dint(self.axis.position(self.now())), 1)
         return self.last_out
 
 
 @register_block("SET_AbsPos")
 class SetAbsPos(MotionBlock):
     name = "SET_AbsPos"
+    exact_results = ("Start", "C_Status")
 
     def __call__(self, em_no: int, axis_no: int, pos: int, start: int) -> tuple:
         # perf: Start = 0 with the module and axis of the last call, enabled
         # in this scan: nothing to do
-        if not start and (em_no, axis_no) == self._site \
+        if not start and (self._site_ok or em_no == self._em and axis_no == self._axn) \
                 and self.module.enabled_scan == self.plc.scans:  # type: ignore[union-attr]
             return 0, self.status
         return self.call_exact(em_no, axis_no, pos, start)
@@ -152,20 +171,37 @@ class SetAbsPos(MotionBlock):
 @register_block("SPD_CTRL")
 class SpdCtrl(MotionBlock):
     name = "SPD_CTRL"
+    #: InnerState and Update are 257 and 0 or the inputs as read, C_Spd a
+    #: speed within the output limit (500 kHz at most)
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd")
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, inner, update, direction,
                  e_stop, run) -> tuple:
         # perf: no E_Stop, InnerState as the block keeps it, the module and
-        # axis of the last call enabled in this scan, and either steady
-        # running (the block's own move, Run held, nothing to update) or
-        # nothing to start (no move of this block, no Run edge): command()
-        # has nothing to do, only C_Spd and C_Status to report
-        ax, plc = self.axis, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+        # axis of the last call (at a site with constant EmNo and AxisNo,
+        # InnerState alone tells: MotionBlock._inner_fixed) enabled in this
+        # scan, and either steady running (the block's own move, Run held,
+        # nothing to update) or nothing to start (no move of this block, no
+        # Run edge): command() has nothing to do, only C_Spd and C_Status to
+        # report
+        plc = self.plc
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
+                and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax = self.axis
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
-                    self.last_spd = spd = ax.speed(plc._t_us)
+                    t = plc._t_us
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed inline (its window test and formula)
+                        spd = ax._w_hz
+                        if spd is None:
+                            s = ax._w_seg
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                    else:
+                        spd = ax.speed(t)
+                    self.last_spd = spd
                     return INNER_OK, 0, self.status, spd
             elif self.prev_run or not run:
                 self.prev_run = run
@@ -256,6 +292,8 @@ class SpdCtrl(MotionBlock):
 @register_block("POS_GOTO_R")
 class PosGotoR(MotionBlock):
     name = "POS_GOTO_R"
+    #: C_Pos counts up to |PosSet|, which is 2**31 for PosSet -2**31: masked
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd")
     c_pos = 0   #: the C_Pos last written
 
     def __call__(self, em_no, axis_no, acc, dec, v_ss, v_set, pos, inner, update, e_stop,
@@ -265,14 +303,26 @@ class PosGotoR(MotionBlock):
         # this block running with Run held and nothing to update, or nothing
         # to start (no move of this block, no Run edge): command() has
         # nothing to do, only C_Pos, C_Spd and C_Status to report
-        ax, plc = self.axis, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+        plc = self.plc
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
+                and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax = self.axis
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
-                    self.last_spd = spd = ax.speed(t)
-                    self.c_pos = c_pos = ax.travel(t)
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed and Axis.travel inline (their
+                        # window test and formulas)
+                        s = ax._w_seg
+                        spd = ax._w_hz
+                        if spd is None:
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                        c_pos = ((s.A * t + s.B) * t + s.C) // s.D
+                    else:
+                        spd, c_pos = ax.speed(t), ax.travel(t)
+                    self.last_spd, self.c_pos = spd, c_pos
                     return INNER_OK, 0, self.status, c_pos, spd
             elif self.prev_run or not run:
                 self.prev_run = run
@@ -377,6 +427,7 @@ class Homing(MotionBlock):
     :mod:`.homing`."""
 
     name = "HOMING"
+    exact_results = ("InnerState", "C_Status", "C_Spd")
 
     def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
         super().__init__(plc, loc, itf)
@@ -389,15 +440,26 @@ class Homing(MotionBlock):
         # either the axis moving for this block (poll() has nothing to
         # report) with Run held or no homing active, or no homing active
         # and the axis not moving for it: only C_Spd and C_Status to report
-        ax, seq, plc = self.axis, self.seq, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop \
-                and (self.prev_run or not run) \
+        plc = self.plc
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
+                and not e_stop and (self.prev_run or not run) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax, seq = self.axis, self.seq
             active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
                 if run or not active:
                     self.prev_run = run
-                    self.last_spd = spd = ax.speed(plc._t_us)
+                    t = plc._t_us
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.speed inline (its window test and formula)
+                        spd = ax._w_hz
+                        if spd is None:
+                            s = ax._w_seg
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                    else:
+                        spd = ax.speed(t)
+                    self.last_spd = spd
                     return INNER_OK, self.status, spd
             elif not active:
                 self.prev_run = run

@@ -36,6 +36,13 @@ class EM253Module:
         self.slot = cfg.slot
         self.configured = set(cfg.axes)
         self.axes = [Axis(cfg.axes.get(i, AxisPlant())) for i in (0, 1)]
+        #: perf: a step to a time before this one has nothing to compute:
+        #: no axis is due (Axis.wake), no scripted input event, no CLR
+        #: pulse pending or shown.  Computed after every exact step; 0
+        #: (look again) whenever an axis's wake is set or a CLR pulse starts
+        self.quiet_to = 0
+        for ax in self.axes:
+            ax.module = self
         model = plc.model
         if self.slot >= model.max_modules:
             raise PlcConfigError(
@@ -59,7 +66,10 @@ class EM253Module:
         self._q = plc.mem.areas["Q"]
         self._di2 = slice(self.di, self.di + 2)
         self._do2 = slice(self.do, self.do + 2)
-        self._in2 = self._out2 = b"\0\0"   #: the terminal bytes last written
+        #: the terminal bytes last written (perf: bytearrays, never handed
+        #: out: a slice store from a bytearray copies its bytes at once,
+        #: one from bytes first makes a bytearray of them)
+        self._in2, self._out2 = bytearray(2), bytearray(2)
         self._plant_next = NEVER   #: time of the next scripted input (STF) event
         self._clr_shown = False    #: a CLR output bit is on in the bytes last written
         self._write_terminals(0)
@@ -71,14 +81,11 @@ class EM253Module:
 
     def step(self, plc: Any, t_from: int, t_to: int) -> None:
         """Advance both axes over (t_from, t_to] and write the terminals."""
-        a0, a1 = self.axes
-        # perf: nothing is due on either axis (Axis.wake: no crossing, no
-        # end of a move, no input bit change, no command since the last
-        # step), no scripted input event, no CLR pulse pending and none
-        # shown: the terminals are the bytes of the last step, written again
-        # as every scan does
-        if t_to < a0.wake and t_to < a1.wake and t_to < self._plant_next \
-                and not self.clr_pending and not self._clr_shown:
+        # perf: inside the quiet time (quiet_to: nothing due on either axis,
+        # no scripted input event, no CLR pulse pending and none shown) the
+        # terminals are the bytes of the last step, written again as every
+        # scan does
+        if t_to < self.quiet_to:
             self._pi[self._di2] = self._in2
             self._q[self._do2] = self._out2
             return
@@ -98,6 +105,9 @@ class EM253Module:
             ax.advance(t_to)
         self._write_terminals(t_to, t_from)
         self._plant_next = min((evs[0][0] for evs in self._events if evs), default=NEVER)
+        a0, a1 = self.axes
+        self.quiet_to = 0 if self.clr_pending or self._clr_shown else \
+            min(a0.wake, a1.wake, self._plant_next)
 
     def set_stf(self, i: int, t: int, value: bool) -> None:
         """Hardware emergency stop: pulses stop at once, no ramp (manual 2.1)."""
@@ -129,8 +139,8 @@ class EM253Module:
                 cache[i] = self._bytes(ax, t, clr)
                 ax.wake = ax.next_change(t)
         (b0, o0), (b1, o1) = cache  # type: ignore[misc]
-        self._in2 = self._pi[self._di2] = bytes((b0, b1))
-        self._out2 = self._q[self._do2] = bytes((o0, o1))
+        self._in2 = self._pi[self._di2] = bytearray((b0, b1))
+        self._out2 = self._q[self._do2] = bytearray((o0, o1))
         # a CLR bit on: the next step must see MOTION_EN3 end the pulse
         self._clr_shown = bool((o0 | o1) & 2)
 

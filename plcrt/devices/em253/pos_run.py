@@ -23,6 +23,8 @@ MAX_STEPS = 32
 @register_block("POS_RUN")
 class PosRun(MotionBlock):
     name = "POS_RUN"
+    #: C_Step is 0..32; C_Pos (pulses of a step, up to |PosSet|) is masked
+    exact_results = ("InnerState", "Update", "C_Status", "C_Spd", "C_Step")
     mode_in = 0   #: the Mode input of the current call
     _b_of: object = None   #: the bounds list _b_ceil and _b_floor were made from
 
@@ -34,15 +36,28 @@ class PosRun(MotionBlock):
         # update, or nothing to start (no envelope of this block running,
         # no Run edge): command() has nothing to do, only C_Step, C_Pos,
         # C_Spd and C_Status to report
-        ax, plc = self.axis, self.plc
-        if (em_no, axis_no, inner) == self._ready and not e_stop and not update \
+        plc = self.plc
+        if (inner == self._inner_fixed
+                or inner == self._inner and em_no == self._em and axis_no == self._axn) \
+                and not e_stop and not update \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
+            ax = self.axis
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
                     self.mode_in = mode
-                    self.last = (step, c_pos) = self._step_at(ax.travel(t))
-                    self.last_spd = spd = ax.speed(t)
+                    if ax._w_lo <= t < ax._w_hi:
+                        # perf: Axis.travel and Axis.speed inline (their
+                        # window test and formulas)
+                        s = ax._w_seg
+                        x = ((s.A * t + s.B) * t + s.C) // s.D
+                        spd = ax._w_hz
+                        if spd is None:
+                            spd = ax.direction * ((s.HA * t + s.HB) // s.HD)
+                    else:
+                        x, spd = ax.travel(t), ax.speed(t)
+                    self.last = (step, c_pos) = self._step_at(x)
+                    self.last_spd = spd
                     return INNER_OK, 0, self.status, c_pos, spd, step
             elif self.prev_run or not run:
                 self.prev_run = run

@@ -62,7 +62,8 @@ def _run(items: list[tuple[Addr, str, int]], joined: bool) -> tuple[bytes, ...]:
                 g.wbit(op, expr)
             else:
                 g.wr(op, kind, expr)
-    areas = {"V": bytearray(range(40)), "M": bytearray(b"\xa5" * 40), "AC": bytearray(16)}
+    # the strategy's last address is at most 8 + 7 * 7 = 57, 4 bytes wide
+    areas = {"V": bytearray(range(72)), "M": bytearray(b"\xa5" * 72), "AC": bytearray(16)}
     ns: dict[str, Any] = dict(CODECS, **areas, r=[_value(k, v) for _, k, v in items])
     exec("\n".join(line.strip() for line in g.lines), ns)
     return tuple(bytes(b) for b in areas.values())

@@ -44,6 +44,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TextIO
 
+from ..engine.access import force_covers
 from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError, PlcRuntimeError
@@ -289,21 +290,8 @@ class Session:
         return self.plc.locate(spec)[:4]
 
     def _is_forced(self, spec: str) -> bool:
-        """Whether any forced address overlaps ``spec`` (forcing Q0.0 marks
-        QB0 too: part of what it shows cannot change)."""
-        if not self.plc.forces:
-            return False
-        buf, off, width, bit = self._location(spec)
-        for key in self.plc.forces:
-            fbuf, foff, fwidth, fbit = self._location(key)
-            if fbuf is not buf:
-                continue
-            if width == 0 and fwidth == 0:
-                if off == foff and bit == fbit:
-                    return True
-            elif off < foff + max(fwidth, 1) and foff < off + max(width, 1):
-                return True
-        return False
+        """Whether any forced address overlaps ``spec`` (see force_covers)."""
+        return force_covers(self.plc, spec)
 
     # ------------------------------------------------------------------
     # Networks and breakpoints

@@ -16,7 +16,7 @@ from typing import Any, Callable, Sequence
 
 from ..compiler.operands import Addr, OperandError, parse_operand
 from ..compiler.rt import CODECS
-from ..errors import PlcAddressError
+from ..errors import PlcAddressError, PlcError
 from ..safetext import excerpt, printable
 from .values import check_address, check_value, split_format
 
@@ -227,6 +227,29 @@ class AddressAccess:
 
 #: big-endian signed decoders of words and double words
 _SIGNED = {2: struct.Struct(">h").unpack_from, 4: struct.Struct(">i").unpack_from}
+
+
+def force_covers(plc: Any, spec: str) -> bool:
+    """Whether a forced address overlaps ``spec`` (forcing Q0.0 marks QB0
+    too: part of what it shows cannot change), as Micro/WIN's status chart
+    marks a forced value; False for an address that does not resolve.
+    The debugger's and the panel's watch tables mark their rows with it."""
+    if not plc.forces:
+        return False
+    try:
+        buf, off, width, bit = plc.locate(spec)[:4]
+    except PlcError:
+        return False
+    for key in plc.forces:
+        fbuf, foff, fwidth, fbit = plc.locate(key)[:4]
+        if fbuf is not buf:
+            continue
+        if width == 0 and fwidth == 0:
+            if off == foff and bit == fbit:
+                return True
+        elif off < foff + max(fwidth, 1) and foff < off + max(width, 1):
+            return True
+    return False
 
 
 def _same_loc(a: Sequence[Any], b: Sequence[Any]) -> bool:

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..cli import SetItem, apply_sets, parse_sets
+from ..engine.access import force_covers
 from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError, PlcRuntimeError
@@ -759,23 +760,7 @@ class PanelSession:
 
     def _is_forced(self, spec: str) -> bool:
         """Whether a force overlaps ``spec`` (forcing Q0.0 marks QB0 too)."""
-        plc = self.plc
-        if not plc.forces:
-            return False
-        try:
-            buf, off, width, bit = plc.locate(spec)[:4]
-        except PlcError:
-            return False
-        for key in plc.forces:
-            fbuf, foff, fwidth, fbit = plc.locate(key)[:4]
-            if fbuf is not buf:
-                continue
-            if width == 0 and fwidth == 0:
-                if off == foff and bit == fbit:
-                    return True
-            elif off < foff + max(fwidth, 1) and foff < off + max(width, 1):
-                return True
-        return False
+        return force_covers(self.plc, spec)
 
 
 __all__ = ["CHUNK_S", "Client", "DISPLAY_HZ", "Mailbox", "PanelSession", "TREND_MAX"]

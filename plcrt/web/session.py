@@ -566,22 +566,20 @@ class PanelSession:
         if self._until is not None:
             pred, what, deadline = self._until
             if pred():
-                self._until = None
-                self.state = "stopped"
-                self._broadcast({"type": "notice", "level": "info",
-                                 "message": printable(f"'{what}' is true at "
-                                                      f"t={self.plc.time:g} s")})
-                return True
+                return self._end_until("info", f"'{what}' is true at t={self.plc.time:g} s")
             if self.plc.now_us >= deadline:
-                self._until = None
-                self.state = "stopped"
-                self._broadcast({"type": "notice", "level": "warning",
-                                 "message": printable(f"'{what}' still false at the "
-                                                      f"timeout (t={self.plc.time:g} s)")})
-                return True
+                return self._end_until("warning", f"'{what}' still false at the timeout "
+                                                  f"(t={self.plc.time:g} s)")
         if self.state not in ("running", "stepping", "until"):
             return True
         return self.plc.mode != "RUN"
+
+    def _end_until(self, level: str, message: str) -> bool:
+        """A run until a condition ends (met or timed out): stop and say so."""
+        self._until = None
+        self.state = "stopped"
+        self._broadcast({"type": "notice", "level": level, "message": printable(message)})
+        return True
 
     def _scans_now(self) -> int:
         """How many scans this chunk runs."""
@@ -625,8 +623,7 @@ class PanelSession:
         old = self.plc
         if (old.coverage is not None) == probes:
             return
-        backend = self._home[1] if probes == self._home[0] else "python"
-        new = old.recompiled(instrument=probes, backend=backend)
+        new = old.recompiled(instrument=probes, backend=self._backend(probes))
         new.observers[:] = old.observers
         self.plc = new
         self.harness = Harness(new)
@@ -646,10 +643,15 @@ class PanelSession:
         snap = self._power_ups.get(probes)
         if snap is None:
             home = self._power_ups[self._home[0]]
-            backend = self._home[1] if probes == self._home[0] else "python"
             snap = self._power_ups[probes] = home.recompiled(instrument=probes,
-                                                             backend=backend)
+                                                             backend=self._backend(probes))
         return snap
+
+    def _backend(self, probes: bool) -> str:
+        """The backend of the build with (or without) probes: the loaded
+        one's for its own kind, Python for the other (the native backend
+        does not compile probes)."""
+        return self._home[1] if probes == self._home[0] else "python"
 
     def _on_break(self, net: NetworkRef) -> None:
         """Called by the program's code before a network with a breakpoint;

@@ -460,7 +460,7 @@ class Plc(AddressAccess):
         if held is not None and len(held) == 2:
             (hb0, hs0, hd0), (hb1, hs1, hd1) = held
         else:
-            held = None
+            dev1 = _NOT_QUIET   # never quiet: the test below is always False
         irq, timers, ob1 = self.interrupts, self.timers, self._ob1
         scan_us, edge_mask = self.scan_us, self._edge_mask
         if self.mode != "RUN":
@@ -497,7 +497,7 @@ class Plc(AddressAccess):
             t_to = now + scan_us
             if self._plain:   # the program can end it (ATCH, PLS, HDEF, STOP...)
                 try:
-                    if held is not None and t_to < dev1.quiet_to and dev1.held is held:
+                    if t_to < dev1.quiet_to and dev1.held is held:
                         hb0[hs0] = hd0
                         hb1[hs1] = hd1
                     elif step1 is not None:
@@ -1040,6 +1040,15 @@ class Plc(AddressAccess):
             dst.force(key, value)
         dst._replain()
 
+
+class _NotQuiet:
+    """The scan loop's stand-in for a device without held runs: never quiet."""
+
+    quiet_to = -1
+    held = None
+
+
+_NOT_QUIET = _NotQuiet()
 
 #: SMB0 of every scan but the first, by the scan count's parity: SM0.0
 #: (always on), SM0.7 (RUN switch position), SM0.6 (on every other scan)

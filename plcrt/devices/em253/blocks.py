@@ -446,9 +446,8 @@ class Homing(MotionBlock):
                 and not e_stop and (self.prev_run or not run) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax, seq = self.axis, self.seq
-            active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
-                if run or not active:
+                if run or seq is None or not seq.active:
                     self.prev_run = run
                     t = plc._t_us
                     if ax._w_lo <= t < ax._w_hi:
@@ -461,7 +460,7 @@ class Homing(MotionBlock):
                         spd = ax.speed(t)
                     self.last_spd = spd
                     return INNER_OK, self.status, spd
-            elif not active:
+            elif seq is None or not seq.active:
                 self.prev_run = run
                 if self.status == ST_RUN:
                     self.status = ST_STOPPED

@@ -32,6 +32,9 @@ from typing import Any
 from ...blocks import register_block
 from .axis import distance_plan, stop_plan, velocity_plan
 from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, dint, ramp_rate
+# imported with the library, not at the first homing: the import (its
+# dataclasses are compiled) took milliseconds inside that scan
+from .homing import MODES, HomingSequence
 from . import pos_run  # noqa: F401  (registers POS_RUN)
 
 
@@ -514,7 +517,6 @@ class Homing(MotionBlock):
                   "200 kHz: the homing keeps its speeds", "dorccw")
 
     def _start(self, t: int, mode: int, v_low: int, v_high: int, offset: int) -> None:
-        from .homing import MODES, HomingSequence
         assert self.axis is not None
         if mode not in MODES:
             self.warn(f"HomingMode {mode} is not one of 0..14: nothing happens", "mode")

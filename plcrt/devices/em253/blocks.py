@@ -126,9 +126,8 @@ class GetAbsPos(MotionBlock):
             ax, t = self.axis, plc._t_us
             if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
                 # perf: Axis.position inline (its window test and formula)
-                s = ax._w_seg  # type: ignore[union-attr]
-                pos = ax.counter + ax.direction * (  # type: ignore[union-attr]
-                    ((s.A * t + s.B) * t + s.C) // s.D)
+                a, b, c, d = ax._w_pos  # type: ignore[union-attr]
+                pos = ((a * t + b) * t + c) // d
             else:
                 pos = ax.position(t)  # type: ignore[union-attr]
             if not -0x3FFFFFFF <= pos <= 0x3FFFFFFF:   # perf: one-digit bounds

@@ -370,8 +370,9 @@ class Gen:
                         self.line(f"{now} = {self.use('_bits')}[{buf}[{op.offset}]]")
                         differs = " or ".join(f"{e} != {now}[{o.bit}]"
                                               for o, _, e in items[i:j])
-                        with self.block(f"if {differs}:"):
-                            self.line(store)
+                        # one line, not a suite: the logic stack's pending
+                        # value has nothing to do with it and stays pending
+                        self.line(f"if {differs}: {store}")
                     else:
                         self.line(store)
             else:

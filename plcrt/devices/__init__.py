@@ -134,6 +134,15 @@ class Device(Protocol):
     def snapshot(self, t: int) -> list[AxisState]:
         """Per-axis state for status displays, tests and JSON."""
 
+    # Optional (perf): a device whose step, to any time before ``quiet_to``
+    # (µs), only stores the same bytes again (its terminals) may list them
+    # as ``held``: a tuple of (buffer, slice, bytearray) runs, changed in
+    # place by the device, replaced only by a restore.  The scan loop then
+    # stores two such runs itself instead of calling ``step``.
+    #
+    #   quiet_to: int
+    #   held: tuple[tuple[bytearray, slice, bytearray], ...]
+
 
 def build_devices(plc: Any, plant: Any) -> list[Any]:
     """Create the devices a plant describes (table of module kinds)."""

@@ -446,8 +446,21 @@ class Plc(AddressAccess):
         i_img, pi, sm, l_ob1 = self._bufs_begin
         q, pq = self._bufs_end[1:]
         steps = [dev.step for dev in self.devices]
-        # perf: one device (an EM253, a drive...) is called without a loop
+        # perf: one device (an EM253, a drive...) is called without a loop,
+        # and its quiet steps (plcrt.devices.Device: before ``quiet_to`` a
+        # step stores its two ``held`` byte runs again, nothing else) are
+        # done here without calling it, while ``held`` is still the tuple
+        # seen now (a restore replaces it) and the device's step is its
+        # class's
         step1 = steps.pop() if len(steps) == 1 else None
+        dev1 = self.devices[0] if step1 is not None else None
+        held = getattr(dev1, "held", None)
+        if getattr(step1, "__func__", None) is not getattr(type(dev1), "step", None):
+            held = None   # its step replaced on the instance (a wrapper): call it
+        if held is not None and len(held) == 2:
+            (hb0, hs0, hd0), (hb1, hs1, hd1) = held
+        else:
+            dev1 = _NOT_QUIET   # never quiet: the test below is always False
         irq, timers, ob1 = self.interrupts, self.timers, self._ob1
         scan_us, edge_mask = self.scan_us, self._edge_mask
         if self.mode != "RUN":
@@ -484,7 +497,10 @@ class Plc(AddressAccess):
             t_to = now + scan_us
             if self._plain:   # the program can end it (ATCH, PLS, HDEF, STOP...)
                 try:
-                    if step1 is not None:
+                    if t_to < dev1.quiet_to and dev1.held is held:
+                        hb0[hs0] = hd0
+                        hb1[hs1] = hd1
+                    elif step1 is not None:
                         step1(self, now, t_to)
                     else:
                         for step in steps:
@@ -1085,6 +1101,15 @@ def _binding_pairs(src: Plc, dst: Plc) -> list[tuple[str, Any, Any]]:
             pairs.append((name, obj, other))
     return pairs
 
+
+class _NotQuiet:
+    """The scan loop's stand-in for a device without held runs: never quiet."""
+
+    quiet_to = -1
+    held = None
+
+
+_NOT_QUIET = _NotQuiet()
 
 #: SMB0 of every scan but the first, by the scan count's parity: SM0.0
 #: (always on), SM0.7 (RUN switch position), SM0.6 (on every other scan)

@@ -244,3 +244,37 @@ def test_get_abspos_wraps_the_counter_as_a_dint(start: int, direction: int,
         assert fast["VD120"] == (count + 2**31) % 2**32 - 2**31
         seen.add(count > 2**31 - 1 or count < -2**31)
     assert seen == {False, True} if abs(start) > 2**30 else seen == {False}
+
+
+def test_a_restore_by_an_observer_inside_one_scan_call_reaches_the_terminals() -> None:
+    """The scan loop stores a quiet module's terminal bytes itself (its
+    ``held`` runs); an observer that restores a snapshot in the middle of
+    one ``scan(n)`` replaces them: the scans after it store the restored
+    module's bytes, as scan by scan."""
+    runs: list[plcrt.Plc] = []
+    for one_call in (True, False):
+        plc = _load("spd_ctrl.awl", 1)
+        for bit in ("M1.0", "M1.3"):
+            plc[bit] = 0
+        plc.scan(10)
+        stopped = plc.snapshot()
+        assert plc["QB2"] & 4 == 0                       # P off: no pulses
+        for bit in ("M1.0", "M1.3"):
+            plc[bit] = 1
+        plc.scan(300)
+        assert plc["QB2"] & 4                            # pulsing
+
+        def back(p: plcrt.Plc, snap: plcrt.Plc = stopped) -> None:
+            if p.scans == 400:
+                p.restore(snap)
+
+        plc.observers.append(back)
+        if one_call:
+            plc.scan(200)
+        else:
+            for _ in range(200):
+                plc.scan()
+        runs.append(plc)
+    fast, ref = runs
+    assert fast.scans == ref.scans and _memory(fast) == _memory(ref)
+    assert fast["QB2"] & 4 == 0 and not fast.module(0).axes[0].segs

@@ -96,6 +96,7 @@ class Axis:
     def _stopped_window(self) -> None:
         """perf: the window of a stopped axis covers all time (travel 0)."""
         self._w_lo, self._w_hi, self._w_seg, self._w_hz = -NEVER, NEVER, _STOPPED, 0
+        self._w_pos = (0, 0, self.counter, 1)
 
     def _seg_at(self, t: int) -> Seg:
         """The segment of the current move that holds time ``t``; it and its
@@ -124,7 +125,21 @@ class Axis:
         # speed computed once for the window (the direction is only set by
         # start(), which empties the window); None: compute it per time
         self._w_hz = self.direction * (s.HB // s.HD) if s.HA == 0 else None
+        self._w_pos = self._position_poly(s)
         return s
+
+    def _position_poly(self, s: Seg) -> tuple[int, int, int, int]:
+        """perf: (a, b, c, d) with the position counter at every time t of
+        segment ``s`` equal to ((a t + b) t + c) // d: the counter and the
+        direction folded into the travel's polynomial.  Going forward that
+        is counter + N // D (N the travel's numerator); going backwards,
+        counter - N // D, and -(N // D) == (D - 1 - N) // D for D > 0.
+        Valid while the counter and the direction stay (a window is left
+        or recomputed whenever they change)."""
+        base = self.counter * s.D
+        if self.direction > 0:
+            return s.A, s.B, s.C + base, s.D
+        return -s.A, -s.B, base - s.C + s.D - 1, s.D
 
     def travel(self, t: int) -> int:
         """Whole pulses of the current move emitted by time ``t``."""
@@ -143,9 +158,9 @@ class Axis:
 
     def position(self, t: int) -> int:
         """The module's position counter at time ``t``."""
-        if self._w_lo <= t < self._w_hi:   # perf: travel() inline
-            s = self._w_seg
-            return self.counter + self.direction * (((s.A * t + s.B) * t + s.C) // s.D)
+        if self._w_lo <= t < self._w_hi:   # perf: the window's counter polynomial
+            a, b, c, d = self._w_pos
+            return ((a * t + b) * t + c) // d
         return self.counter + self.direction * self.travel(t)
 
     def mechanical(self, t: int) -> int:
@@ -249,6 +264,11 @@ class Axis:
         mech = self.mechanical(t)
         self.wake = 0
         self.counter = value - self.direction * n
+        # the window's position polynomial holds the old counter
+        if self.segs:
+            self._w_lo = self._w_hi = 0   # no window until a reader finds one
+        else:
+            self._stopped_window()
         if not self.masked:
             self.mech_offset = mech - value
 

@@ -32,6 +32,9 @@ from typing import Any
 from ...blocks import register_block
 from .axis import distance_plan, stop_plan, velocity_plan
 from .base import INNER_OK, ST_RUN, ST_STOPPED, MotionBlock, dint, ramp_rate
+# imported with the library, not at the first homing: the import (its
+# dataclasses are compiled) took milliseconds inside that scan
+from .homing import MODES, HomingSequence
 from . import pos_run  # noqa: F401  (registers POS_RUN)
 
 
@@ -123,9 +126,8 @@ class GetAbsPos(MotionBlock):
             ax, t = self.axis, plc._t_us
             if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
                 # perf: Axis.position inline (its window test and formula)
-                s = ax._w_seg  # type: ignore[union-attr]
-                pos = ax.counter + ax.direction * (  # type: ignore[union-attr]
-                    ((s.A * t + s.B) * t + s.C) // s.D)
+                a, b, c, d = ax._w_pos  # type: ignore[union-attr]
+                pos = ((a * t + b) * t + c) // d
             else:
                 pos = ax.position(t)  # type: ignore[union-attr]
             if not -0x3FFFFFFF <= pos <= 0x3FFFFFFF:   # perf: one-digit bounds
@@ -446,9 +448,8 @@ class Homing(MotionBlock):
                 and not e_stop and (self.prev_run or not run) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax, seq = self.axis, self.seq
-            active = seq is not None and seq.active
             if ax.owner is self and ax.segs:
-                if run or not active:
+                if run or seq is None or not seq.active:
                     self.prev_run = run
                     t = plc._t_us
                     if ax._w_lo <= t < ax._w_hi:
@@ -461,7 +462,7 @@ class Homing(MotionBlock):
                         spd = ax.speed(t)
                     self.last_spd = spd
                     return INNER_OK, self.status, spd
-            elif not active:
+            elif seq is None or not seq.active:
                 self.prev_run = run
                 if self.status == ST_RUN:
                     self.status = ST_STOPPED
@@ -515,7 +516,6 @@ class Homing(MotionBlock):
                   "200 kHz: the homing keeps its speeds", "dorccw")
 
     def _start(self, t: int, mode: int, v_low: int, v_high: int, offset: int) -> None:
-        from .homing import MODES, HomingSequence
         assert self.axis is not None
         if mode not in MODES:
             self.warn(f"HomingMode {mode} is not one of 0..14: nothing happens", "mode")

@@ -70,6 +70,8 @@ class EM253Module:
         #: out: a slice store from a bytearray copies its bytes at once,
         #: one from bytes first makes a bytearray of them)
         self._in2, self._out2 = bytearray(2), bytearray(2)
+        #: perf: the runs a quiet step stores (plcrt.devices.Device)
+        self.held = ((self._pi, self._di2, self._in2), (self._q, self._do2, self._out2))
         self._plant_next = NEVER   #: time of the next scripted input (STF) event
         self._clr_shown = False    #: a CLR output bit is on in the bytes last written
         self._write_terminals(0)
@@ -139,8 +141,11 @@ class EM253Module:
                 cache[i] = self._bytes(ax, t, clr)
                 ax.wake = ax.next_change(t)
         (b0, o0), (b1, o1) = cache  # type: ignore[misc]
-        self._in2 = self._pi[self._di2] = bytearray((b0, b1))
-        self._out2 = self._q[self._do2] = bytearray((o0, o1))
+        # in place: the bytearrays are those of ``held``
+        self._in2[0], self._in2[1] = b0, b1
+        self._out2[0], self._out2[1] = o0, o1
+        self._pi[self._di2] = self._in2
+        self._q[self._do2] = self._out2
         # a CLR bit on: the next step must see MOTION_EN3 end the pulse
         self._clr_shown = bool((o0 | o1) & 2)
 

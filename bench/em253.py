@@ -18,7 +18,14 @@ Run ``python bench/em253.py`` (``--json`` for one JSON object).  It
    ("x real time") and microseconds per scan, with the machine it ran on.
 
 Each repeat loads a fresh PLC (not timed) and runs the window from
-power-up, so every repeat does the same work.  This is a measuring tool:
+power-up, so every repeat does the same work.
+
+``--against DIR`` measures side by side instead: DIR is another checkout
+(``git worktree add DIR <commit>``) whose ``bench/em253.py`` has
+``--json``; the two alternate in fresh processes for ``--rounds``
+rounds, and the script prints each example's median speed on both sides
+and the median of the per-round ratios.  On a shared machine whose speed
+moves from minute to minute, that ratio is the figure that holds.  This is a measuring tool:
 it asserts nothing and never fails on slow results unless ``--check`` is
 given (exit 1 below the target of 300 x real time).
 """
@@ -29,6 +36,8 @@ import argparse
 import dataclasses
 import gc
 import json
+import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -255,6 +264,44 @@ def _line(r: Result) -> str:
             f"- {verdict} {TARGET_X:g} x" + (f"  [{r.source}]" if r.source != "file" else ""))
 
 
+def _bench_json(root: Path, args: argparse.Namespace) -> dict[str, float]:
+    """x real time per example of the bench in checkout ``root``, run in a
+    fresh process with this run's options."""
+    cmd = [sys.executable, str(root / "bench" / "em253.py"), "--json",
+           "--repeats", str(args.repeats), "--seconds", str(args.seconds),
+           "--scan-ms", str(args.scan_ms)]
+    out = subprocess.run(cmd, cwd=root, capture_output=True, text=True, check=True).stdout
+    return {e["name"]: e["x_real_time"] for e in json.loads(out)["examples"]}
+
+
+def compare(against: Path, args: argparse.Namespace) -> int:
+    """Alternate this checkout's bench with ``against``'s; print medians."""
+    if not (against / "bench" / "em253.py").is_file():
+        print(f"error: {against} has no bench/em253.py", file=sys.stderr)
+        return 2
+    sides: dict[str, list[dict[str, float]]] = {"this": [], "other": []}
+    for k in range(args.rounds):
+        # the order flips every round, so neither side always runs first
+        order = [("this", ROOT), ("other", against)]
+        for side, root in order if k % 2 == 0 else order[::-1]:
+            sides[side].append(_bench_json(root, args))
+        print(f"round {k + 1}: slowest example {min(sides['this'][-1].values()):.0f} x here, "
+              f"{min(sides['other'][-1].values()):.0f} x there", flush=True)
+    names = sorted(set(sides["this"][0]) & set(sides["other"][0]))
+    print(f"{args.rounds} rounds, best of {args.repeats} each, x real time "
+          f"(median over rounds; ratio: median of the per-round ratios):")
+    print(f"  {'example':<22} {'here':>7} {'there':>7} {'ratio':>6}   here, every round")
+    rows = [(n, [r[n] for r in sides["this"]], [r[n] for r in sides["other"]])
+            for n in names]
+    rows.append(("slowest example", [min(r.values()) for r in sides["this"]],
+                 [min(r.values()) for r in sides["other"]]))
+    for name, here, there in rows:
+        ratio = statistics.median(a / b for a, b in zip(here, there))
+        print(f"  {name:<22} {statistics.median(here):7.0f} {statistics.median(there):7.0f} "
+              f"{ratio:6.2f}   " + " ".join(f"{x:.0f}" for x in here))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
@@ -264,7 +311,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats (best is kept)")
     ap.add_argument("--check", action="store_true",
                     help=f"exit 1 when a case is below {TARGET_X:g} x real time")
+    ap.add_argument("--against", type=Path, metavar="DIR",
+                    help="another checkout to measure side by side with this one")
+    ap.add_argument("--rounds", type=int, default=6,
+                    help="rounds of the side-by-side comparison (default 6)")
     args = ap.parse_args(argv)
+    if args.against is not None:
+        return compare(args.against.resolve(), args)
 
     opts = {"seconds": args.seconds, "scan_ms": args.scan_ms, "repeats": args.repeats}
     examples = [measure(c, **opts) for c in example_cases()]

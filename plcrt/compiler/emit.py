@@ -384,7 +384,18 @@ class Gen:
                         break
                     end = nxt
                     j += 1
-                if j - i == 1:
+                if j - i == 1 and exacts[i] and kind in ("W", "WU") \
+                        and end is not None and expr.isidentifier():
+                    # perf: a lone word result of a block (mostly a status
+                    # word, the same scan after scan) is stored only when
+                    # the memory does not hold it already: two byte reads
+                    # and compares instead of a struct call.  Only a value
+                    # of 0..255 can match the bytes (0, v); any other is
+                    # always stored
+                    buf = self._buf(op.area)
+                    self.line(f"if {buf}[{op.offset}] or {buf}[{op.offset + 1}] != {expr}: "
+                              f"{self.use('_w' + EXACT_CODE[kind])}({buf}, {op.offset}, {expr})")
+                elif j - i == 1:
                     self.wr(op, kind, expr, exact=exacts[i])
                 else:
                     # bytes between two values are written again with their

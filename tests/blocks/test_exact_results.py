@@ -126,6 +126,23 @@ def test_an_exact_word_out_of_range_faults(stand_in: Any, status: int, call: str
         plc.scan()
 
 
+@pytest.mark.parametrize("before", [0x0000, 0x0001, 0x002C, 0x0100, 0x012C, 0xFFFF, 0x2C00])
+@pytest.mark.parametrize("status", [0, 1, 44, 255, 256, 300, 0x2C00, 65535])
+def test_a_lone_word_result_leaves_the_word_holding_it(stand_in: Any, before: int,
+                                                        status: int) -> None:
+    """A lone exact WORD result is stored only when the word does not hold
+    it already (the bytes 0, v for v in 0..255); whatever the word held,
+    it holds the result after the call: 300 over 0x002C (its low byte) and
+    0x2C00 over 0x002C are stored, 44 over 0x002C is the same bytes."""
+    stand_in("GET_AbsPos", (7, status), ("C_Pos", "C_Status"))
+    plc = plcrt.load(_program(GET_APART))
+    for _ in range(2):                 # the second scan: the word holds it
+        plc["VW200"] = before
+        plc.scan()
+        assert _bytes(plc, 200, 2) == status.to_bytes(2, "big")
+        assert plc["VD120"] == 7
+
+
 @pytest.mark.parametrize("out", [(0,), (0, 1, 2)])
 def test_a_block_declaring_exact_results_must_return_them_all(stand_in: Any,
                                                               out: tuple) -> None:

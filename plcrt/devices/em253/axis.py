@@ -144,8 +144,11 @@ class Axis:
     def travel(self, t: int) -> int:
         """Whole pulses of the current move emitted by time ``t``."""
         # perf: inside the window of the last segment found, the segment's
-        # polynomial (Seg.pulses) inline; readers ask at every scan start
-        if self._w_lo <= t < self._w_hi:
+        # polynomial (Seg.pulses) inline; readers ask at every scan start.
+        # The window test is two comparisons joined by ``and`` here and in
+        # the blocks' shortcuts: CPython 3.11 runs fewer instructions for
+        # that than for the chained ``lo <= t < hi``
+        if self._w_lo <= t and t < self._w_hi:
             s = self._w_seg
             return ((s.A * t + s.B) * t + s.C) // s.D
         if not self.segs:
@@ -158,7 +161,7 @@ class Axis:
 
     def position(self, t: int) -> int:
         """The module's position counter at time ``t``."""
-        if self._w_lo <= t < self._w_hi:   # perf: the window's counter polynomial
+        if self._w_lo <= t and t < self._w_hi:   # perf: the window's counter polynomial
             a, b, c, d = self._w_pos
             return ((a * t + b) * t + c) // d
         return self.counter + self.direction * self.travel(t)
@@ -171,7 +174,7 @@ class Axis:
 
     def speed(self, t: int) -> int:
         """Signed output frequency in Hz (0 when stopped)."""
-        if self._w_lo <= t < self._w_hi:   # perf: Seg.hz inline, as in travel()
+        if self._w_lo <= t and t < self._w_hi:   # perf: Seg.hz inline, as in travel()
             hz = self._w_hz
             if hz is None:
                 s = self._w_seg

@@ -124,13 +124,13 @@ class GetAbsPos(MotionBlock):
         if (self._site_ok or em_no == self._em and axis_no == self._axn) \
                 and self.module.enabled_scan == plc.scans:  # type: ignore[union-attr]
             ax, t = self.axis, plc._t_us
-            if ax._w_lo <= t < ax._w_hi:  # type: ignore[union-attr]
+            if ax._w_lo <= t and t < ax._w_hi:  # type: ignore[union-attr]
                 # perf: Axis.position inline (its window test and formula)
                 a, b, c, d = ax._w_pos  # type: ignore[union-attr]
                 pos = ((a * t + b) * t + c) // d
             else:
                 pos = ax.position(t)  # type: ignore[union-attr]
-            if not -0x3FFFFFFF <= pos <= 0x3FFFFFFF:   # perf: one-digit bounds
+            if pos < -0x3FFFFFFF or pos > 0x3FFFFFFF:   # perf: one-digit bounds
                 pos = dint(pos)
             self.last_out = out = (pos, 1)
             return out
@@ -195,7 +195,7 @@ class SpdCtrl(MotionBlock):
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
-                    if ax._w_lo <= t < ax._w_hi:
+                    if ax._w_lo <= t and t < ax._w_hi:
                         # perf: Axis.speed inline (its window test and formula)
                         spd = ax._w_hz
                         if spd is None:
@@ -314,7 +314,7 @@ class PosGotoR(MotionBlock):
             if ax.owner is self and ax.segs:
                 if run and self.prev_run:
                     t = plc._t_us
-                    if ax._w_lo <= t < ax._w_hi:
+                    if ax._w_lo <= t and t < ax._w_hi:
                         # perf: Axis.speed and Axis.travel inline (their
                         # window test and formulas)
                         s = ax._w_seg
@@ -452,7 +452,7 @@ class Homing(MotionBlock):
                 if run or seq is None or not seq.active:
                     self.prev_run = run
                     t = plc._t_us
-                    if ax._w_lo <= t < ax._w_hi:
+                    if ax._w_lo <= t and t < ax._w_hi:
                         # perf: Axis.speed inline (its window test and formula)
                         spd = ax._w_hz
                         if spd is None:

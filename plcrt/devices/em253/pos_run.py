@@ -46,7 +46,7 @@ class PosRun(MotionBlock):
                 if run and self.prev_run:
                     t = plc._t_us
                     self.mode_in = mode
-                    if ax._w_lo <= t < ax._w_hi:
+                    if ax._w_lo <= t and t < ax._w_hi:
                         # perf: Axis.travel and Axis.speed inline (their
                         # window test and formulas)
                         s = ax._w_seg

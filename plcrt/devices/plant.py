@@ -346,7 +346,8 @@ def _encoders(raw: Any, where: str, wired: dict[int, int]) -> list[dict[str, Any
         for key in ("start", "stop"):
             v = enc.get(key, 0.0 if key == "start" else None)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
-                                  or not math.isfinite(v) or v < 0):
+                                  or not math.isfinite(v) or v < 0
+                                  or not math.isfinite(v * 1e6)):
                 raise PlcConfigError(f"{ew}.{key} must be seconds (0 or more), got {v!r}")
             times.append(None if v is None else int(round(v * 1e6)))
         if times[1] is not None and times[1] < times[0]:

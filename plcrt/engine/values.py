@@ -324,6 +324,11 @@ def duration(d: Any, what: str = "") -> float:
     if not (math.isfinite(value) and value >= 0):
         raise PlcConfigError(f"{where}a duration must be a non-negative, finite time, "
                              f"got {_shown(d)}")
+    if not math.isfinite(value * 1e6):
+        # simulated time is counted in whole microseconds: the count must
+        # exist (about 1.8e302 s and more overflow a float)
+        raise PlcConfigError(f"{where}a duration of {_shown(d)} s is too long to count in "
+                             f"microseconds")
     return value
 
 

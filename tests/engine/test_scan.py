@@ -90,9 +90,12 @@ def test_time_does_not_drift_over_many_scans() -> None:
     assert p.time == 1000.0
 
 
-@pytest.mark.parametrize("kwargs", [{}, {"seconds": 1, "scans": 2}, {"seconds": -1}])
+@pytest.mark.parametrize("kwargs", [{}, {"seconds": 1, "scans": 2}, {"seconds": -1},
+                                    {"seconds": 1.8e302}, {"seconds": float("nan")}])
 def test_run_needs_exactly_one_non_negative_duration(kwargs: dict) -> None:
-    """run() takes exactly one of seconds= or scans=."""
+    """run() takes exactly one of seconds= or scans=, a duration that can
+    be counted in microseconds (1.8e302 s is finite, its microseconds are
+    not)."""
     p = plcrt.load(SM_PROGRAM)
     with pytest.raises(PlcConfigError):
         p.run(**kwargs)

@@ -248,6 +248,7 @@ def test_cv_pv_from_an_encoder_comes_at_its_exact_edge():
     ('inputs = ["I0.0"]\nhz = 10\nstart = 2\nstop = 1', "stop is before start"),
     ('inputs = ["I0.0"]\nhz = 10\ndirection = "left"', "direction must be"),
     ('inputs = ["I0.0"]\nhz = 10\nspeed = 1', "unknown key(s) speed"),
+    ('inputs = ["I0.0"]\nhz = 10\nstop = 1.8e302', "stop must be seconds"),
 ])
 def test_bad_encoders_are_located_errors(encoder, message):
     with pytest.raises(PlcConfigError) as e:

@@ -399,6 +399,16 @@ def test_trace_records_numpy_arrays_from_now_on() -> None:
     assert len(tr) == 250
 
 
+@pytest.mark.parametrize("limit", [1.8e302, "inf", -1, "soon"])
+def test_a_time_limit_that_cannot_be_counted_is_a_config_error(limit: object) -> None:
+    """max_time, like run(seconds=), must be a duration whose microseconds
+    exist: 1.8e302 s is a finite float, its microseconds are not."""
+    h = Harness.load(ROOT / "programs" / "seal_in.awl")
+    with pytest.raises(PlcConfigError):
+        h.limit_time(limit)
+    assert h.max_time is None and h.run("0.1s").plc.scans == 10
+
+
 def test_max_time_stops_any_run_and_carries_over_to_forks() -> None:
     """max_time counts simulated time from power-up: plain runs, run_until
     and forks all stop at the first scan past it."""

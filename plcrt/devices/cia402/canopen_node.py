@@ -56,6 +56,7 @@ import canopen
 from canopen.nmt import NmtSlave
 from canopen.objectdictionary import ODRecord, ODVariable, datatypes
 
+from ...engine.values import Duration, duration
 from ...errors import PlcConfigError
 from .drive import Drive
 from .esm import EsmState
@@ -149,15 +150,16 @@ class CanopenDrive:
             self._thread.start()
 
     # ---------------------------------------------------------------- time
-    def advance(self, seconds: float) -> None:
-        """Run the drive *seconds* further, one bus cycle at a time
-        (``clock="manual"`` or ``"step"``; in wall-clock mode time follows
-        the wall clock and this raises)."""
+    def advance(self, seconds: Duration) -> None:
+        """Run the drive *seconds* further (a duration: ``0.5``, ``"200ms"``),
+        one bus cycle at a time (``clock="manual"`` or ``"step"``; in
+        wall-clock mode time follows the wall clock and this raises)."""
         if self.clock == "wall":
             raise PlcConfigError("cia402: advance() needs clock='manual' or 'step'; "
                                  "this drive follows the wall clock")
-        if seconds < 0:
+        if isinstance(seconds, (int, float)) and not isinstance(seconds, bool) and seconds < 0:
             raise PlcConfigError(f"cia402: advance({seconds}) cannot go back in time")
+        seconds = duration(seconds, "cia402: advance()")
         with self._lock:
             end = self.drive.now + round(seconds * 1e6)
             while self.drive.now < end:

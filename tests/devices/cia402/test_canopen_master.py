@@ -96,6 +96,21 @@ def test_pv_velocity_reached(pair):
     assert n.sdo[0x606C].raw == 50_000
 
 
+@pytest.mark.parametrize("seconds, words", [
+    (-0.1, "cannot go back in time"), (float("nan"), "non-negative, finite"),
+    (1.8e302, "too long to count in microseconds"), ("soon", "not a duration")])
+def test_advance_takes_a_duration_it_can_count(pair, seconds, words):
+    """advance() refuses what is not a countable duration with a PlcError,
+    and the drive's time stays where it was."""
+    sim, _ = pair
+    t0 = sim.drive.now
+    with pytest.raises(PlcConfigError, match=words):
+        sim.advance(seconds)
+    assert sim.drive.now == t0
+    sim.advance("10ms")
+    assert sim.drive.now == t0 + 10_000
+
+
 def test_homing_method_35_returns_true(pair):
     sim, n = pair
     n.state = "OPERATION ENABLED"

@@ -451,19 +451,19 @@ class Harness:
 
     def fork(self) -> Harness:
         """An independent copy in the same state (e.g. after a long warm-up)."""
-        h = Harness(self.plc.fork(), watch=self.watched, history=self.history.maxlen or 20,
-                    name=self.name, max_time=self.max_time)
-        h.history.extend(self.history)
-        self.forks.append(h)
-        return h
+        return self._twin(self.plc.fork())
 
     def recompiled(self, *, instrument: bool | None = None,
                    backend: str | None = None) -> Harness:
         """A copy in the same state, its program compiled with other probes
         or another backend (:meth:`plcrt.Plc.recompiled`): e.g. warm up on
         the native backend, then look at coverage from there on."""
-        h = Harness(self.plc.recompiled(instrument=instrument, backend=backend),
-                    watch=self.watched, history=self.history.maxlen or 20,
+        return self._twin(self.plc.recompiled(instrument=instrument, backend=backend))
+
+    def _twin(self, plc: Plc) -> Harness:
+        """A harness of ``plc``, a copy of this one's PLC: the same watch
+        list, history, name and time limit, reported with this one's."""
+        h = Harness(plc, watch=self.watched, history=self.history.maxlen or 20,
                     name=self.name, max_time=self.max_time)
         h.history.extend(self.history)
         self.forks.append(h)

@@ -18,7 +18,7 @@ import pytest
 
 import plcrt
 from plcrt.compiler import cache
-from test_em253_fastpath import BLOCKS, EXAMPLES, _commands, _load, load_exact
+from test_em253_fastpath import BLOCKS, EXAMPLES, _commands, _load, load_exact, lockstep
 
 EM253 = Path(__file__).resolve().parents[2] / "programs" / "em253"
 PLANT = {"module": {"0": {"axis": {"0": {"limit_neg": -10**9, "limit_pos": 10**9},
@@ -43,13 +43,7 @@ def test_readers_alone_agree_with_the_exact_run(name: str, seed: int,
     fast = _load(name, 1)
     scans = 6000
     commands = _commands(name, scans, 1, seed) if seed else iter([[]] * scans)
-    for k, writes in enumerate(commands):
-        for addr, value in writes:
-            exact[addr] = value
-            fast[addr] = value
-        exact.scan()
-        fast.scan()
-        assert _memory(fast) == _memory(exact), f"{name}: differs after scan {k} ({writes})"
+    lockstep(name, fast, exact, commands, _memory)
     assert [a.to_dict() for a in fast.axes()] == [a.to_dict() for a in exact.axes()]
 
 

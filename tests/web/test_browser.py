@@ -29,6 +29,18 @@ def frame(page) -> dict:
     return page.evaluate("() => window.plcrtPanel.frame")
 
 
+def force_in_watch(page, addr: str, value: str):
+    """Add ``addr`` to the watch table, force it to ``value`` with the
+    row's button and wait until the page shows it forced; the row."""
+    page.fill("#watch-spec", addr)
+    page.click('#watch-add button[type="submit"]')
+    row = page.locator(f'tr[data-watch="{addr}"]')
+    row.locator("input").fill(value)
+    row.locator("button[title=force]").click()
+    page.wait_for_selector(f'tr[data-watch="{addr}"].forced')
+    return row
+
+
 def test_push_button_turns_on_the_coil_and_the_lamp(serve, page) -> None:
     served = serve()
     open_panel(page, served)
@@ -59,12 +71,7 @@ def test_keyboard_toggles_a_switch(serve, page) -> None:
 def test_force_a_value_and_step_one_scan(serve, page) -> None:
     served = serve()
     open_panel(page, served)
-    page.fill("#watch-spec", "VW0")
-    page.click('#watch-add button[type="submit"]')
-    row = page.locator('tr[data-watch="VW0"]')
-    row.locator("input").fill("7")
-    row.locator("button[title=force]").click()
-    page.wait_for_selector('tr[data-watch="VW0"].forced')
+    row = force_in_watch(page, "VW0", "7")
     assert row.locator(".value").inner_text() == "7"
     assert frame(page)["scans"] == 0
     page.click("#step")
@@ -83,12 +90,7 @@ def test_timer_counts_in_run_until(serve, page) -> None:
     served = serve()
     open_panel(page, served)
     page.select_option("#speed", "max")
-    page.fill("#watch-spec", "I0.0")
-    page.click('#watch-add button[type="submit"]')
-    row = page.locator('tr[data-watch="I0.0"]')
-    row.locator("input").fill("1")
-    row.locator("button[title=force]").click()
-    page.wait_for_selector('tr[data-watch="I0.0"].forced')
+    force_in_watch(page, "I0.0", "1")
     page.fill("#cond", "T37 >= 20")
     page.click("#until")
     page.wait_for_function("() => window.plcrtPanel.frame.scans > 0 && "

@@ -270,8 +270,11 @@ def _bench_json(root: Path, args: argparse.Namespace) -> dict[str, float]:
     cmd = [sys.executable, str(root / "bench" / "em253.py"), "--json",
            "--repeats", str(args.repeats), "--seconds", str(args.seconds),
            "--scan-ms", str(args.scan_ms)]
-    out = subprocess.run(cmd, cwd=root, capture_output=True, text=True, check=True).stdout
-    return {e["name"]: e["x_real_time"] for e in json.loads(out)["examples"]}
+    done = subprocess.run(cmd, cwd=root, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"error: the bench in {root} failed (exit {done.returncode}):\n"
+                         f"{done.stderr.strip()}")
+    return {e["name"]: e["x_real_time"] for e in json.loads(done.stdout)["examples"]}
 
 
 def compare(against: Path, args: argparse.Namespace) -> int:

@@ -41,3 +41,15 @@ def test_against_a_directory_without_the_bench_is_a_clear_error(tmp_path: Path) 
     assert done.returncode == 2
     assert done.stderr.strip() == f"error: {tmp_path} has no bench/em253.py"
     assert "Traceback" not in done.stderr
+
+
+def test_a_failing_bench_on_the_other_side_is_reported_without_a_traceback(
+        tmp_path: Path) -> None:
+    (tmp_path / "bench").mkdir()
+    (tmp_path / "bench" / "em253.py").write_text('import sys\nsys.exit("no such example")\n')
+    done = _run("--against", str(tmp_path), "--rounds", "1", "--seconds", "0.02",
+                "--repeats", "1")
+    assert done.returncode == 1
+    assert done.stderr.strip() == (f"error: the bench in {tmp_path} failed (exit 1):\n"
+                                   f"no such example")
+    assert "Traceback" not in done.stderr

@@ -34,6 +34,9 @@ def register(sub: Any) -> None:
                    help=f"TCP port (default {DEFAULT_PORT}; 0 picks a free one)")
     p.add_argument("--host", default="127.0.0.1", metavar="ADDR",
                    help="address to listen on (default 127.0.0.1, this machine only)")
+    p.add_argument("--allow-host", action="append", default=[], metavar="NAME",
+                   help="a host name the page may be opened under, besides the address it "
+                        "is served on and localhost (repeatable; other names are refused)")
     p.add_argument("--open", action="store_true", help="open the page in a web browser")
     p.add_argument("--no-breakpoints", action="store_true",
                    help="no breakpoints (scans never move to the build with network probes "
@@ -66,21 +69,34 @@ def build_panel(args: argparse.Namespace) -> Any:
         ns.plant = str(les.plant) if les.plant else args.plant
         plc = load_from_args(ns, args.scan_ms)
         print_diagnostics(plc.diagnostics)
-        return PanelSession(plc, breakpoints=not args.no_breakpoints)
+        return PanelSession(plc, breakpoints=not args.no_breakpoints, kinds=les.kinds())
 
+    # --host NAME (not an address) is a name the page is opened under
+    hosts = [*getattr(args, "allow_host", []),
+             *([] if _is_address(getattr(args, "host", "")) else [getattr(args, "host", "")])]
     first = Path(args.programs[0])
     if len(args.programs) == 1 and first.is_dir():
         les = course.lesson(first)
         return Panel(load_lesson(les), lessons=course.lessons(first.parent), current=les,
-                     load_lesson=load_lesson)
+                     load_lesson=load_lesson, hosts=hosts)
     plc = load_from_args(args, args.scan_ms)
     print_diagnostics(plc.diagnostics)
     current = None
     if course.is_lesson(first.parent) and first.name == "lesson.awl":
         current = course.lesson(first.parent)
     lessons = course.lessons(first.parent.parent) if current else []
-    return Panel(PanelSession(plc, breakpoints=not args.no_breakpoints), lessons=lessons,
-                 current=current, load_lesson=load_lesson if current else None)
+    session = PanelSession(plc, breakpoints=not args.no_breakpoints,
+                           kinds=current.kinds() if current else None)
+    return Panel(session, lessons=lessons, current=current,
+                 load_lesson=load_lesson if current else None, hosts=hosts)
+
+
+def _is_address(host: str) -> bool:
+    try:
+        ipaddress.ip_address(host.strip("[]"))
+    except ValueError:
+        return False
+    return True
 
 
 def _loopback(host: str) -> bool:

@@ -2,10 +2,16 @@
 program".
 
 A lesson is a folder with ``lesson.awl`` and ``README.md`` (and optionally
-``symbols.txt``, ``plant.toml`` and ``test_NN_*.py``); its course is the
-folder holding it.  :func:`check` runs the lesson's test file with pytest
-in a subprocess, with a timeout, and reads each test's outcome from a
-JUnit XML report written into a temporary folder.
+``panel.md``, ``symbols.txt``, ``plant.toml`` and ``test_NN_*.py``); its
+course is the folder holding it.  The README is the lesson for the
+terminal; ``panel.md`` is the lesson for the page (steps to do with the
+mouse), shown instead of the README when it exists, and its table of
+inputs (``| input | kind | ... |``) says which input is a switch or a
+push-button and whether it is normally closed.  :func:`check` runs the
+lesson's test file with pytest in a subprocess, with a timeout, and reads
+each test's outcome from a JUnit XML report written into a temporary
+folder: it runs the lesson folder's Python code, so a lesson folder must
+be trusted.
 
 This module neither serves nor draws anything.
 """
@@ -23,11 +29,17 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import PlcConfigError
+from . import markdown
+from .present import KIND_WORDS
 
 #: wall seconds a check may take
 CHECK_TIMEOUT = 120.0
 #: characters of pytest's output kept for the page
 OUTPUT_CHARS = 20000
+#: the files of a lesson folder the page may open (links of the lesson text)
+SERVED_SUFFIXES = (".awl", ".txt", ".toml", ".md", ".py", ".dbg")
+#: the files whose change reloads the lesson in the panel
+WATCHED = ("lesson.awl", "symbols.txt", "plant.toml", "panel.md", "README.md")
 
 
 @dataclass(frozen=True)
@@ -57,8 +69,67 @@ class Lesson:
         return sorted(self.dir.glob("test_*.py"))
 
     def text(self) -> str:
-        """The lesson's README (Markdown, shown as text by the page)."""
-        return (self.dir / "README.md").read_text(encoding="utf-8", errors="replace")
+        """The lesson's text for the page: ``panel.md``, else the README
+        (Markdown)."""
+        page = self.dir / "panel.md"
+        return _read(page if page.is_file() else self.dir / "README.md")
+
+    def page(self) -> list[dict[str, Any]]:
+        """The page's lesson text as safe blocks (:mod:`plcrt.web.markdown`);
+        relative links to the lesson's own files point at ``lesson/NAME``."""
+        return markdown.parse(self.text(), self._link)
+
+    def _link(self, url: str) -> str | None:
+        name = url.split("#")[0].split("?")[0]
+        return f"lesson/{name}" if self.file(name) is not None else None
+
+    def file(self, name: str) -> Path | None:
+        """A file of the lesson's folder the page may open (a plain name,
+        one of :data:`SERVED_SUFFIXES`), or None."""
+        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,99}", name) or \
+                not name.endswith(SERVED_SUFFIXES):
+            return None
+        p = self.dir / name
+        return p if p.is_file() else None
+
+    def kinds(self) -> dict[str, str]:
+        """The input kinds the lesson's page text declares: its table whose
+        head starts ``| input | kind |``, e.g. ``| I0.1 | NC push-button |
+        stop |`` (kinds: :data:`plcrt.web.present.KIND_WORDS`).
+
+        Raises:
+            PlcConfigError: a kind that is not one of them.
+        """
+        out: dict[str, str] = {}
+        for b in self.page():
+            table = b.get("table")
+            if table is None:
+                continue
+            head = [_spans_text(c).lower() for c in table["head"]]
+            if head[:2] != ["input", "kind"]:
+                continue
+            for row in table["rows"]:
+                if len(row) < 2:
+                    continue
+                addr, kind = _spans_text(row[0]), _spans_text(row[1]).lower()
+                if kind not in KIND_WORDS:
+                    raise PlcConfigError(
+                        f"{self.id}/panel.md: input {addr}: kind '{kind}' is not one of "
+                        f"{', '.join(KIND_WORDS)}")
+                out[addr] = KIND_WORDS[kind]
+        return out
+
+    def stamp(self) -> tuple[tuple[str, int, int], ...]:
+        """The modification times and sizes of the :data:`WATCHED` files:
+        a change means the lesson must be loaded again."""
+        out = []
+        for name in WATCHED:
+            try:
+                st = (self.dir / name).stat()
+            except OSError:
+                continue
+            out.append((name, st.st_mtime_ns, st.st_size))
+        return tuple(out)
 
     def to_dict(self) -> dict[str, Any]:
         return {"id": self.id, "title": self.title}
@@ -73,7 +144,7 @@ def lesson(path: Path) -> Lesson:
     if not is_lesson(path):
         raise PlcConfigError(f"{path} is not a lesson folder (lesson.awl and README.md)")
     title = path.name
-    for line in (path / "README.md").read_text(encoding="utf-8", errors="replace").splitlines():
+    for line in _read(path / "README.md").splitlines():
         if line.startswith("#"):
             title = line.lstrip("#").strip()
             break
@@ -85,6 +156,16 @@ def lessons(course: Path) -> list[Lesson]:
     if not course.is_dir():
         return []
     return [lesson(p) for p in sorted(course.iterdir()) if is_lesson(p)]
+
+
+def _read(path: Path) -> str:
+    """A lesson text, at most :data:`markdown.MAX_CHARS` characters' worth."""
+    with open(path, "rb") as f:
+        return f.read(4 * markdown.MAX_CHARS + 4).decode("utf-8", errors="replace")
+
+
+def _spans_text(spans: list[dict[str, Any]]) -> str:
+    return "".join(s["t"] for s in spans).strip()
 
 
 def find(course: list[Lesson], ident: str) -> Lesson:

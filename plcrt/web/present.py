@@ -1,12 +1,13 @@
 """What the panel shows of a PLC beside the ladder: watch values in their
 formats, symbol names with their comments, the input and output bits that
-become switches and lamps, and the marks of axes and drives from the plant
-file.  Pure functions of a loaded PLC: no state, no threads, no web code
+become switches and lamps (and which kind of switch each input is), and
+the marks of axes and drives from the plant file.  Pure functions of a loaded PLC: no state, no threads, no web code
 (the runner, :mod:`plcrt.web.session`, calls them)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from ..engine.runtime import Plc
@@ -80,6 +81,56 @@ def io_bits(plc: Plc) -> tuple[list[str], list[str]]:
     return ins, outs
 
 
+#: input kinds -> the input's value at rest (a normally-closed contact reads 1
+#: while nobody touches it); a switch keeps what a click gives it, a
+#: push-button only while it is held
+INPUT_KINDS: dict[str, int] = {"switch": 0, "switch_nc": 1, "button": 0, "button_nc": 1}
+
+#: words of a symbol comment -> what they say about the input (first match
+#: of each group wins); the symbol's name is not read: "PB" in a name says
+#: nothing about the wiring
+_COMMENT_WORDS: tuple[tuple[str, re.Pattern[str]], ...] = (
+    ("button", re.compile(r"push[- ]?button|\btaster\b|\bmomentary\b", re.I)),
+    ("nc", re.compile(r"normally[- ]closed|\bN\.?C\b|\bbreak contact\b|\böffner\b", re.I)),
+)
+
+#: the words of a lesson's input table (``panel.md``) -> input kind
+KIND_WORDS: dict[str, str] = {
+    "switch": "switch", "nc switch": "switch_nc",
+    "push-button": "button", "nc push-button": "button_nc",
+}
+
+
+def kind_from_comment(comment: str) -> str:
+    """The input kind a symbol's comment describes: ``push button`` makes a
+    push-button, ``normally closed`` / ``NC`` one that rests at 1."""
+    said = {what for what, pat in _COMMENT_WORDS if pat.search(comment or "")}
+    return ("button" if "button" in said else "switch") + ("_nc" if "nc" in said else "")
+
+
+def input_kinds(plc: Plc, inputs: list[str],
+                declared: Mapping[str, str] | None = None) -> dict[str, str]:
+    """Each input bit's kind (:data:`INPUT_KINDS`): the lesson's own table
+    first (``declared``: address or symbol -> kind), then the comment of
+    the input's symbol, else a switch."""
+    table = plc.symbols
+    entries: dict[str, Any] = dict(getattr(table, "entries", {}) or {})
+    by_addr = {_norm(s.address): s for s in entries.values()}
+    said: dict[str, str] = {}
+    for key, kind in (declared or {}).items():
+        s = entries.get(key)
+        said[_norm(s.address if s is not None else key)] = kind
+    out = {}
+    for a in inputs:
+        s = by_addr.get(_norm(a))
+        out[a] = said.get(_norm(a)) or kind_from_comment(s.comment if s is not None else "")
+    return out
+
+
+def _norm(addr: str) -> str:
+    return addr.replace(" ", "").upper()
+
+
 def plant_of(plc: Plc) -> Any:
     return getattr(plc, "_config", {}).get("plant")
 
@@ -117,5 +168,5 @@ def drive_marks(plc: Plc) -> list[dict[str, Any]]:
     return out
 
 
-__all__ = ["MAX_IO", "axis_marks", "drive_marks", "format_value", "io_bits", "plant_of",
-           "symbol_names"]
+__all__ = ["INPUT_KINDS", "KIND_WORDS", "MAX_IO", "axis_marks", "drive_marks", "format_value",
+           "input_kinds", "io_bits", "kind_from_comment", "plant_of", "symbol_names"]

@@ -34,6 +34,10 @@ MAX_TREND = 8
 MAX_VIEW = 1000
 #: the most scans one ``step`` may ask for
 MAX_STEP = 1_000_000
+#: the deepest nesting of arrays and objects in a message (a message needs 2)
+MAX_DEPTH = 8
+#: the most rows of the watch table (shared by every page)
+MAX_WATCH = 100
 
 
 class ProtocolError(PlcConfigError):
@@ -120,13 +124,52 @@ def parse(text: str | bytes) -> dict[str, Any]:
         ProtocolError: not JSON, not an object, an unknown type, a missing,
             unknown or badly typed field, or a value out of range.
     """
-    if len(text) > MAX_MESSAGE:
-        raise ProtocolError(f"message too long ({len(text)} bytes, at most {MAX_MESSAGE})")
+    size = len(text.encode("utf-8", "surrogatepass") if isinstance(text, str) else text)
+    if size > MAX_MESSAGE:
+        raise ProtocolError(f"message too long ({size} bytes, at most {MAX_MESSAGE})")
+    if isinstance(text, bytes):
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ProtocolError("a message must be UTF-8 JSON text") from None
+    # perf: every normal message has fewer brackets than the limit
+    if text.count("[") + text.count("{") > MAX_DEPTH:
+        depth = nesting(text)
+        if depth > MAX_DEPTH:
+            raise ProtocolError(f"a message may nest arrays and objects {MAX_DEPTH} deep at "
+                                f"most (this one: {depth})")
     try:
         msg = json.loads(text)
-    except (ValueError, UnicodeDecodeError):
+    except (ValueError, RecursionError):
+        # RecursionError cannot happen after nesting(); kept so that no
+        # parser limit ever escapes as a traceback
         raise ProtocolError("a message must be a JSON object") from None
     return validate(msg)
+
+
+def nesting(text: str) -> int:
+    """How deep arrays and objects nest in JSON ``text`` (brackets inside
+    strings do not count), found before parsing: Python's JSON decoder
+    recurses once per level and fails with RecursionError near 1000.  One
+    pass over the text, whatever it holds."""
+    depth = deepest = 0
+    in_str = escaped = False
+    for ch in text:
+        if in_str:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == '"':
+                in_str = False
+        elif ch == '"':
+            in_str = True
+        elif ch in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in "]}":
+            depth -= 1
+    return deepest
 
 
 def validate(msg: Any) -> dict[str, Any]:
@@ -217,5 +260,5 @@ def finite(v: int | float) -> int | float | str:
     return v
 
 
-__all__ = ["CLIENT", "Field", "MAX_MESSAGE", "ProtocolError", "SERVER", "dumps", "finite",
-           "parse", "validate"]
+__all__ = ["CLIENT", "Field", "MAX_DEPTH", "MAX_MESSAGE", "MAX_WATCH", "ProtocolError",
+           "SERVER", "dumps", "finite", "nesting", "parse", "validate"]

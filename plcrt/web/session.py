@@ -51,8 +51,9 @@ from ..testing.harness import Harness, condition, reader
 from ..view.ladder import Ladder, to_ladder
 from ..view.status import PlcStatus
 from .mailbox import Client, Mailbox
-from .present import axis_marks, drive_marks, format_value, io_bits, symbol_names
-from .protocol import finite
+from .present import INPUT_KINDS, axis_marks, drive_marks, format_value, input_kinds, io_bits, \
+    symbol_names
+from .protocol import MAX_WATCH, finite
 from .svg import network_state, network_svg, stl_lines
 
 #: frames per wall second
@@ -98,15 +99,23 @@ class PanelSession:
             they are used.  A PLC loaded with ``instrument=True`` keeps its
             probes.
         breakpoints: whether breakpoints may be set (default: yes).
+        kinds: the lesson's own input kinds (address or symbol ->
+            ``switch``, ``switch_nc``, ``button``, ``button_nc``); the other
+            inputs take theirs from their symbol's comment
+            (:func:`plcrt.web.present.input_kinds`).  Inputs that rest at 1
+            (normally closed) read 1 from power-up on.
         display_hz: frames per wall second.
         clock, sleep: the wall clock (tests pass their own).
     """
 
     def __init__(self, plc: Plc, *, breakpoints: bool = True,
+                 kinds: dict[str, str] | None = None,
                  display_hz: float = DISPLAY_HZ,
                  clock: Callable[[], float] = time.monotonic,
                  sleep: Callable[[float], None] = time.sleep) -> None:
         self.plc = plc
+        self.inputs, self.outputs = io_bits(plc)
+        self.kinds = self._rest_inputs(kinds)     # before the power-up snapshot
         self.harness = Harness(plc)
         self.display_hz = display_hz
         self.clock, self.sleep = clock, sleep
@@ -151,7 +160,6 @@ class PanelSession:
         for p in prog.pous:
             self._blocks.setdefault(p.name.upper(), p.ident)
         self._names = symbol_names(plc.symbols)
-        self.inputs, self.outputs = io_bits(plc)
         if plc.coverage is not None:
             plc.coverage.on_break = self._on_break
         self._hello: dict[str, Any] | None = None
@@ -177,6 +185,15 @@ class PanelSession:
         """Queue a checked message (:func:`plcrt.web.protocol.validate`);
         it is applied in the runner thread between two chunks of scans."""
         self._queue.put((client, msg))
+
+    def _rest_inputs(self, declared: dict[str, str] | None) -> dict[str, str]:
+        """Each input's kind; the inputs that rest at 1 (normally closed)
+        are written 1, as their wiring gives them at power-up."""
+        kinds = input_kinds(self.plc, self.inputs, declared)
+        for addr, kind in kinds.items():
+            if INPUT_KINDS.get(kind):
+                self.plc.write(addr, 1)
+        return kinds
 
     # ------------------------------------------------------------------
     # The program, once
@@ -209,7 +226,8 @@ class PanelSession:
 
         def io(addr: str) -> dict[str, str]:
             shown, tip = self._names(addr)
-            return {"addr": addr, "name": shown if shown != addr else "", "comment": tip}
+            return {"addr": addr, "name": shown if shown != addr else "", "comment": tip,
+                    "kind": self.kinds.get(addr, "switch")}
 
         return {"type": "hello", "files": sorted({p.loc.file for p in prog.pous}),
                 "blocks": blocks, "symbols": symbols,
@@ -396,6 +414,10 @@ class PanelSession:
         spec, fmt = msg["spec"], msg.get("format", "auto")
         if any(w.spec == spec and w.format == fmt for w in self.watches):
             return
+        if len(self.watches) >= MAX_WATCH:
+            # every row is read and sent to every page in every frame
+            raise PlcConfigError(f"the watch table is full ({MAX_WATCH} rows at most): "
+                                 f"remove a row first")
         read, width = self._watch_reader(spec, fmt)
         self.watches.append(_Watch(spec, fmt, read, width))
 

@@ -172,10 +172,10 @@ function buildNetwork(n) {
 function buildIO(h) {
   const ins = $("inputs");
   ins.replaceChildren();
+  resetKinds();
   h.inputs.forEach((io, i) => {
     const wrap = el("div", { class: "io" });
-    const guess = /push|button|\bPB\b|_PB|taster|momentary/i.test(io.name + " " + io.comment);
-    if (!(io.addr in P.kinds)) P.kinds[io.addr] = guess ? "momentary" : "switch";
+    setKind(io);
     const sw = el("button", { class: "sw", "data-input": io.addr,
                               title: (io.comment || io.addr) + (i < 9 ? " (key " + (i + 1) + ")" : "") },
                   i < 9 ? String(i + 1) : "");
@@ -183,7 +183,7 @@ function buildIO(h) {
     const paint = () => {
       const m = P.kinds[io.addr] === "momentary";
       sw.classList.toggle("momentary", m);
-      kind.textContent = m ? "push-button" : "switch";
+      kind.textContent = kindLabel(io.addr);
     };
     paint();
     kind.addEventListener("click", () => {
@@ -214,12 +214,27 @@ function buildIO(h) {
   }
 }
 
+// Input kinds come from the server (the lesson's table or the symbol's
+// comment): a switch, or a push-button that rests at 0 (normally open) or
+// at 1 (normally closed: held, it reads 0).  A new hello starts afresh.
+function resetKinds() { P.kinds = {}; P.pressed = {}; P.rest = {}; }
+function setKind(io) {
+  const kind = io.kind || "switch";
+  P.kinds[io.addr] = kind.startsWith("button") ? "momentary" : "switch";
+  P.rest[io.addr] = kind.endsWith("_nc") ? 1 : 0;
+}
+function kindLabel(addr) {
+  if (P.kinds[addr] !== "momentary") return "switch";
+  return P.rest[addr] ? "NC push-button" : "push-button";
+}
+
 // down: pointer or key pressed on an input
 function press(addr, down) {
   if (P.kinds[addr] === "momentary") {
     if (P.pressed[addr] === down) return;
     P.pressed[addr] = down;
-    send({ type: "set", addr: addr, value: down ? "1" : "0" });
+    const rest = P.rest[addr] || 0;
+    send({ type: "set", addr: addr, value: String(down ? 1 - rest : rest) });
   } else if (down) {
     const now = P.frame ? P.frame.io[addr] : 0;
     send({ type: "set", addr: addr, value: now ? "0" : "1" });
@@ -524,7 +539,11 @@ function buildLesson(h) {
   if (!h.lesson) return;
   $("lesson-title").textContent = h.lesson.title;
   $("check").hidden = !h.lesson.checkable;
-  $("lesson-text").replaceChildren(markdown(h.lesson.text));
+  $("lesson-text").replaceChildren(renderDoc(h.lesson.doc));
+  if (h.load_error) {
+    $("lesson-text").prepend(el("pre", { class: "load-error", "data-load-error": "" },
+                                h.load_error.message));
+  }
 }
 $("lessons").addEventListener("change", () => send({ type: "lesson", id: $("lessons").value }));
 $("check").addEventListener("click", () => {
@@ -546,62 +565,47 @@ function onCheck(m) {
   $("check-output").hidden = m.ok;
 }
 
-// Inline Markdown as plain text: links keep their words, emphasis and
-// code marks go.
-function inline(text) {
-  return text.replace(/\[([^\]]*)\]\([^)]*\)/g, "$1").replace(/\*\*|`/g, "");
+// The lesson text: blocks and spans the server built from its Markdown
+// (plcrt/web/markdown.py); every word goes in with textContent, and a link
+// only to an http(s) address (new tab, no opener) or a lesson file.
+function renderSpans(parent, spans) {
+  for (const s of spans || []) {
+    let e = document.createTextNode(s.t);
+    if (s.code) { const c = el("code"); c.append(e); e = c; }
+    if (s.i) { const c = el("em"); c.append(e); e = c; }
+    if (s.b) { const c = el("strong"); c.append(e); e = c; }
+    if (s.href && /^(https?:\/\/|lesson\/)/.test(s.href)) {
+      const a = el("a", { href: s.href, target: "_blank", rel: "noopener noreferrer" });
+      a.append(e); e = a;
+    }
+    parent.append(e);
+  }
+  return parent;
 }
 
-// A table's cells: | a | b | -> ["a", "b"].
-function cells(line) {
-  return line.trim().replace(/^\|/, "").replace(/\|$/, "").split("|").map(c => inline(c.trim()));
-}
-
-// A small Markdown reader: headings, paragraphs, lists, code blocks and
-// tables.  Every piece of the lesson goes in with textContent.
-function markdown(text) {
+function renderDoc(doc) {
   const out = document.createDocumentFragment();
-  const lines = text.split("\n");
-  let para = [], list = null;
-  const flush = () => {
-    if (para.length) out.append(el("p", {}, para.join(" ")));
-    para = []; list = null;
-  };
-  for (let i = 0; i < lines.length; i++) {
-    const line = lines[i];
-    if (line.startsWith("```")) {
-      flush();
-      const code = [];
-      for (i++; i < lines.length && !lines[i].startsWith("```"); i++) code.push(lines[i]);
-      out.append(el("pre", {}, code.join("\n")));
-    } else if (/^\s*\|/.test(line) && i + 1 < lines.length && /^\s*\|[\s:|-]+\|\s*$/.test(lines[i + 1])) {
-      flush();
+  for (const b of doc || []) {
+    if (b.h !== undefined) out.append(renderSpans(el("h3"), b.s));
+    else if (b.p !== undefined) out.append(renderSpans(el("p"), b.p));
+    else if (b.pre !== undefined) out.append(el("pre", {}, b.pre));
+    else if (b.ul || b.ol) {
+      const list = el(b.ul ? "ul" : "ol");
+      for (const item of b.ul || b.ol) list.append(renderSpans(el("li"), item));
+      out.append(list);
+    } else if (b.table) {
       const table = el("table", { class: "md" });
       const head = el("tr");
-      for (const c of cells(line)) head.append(el("th", {}, c));
+      for (const c of b.table.head) head.append(renderSpans(el("th"), c));
       table.append(head);
-      for (i += 2; i < lines.length && /^\s*\|/.test(lines[i]); i++) {
+      for (const row of b.table.rows) {
         const tr = el("tr");
-        for (const c of cells(lines[i])) tr.append(el("td", {}, c));
+        for (const c of row) tr.append(renderSpans(el("td"), c));
         table.append(tr);
       }
-      i--;
       out.append(table);
-    } else if (/^#{1,6} /.test(line)) {
-      flush(); out.append(el("h3", {}, line.replace(/^#+ /, "")));
-    } else if (/^\s*([*-]|\d+\.) /.test(line)) {
-      if (para.length) { out.append(el("p", {}, para.join(" "))); para = []; }
-      if (!list) { list = el("ul"); out.append(list); }
-      list.append(el("li", {}, inline(line.replace(/^\s*([*-]|\d+\.) /, ""))));
-    } else if (!line.trim() || line.startsWith("<!--")) {
-      flush();
-    } else if (list && /^\s+/.test(line)) {
-      list.lastChild.textContent += " " + line.trim();
-    } else {
-      para.push(inline(line.trim()));
     }
   }
-  flush();
   return out;
 }
 

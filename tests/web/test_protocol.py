@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from plcrt.errors import PlcError
-from plcrt.web.protocol import CLIENT, SERVER, ProtocolError, dumps, parse, validate
+from plcrt.web.protocol import (CLIENT, MAX_DEPTH, MAX_MESSAGE, SERVER, ProtocolError, dumps,
+                                nesting, parse, validate)
 
 GOOD = [
     ({"type": "run"}, {"type": "run"}),
@@ -85,3 +86,25 @@ def test_docs_name_every_message_type_of_both_directions() -> None:
     doc = (Path(__file__).resolve().parents[2] / "docs" / "panel.md").read_text()
     for kind in list(CLIENT) + list(SERVER):
         assert f"`{kind}`" in doc, kind
+
+
+@pytest.mark.parametrize("text", ["[" * 1000 + "]" * 1000, "[" * 5000,
+                                  '{"type": "step", "x": ' + "{\"a\": " * 900 + "1" + "}" * 901])
+def test_deep_nesting_is_refused_before_the_parser_recurses(text: str) -> None:
+    """Python's JSON decoder recurses once per level and raises
+    RecursionError near 1000: the depth is bounded before parsing."""
+    with pytest.raises(ProtocolError, match=f"{MAX_DEPTH} deep at most"):
+        parse(text)
+
+
+def test_brackets_inside_texts_do_not_count_as_nesting() -> None:
+    msg = parse(json.dumps({"type": "trend", "signals": ["[" * 50 + '\\"{']}))
+    assert msg["signals"] == ["[" * 50 + '\\"{']
+    assert nesting('{"a": "[[[[", "b": [[1]]}') == 3
+
+
+def test_the_size_limit_counts_bytes_not_characters() -> None:
+    text = json.dumps({"type": "unwatch", "spec": "é" * 9000}, ensure_ascii=False)
+    assert len(text) < MAX_MESSAGE < len(text.encode())
+    with pytest.raises(ProtocolError, match="message too long"):
+        parse(text)

@@ -94,7 +94,8 @@ def test_own_origin_gets_hello_then_frames() -> None:
         hello = await _next(ws, "hello")
         assert [b["id"] for b in hello["blocks"]] == ["OB1"]
         assert hello["inputs"][0] == {"addr": "I0.0", "name": "Start_PB:I0.0",
-                                      "comment": "Start_PB = I0.0: start push button"}
+                                      "comment": "Start_PB = I0.0: start push button",
+                                      "kind": "button"}
         assert hello["blocks"][0]["networks"][0]["svg"].startswith("<svg")
         await ws.send_json({"type": "speed", "mode": "max"})
         await ws.send_json({"type": "set", "addr": "I0.0", "value": "1"})
@@ -181,3 +182,199 @@ def test_serve_builds_a_lesson_panel_from_a_lesson_folder() -> None:
     hello = panel.hello()
     assert hello["lesson"]["id"] == "05-jog-and-position" and len(hello["lessons"]) >= 6
     assert hello["axes"][0]["limit_pos"] == 60000 and hello["breakable"] is True
+
+
+# ---------------------------------------------------------------- Host names
+_WS = {"Connection": "Upgrade", "Upgrade": "websocket", "Sec-WebSocket-Version": "13",
+       "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ=="}
+
+
+@pytest.mark.parametrize("host", ["evil.example:{port}", "rebind.127.0.0.1.nip.io:{port}",
+                                  "127.0.0.1:1", "127.0.0.2:{port}", "[::1]:{port}",
+                                  "localhost.evil.example:{port}", "user@127.0.0.1:{port}",
+                                  ""])
+def test_a_foreign_host_name_is_refused_on_every_route(host: str) -> None:
+    """DNS rebinding: a page of another site whose name resolves to this
+    address sends its own name in Host; the page, the static files and
+    the websocket all answer 403 to it."""
+    async def body(client, panel):
+        h = host.format(port=client.port)
+        for path, extra in (("/", {}), ("/static/panel.js", {}), ("/ws", _WS),
+                            ("/lesson/lesson.awl", {})):
+            r = await client.get(path, headers={"Host": h, **extra})
+            assert r.status == 403, (path, r.status)
+            assert "not this server's name" in await r.text()
+        assert not panel.session.clients
+    _run(body)
+
+
+@pytest.mark.parametrize("host", ["127.0.0.1:{port}", "localhost:{port}", "LOCALHOST:{port}"])
+def test_the_servers_own_names_are_served(host: str) -> None:
+    async def body(client, panel):
+        h = host.format(port=client.port)
+        r = await client.get("/", headers={"Host": h})
+        assert r.status == 200
+        ws = await client.ws_connect("/ws", headers={"Host": h, "Origin": f"http://{h}"})
+        await _next(ws, "hello")
+        await ws.close()
+    _run(body)
+
+
+def test_a_name_allowed_by_the_user_is_served() -> None:
+    async def main():
+        panel = Panel(PanelSession(load_sample()), hosts=["Panel.LAN"])
+        client = await _client(panel)
+        try:
+            r = await client.get("/", headers={"Host": f"panel.lan:{client.port}"})
+            assert r.status == 200
+            r = await client.get("/", headers={"Host": f"other.lan:{client.port}"})
+            assert r.status == 403
+        finally:
+            await client.close()
+            panel.session.close()
+    _in_thread(main)
+
+
+# ---------------------------------------------------------------- hostile messages
+@pytest.mark.parametrize("raw, message", [
+    ("[" * 1000 + "]" * 1000, "deep at most"),
+    ('{"type": "view", "block": "OB1", "networks": ' + "[" * 3000, "deep at most"),
+    ('{"type": "unwatch", "spec": "' + "x" * 30000 + '"}', "message too long"),
+])
+def test_hostile_json_gets_an_error_and_the_connection_stays(raw: str, message: str) -> None:
+    """A deeply nested message used to drop the connection with a
+    RecursionError in the server; a message over 16 KiB used to close it."""
+    async def body(client, panel):
+        ws = await client.ws_connect("/ws")
+        await _next(ws, "hello")
+        await ws.send_str(raw)
+        err = await _next(ws, "error")
+        assert message in err["message"] and err["request"] is None
+        await ws.send_json({"type": "step"})
+        await _next(ws, "frame", lambda m: m["scans"] == 1)
+        await ws.close()
+    _run(body)
+
+
+# ---------------------------------------------------------------- lessons
+BROKEN = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1 // fine\nLD I0.0\n= Q0.0\n"
+          "Network 2 // broken\nLD Q9999.9\n= Q0.1\nEND_ORGANIZATION_BLOCK\n")
+
+
+def _course(tmp_path):
+    """A course of two lessons: lesson 1 of examples/course and a copy of it
+    whose program does not load."""
+    import shutil
+
+    from .conftest import REPO
+    course = tmp_path / "course"
+    good = course / "01-seal-in"
+    shutil.copytree(REPO / "examples/course/01-seal-in", good)
+    bad = course / "02-broken"
+    shutil.copytree(good, bad)
+    (bad / "lesson.awl").write_text(BROKEN)
+    return good, bad
+
+
+def _lesson_panel(folder) -> Panel:
+    import argparse
+
+    from plcrt.web.cli import build_panel
+    args = argparse.Namespace(
+        programs=[str(folder)], symbols=None, encoding=None, data=None, cpu=None, plant=None,
+        auto_symbols=False, backend="python", max_file_mb=None, scan_ms=10.0, clock=None,
+        no_breakpoints=False, host="127.0.0.1", allow_host=[])
+    panel = build_panel(args)
+    panel.watch_s = 0.05
+    return panel
+
+
+def _run_panel(panel: Panel, coro_fn) -> None:
+    async def main():
+        panel.session.start()
+        client = await _client(panel)
+        try:
+            await coro_fn(client, panel)
+        finally:
+            await client.close()
+            panel.session.close()
+    _in_thread(main)
+
+
+def test_a_lesson_that_does_not_load_is_switched_to_with_its_error(tmp_path) -> None:
+    """The page shows the new lesson's text and no program (not the
+    previous lesson's), and the error names the file, line and network."""
+    good, bad = _course(tmp_path)
+
+    async def body(client, panel):
+        ws = await client.ws_connect("/ws")
+        first = await _next(ws, "hello")
+        assert first["lesson"]["id"] == "01-seal-in" and first["load_error"] is None
+        await ws.send_json({"type": "lesson", "id": "02-broken"})
+        hello = await _next(ws, "hello")
+        assert hello["lesson"]["id"] == "02-broken" and hello["lesson"]["doc"]
+        assert [n for b in hello["blocks"] for n in b["networks"]] == []
+        assert hello["inputs"] == [] and hello["outputs"] == []
+        (diag,) = hello["load_error"]["diagnostics"]
+        assert diag["file"] == "02-broken/lesson.awl" and diag["line"] == 7
+        assert diag["block"] == "OB1" and diag["network"] == 2
+        err = await _next(ws, "error")
+        assert err["request"] == "lesson"
+        assert "02-broken/lesson.awl:7:4: error:" in err["message"]
+        assert "[OB1 network 2]" in err["message"] and "Q9999.9" in err["message"]
+        # the program is not there: commands say why instead of acting
+        await ws.send_json({"type": "run"})
+        err = await _next(ws, "error")
+        assert "no program is loaded" in err["message"]
+        await ws.send_json({"type": "lesson", "id": "01-seal-in"})
+        back = await _next(ws, "hello")
+        assert back["load_error"] is None and back["blocks"][0]["networks"]
+        await ws.close()
+    _run_panel(_lesson_panel(good), body)
+
+
+def test_a_lesson_file_edited_on_disk_is_loaded_again(tmp_path) -> None:
+    """The student edits lesson.awl: the page gets the new ladder without
+    switching lessons; a broken edit gives the load error, its fix the
+    program again, all in the same lesson."""
+    good, _ = _course(tmp_path)
+    awl = good / "lesson.awl"
+    text = awl.read_text()
+
+    def nets(hello):
+        return [n["title"] for b in hello["blocks"] for n in b["networks"]]
+
+    async def body(client, panel):
+        ws = await client.ws_connect("/ws")
+        first = await _next(ws, "hello")
+        assert len(nets(first)) == 3
+        extra = "Network 4 // Added by the student\nLD I0.0\n= Q0.3\nEND_ORGANIZATION_BLOCK"
+        awl.write_text(text.replace("END_ORGANIZATION_BLOCK", extra))
+        hello = await _next(ws, "hello")
+        assert hello["lesson"]["id"] == "01-seal-in"
+        assert nets(hello)[-1] == "Added by the student"
+        assert "Q0.3" in [o["addr"] for o in hello["outputs"]]
+        note = await _next(ws, "notice")
+        assert "loaded again" in note["message"]
+        awl.write_text(text.replace("LD     I0.0", "LD     I0.9"))
+        broken = await _next(ws, "hello")
+        assert broken["load_error"]["diagnostics"][0]["file"] == "01-seal-in/lesson.awl"
+        assert broken["lesson"]["id"] == "01-seal-in"
+        awl.write_text(text)
+        fixed = await _next(ws, "hello")
+        assert fixed["load_error"] is None and len(nets(fixed)) == 3
+        await ws.close()
+    _run_panel(_lesson_panel(good), body)
+
+
+def test_the_lesson_text_links_open_the_lessons_own_files_only() -> None:
+    from .conftest import REPO
+
+    async def body(client, panel):
+        r = await client.get("/lesson/lesson.awl")
+        assert r.status == 200 and r.headers["Content-Type"].startswith("text/plain")
+        assert "Network 1" in await r.text()
+        for name in ("..%2Flesson.awl", "missing.awl", "__pycache__", ".hidden.awl"):
+            r = await client.get(f"/lesson/{name}")
+            assert r.status == 404, name
+    _run_panel(_lesson_panel(REPO / "examples/course/01-seal-in"), body)

@@ -10,7 +10,7 @@ import pytest
 
 from plcrt.web.session import Mailbox, PanelSession
 
-from .conftest import load_sample
+from .conftest import REPO, load_sample
 
 
 def session(**kw) -> PanelSession:
@@ -288,3 +288,61 @@ def test_no_breakpoints_refuses_a_break() -> None:
     s.apply({"type": "break", "network": "OB1/2"})
     assert "breakpoints are off" in s.last_error["message"]
     assert s.plc.coverage is None and not s.hello()["breakable"]
+
+
+def test_the_watch_table_is_bounded_and_says_its_limit() -> None:
+    """Every row is read and sent to every page in every frame: a row past
+    MAX_WATCH is refused with an error naming the limit."""
+    from plcrt.web.protocol import MAX_WATCH
+    s = session()
+    for i in range(MAX_WATCH):
+        s.apply({"type": "watch", "spec": f"VW{2 * i}"})
+    assert len(s.watches) == MAX_WATCH and s.last_error is None
+    s.apply({"type": "watch", "spec": "VW1000", "id": 9})
+    assert len(s.watches) == MAX_WATCH
+    assert s.last_error is not None and s.last_error["id"] == 9
+    assert f"{MAX_WATCH} rows at most" in s.last_error["message"]
+    s.apply({"type": "unwatch", "spec": "VW0"})
+    s.apply({"type": "watch", "spec": "VW1000"})
+    assert s.watches[-1].spec == "VW1000"
+
+
+LESSON1 = REPO / "examples/course/01-seal-in"
+
+
+def lesson1(kinds=None) -> PanelSession:
+    import plcrt
+    plc = plcrt.load(str(LESSON1 / "lesson.awl"), symbols=str(LESSON1 / "symbols.txt"))
+    s = PanelSession(plc, kinds=kinds)
+    s.apply({"type": "speed", "mode": "max"})
+    return s
+
+
+def test_input_kinds_come_from_the_symbol_comments_not_the_names() -> None:
+    """Lesson 1's symbol table says Stop_PB_NC is a 'push button, normally
+    closed' and Overload_OK an 'NC' relay: they rest at 1 from power-up on,
+    so Start alone starts the motor; a name with 'PB' and no such comment
+    is a switch."""
+    s = lesson1()
+    kinds = {io["addr"]: io["kind"] for io in s.hello()["inputs"]}
+    assert kinds == {"I0.0": "button", "I0.1": "button_nc", "I0.2": "switch_nc"}
+    assert s.plc.read("I0.1") == 1 and s.plc.read("I0.2") == 1 and s.plc.read("I0.0") == 0
+    s.apply({"type": "set", "addr": "I0.0", "value": "1"})
+    s.apply({"type": "step"})
+    finish(s)
+    s.apply({"type": "set", "addr": "I0.0", "value": "0"})
+    s.apply({"type": "step", "scans": 3})
+    finish(s)
+    assert s.plc.read("Q0.0") == 1                         # sealed in
+    s.apply({"type": "reset"})
+    assert s.plc.read("I0.1") == 1 and s.plc.read("Q0.0") == 0   # the rest is the power-up
+    bare = PanelSession(load_sample(symbols="Start_PB\tI0.0\t\nStop_PB\tI0.1\tstop\n"))
+    assert {io["addr"]: io["kind"] for io in bare.hello()["inputs"]} == \
+        {"I0.0": "switch", "I0.1": "switch"}
+
+
+def test_the_lessons_own_kinds_win_over_the_symbol_comment() -> None:
+    s = lesson1(kinds={"Stop_PB_NC": "switch", "I0.0": "button_nc"})
+    kinds = {io["addr"]: io["kind"] for io in s.hello()["inputs"]}
+    assert kinds == {"I0.0": "button_nc", "I0.1": "switch", "I0.2": "switch_nc"}
+    assert s.plc.read("I0.0") == 1 and s.plc.read("I0.1") == 0

@@ -72,7 +72,11 @@ class Lesson:
         """The lesson's text for the page: ``panel.md``, else the README
         (Markdown)."""
         page = self.dir / "panel.md"
-        return _read(page if page.is_file() else self.dir / "README.md")
+        path = page if page.is_file() else self.dir / "README.md"
+        try:
+            return _read(path)
+        except OSError as e:   # deleted or unreadable while the panel runs
+            return f"*The lesson text {path.name} cannot be read: {e.strerror}.*"
 
     def page(self) -> list[dict[str, Any]]:
         """The page's lesson text as safe blocks (:mod:`plcrt.web.markdown`);

@@ -1,8 +1,9 @@
 """What the panel shows of a PLC beside the ladder: watch values in their
 formats, symbol names with their comments, the input and output bits that
 become switches and lamps (and which kind of switch each input is), and
-the marks of axes and drives from the plant file.  Pure functions of a loaded PLC: no state, no threads, no web code
-(the runner, :mod:`plcrt.web.session`, calls them)."""
+the marks of axes and drives from the plant file.  Pure functions of a
+loaded PLC: no state, no threads, no web code (the runner,
+:mod:`plcrt.web.session`, calls them)."""
 
 from __future__ import annotations
 

@@ -82,6 +82,8 @@ class Panel:
             **self.current.to_dict(), "doc": self.current.page(),
             "checkable": bool(self.current.tests)}
         msg["load_error"] = self.load_error
+        if self.load_error is not None and self.current is not None:
+            msg["files"] = [str(self.current.program)]   # not the empty stand-in's
         return msg
 
 

@@ -315,6 +315,7 @@ def test_a_lesson_that_does_not_load_is_switched_to_with_its_error(tmp_path) -> 
         assert hello["lesson"]["id"] == "02-broken" and hello["lesson"]["doc"]
         assert [n for b in hello["blocks"] for n in b["networks"]] == []
         assert hello["inputs"] == [] and hello["outputs"] == []
+        assert hello["files"] == [str(bad.resolve() / "lesson.awl")]
         (diag,) = hello["load_error"]["diagnostics"]
         assert diag["file"] == "02-broken/lesson.awl" and diag["line"] == 7
         assert diag["block"] == "OB1" and diag["network"] == 2
@@ -378,3 +379,26 @@ def test_the_lesson_text_links_open_the_lessons_own_files_only() -> None:
             r = await client.get(f"/lesson/{name}")
             assert r.status == 404, name
     _run_panel(_lesson_panel(REPO / "examples/course/01-seal-in"), body)
+
+
+def test_serve_passes_its_host_names_to_the_panel() -> None:
+    """--host NAME and each --allow-host NAME are names the page may be
+    opened under; an address given to --host is no name."""
+    import argparse
+
+    from plcrt.web.cli import build_panel
+    from .conftest import REPO
+
+    def hosts(host: str, allow: list[str]) -> frozenset[str]:
+        args = argparse.Namespace(
+            programs=[str(REPO / "examples/course/01-seal-in")], symbols=None, encoding=None,
+            data=None, cpu=None, plant=None, auto_symbols=False, backend="python",
+            max_file_mb=None, scan_ms=10.0, clock=None, no_breakpoints=False, host=host,
+            allow_host=allow)
+        panel = build_panel(args)
+        panel.session.close()
+        return panel.hosts
+
+    assert hosts("0.0.0.0", []) == frozenset()
+    assert hosts("::", ["Panel.LAN"]) == {"panel.lan"}
+    assert hosts("teacher-pc", ["[fd00::1]"]) == {"teacher-pc", "fd00::1"}

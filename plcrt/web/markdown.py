@@ -13,7 +13,8 @@ The structure, one dict per block::
 
     {"h": 2, "s": SPANS}          a heading (level 1..6)
     {"p": SPANS}                   a paragraph
-    {"ul": [SPANS, ...]}           a bullet list ("ol": numbered)
+    {"ul": [SPANS, ...]}           a bullet list ("ol": numbered, "start":
+                                   its first number when not 1)
     {"pre": "text"}                a code block
     {"table": {"head": [SPANS, ...], "rows": [[SPANS, ...], ...]}}
 
@@ -143,6 +144,9 @@ def parse(text: str, local: Callable[[str], str | None] | None = None) -> list[B
             if items is None or kind not in blocks[-1]:
                 items = []
                 blocks.append({kind: items})
+                number = m.group(2)[:-1]
+                if kind == "ol" and number != "1":   # a list split by a code block
+                    blocks[-1]["start"] = int(number)
             items.append(m.group(3).strip())
         elif not stripped or stripped.startswith("<!--"):
             if para:

@@ -93,6 +93,12 @@ def test_blocks_headings_lists_code_and_tables() -> None:
     ]
 
 
+def test_a_numbered_list_split_by_a_code_block_goes_on_counting() -> None:
+    doc = markdown.parse("1. one\n\n   ```sh\n   x\n   ```\n\n2. two\n")
+    assert doc == [{"ol": [[{"t": "one"}]]}, {"pre": "x"},
+                   {"ol": [[{"t": "two"}]], "start": 2}]
+
+
 def test_a_huge_text_is_cut() -> None:
     doc = markdown.parse("word " * (markdown.MAX_CHARS // 2))
     assert "cut after" in doc[-1]["p"][0]["t"]

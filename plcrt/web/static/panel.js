@@ -590,7 +590,7 @@ function renderDoc(doc) {
     else if (b.p !== undefined) out.append(renderSpans(el("p"), b.p));
     else if (b.pre !== undefined) out.append(el("pre", {}, b.pre));
     else if (b.ul || b.ol) {
-      const list = el(b.ul ? "ul" : "ol");
+      const list = el(b.ul ? "ul" : "ol", b.start ? { start: String(b.start) } : {});
       for (const item of b.ul || b.ol) list.append(renderSpans(el("li"), item));
       out.append(list);
     } else if (b.table) {

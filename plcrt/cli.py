@@ -39,14 +39,15 @@ import os
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple, NoReturn, TextIO
+from typing import TYPE_CHECKING, Any, NamedTuple, NoReturn, TextIO
 
 from . import __version__
-from .engine.runtime import Plc, load
 from .engine.values import BACKENDS, json_number, parse_number, split_format
 from .errors import Diagnostic, PlcConfigError, PlcError, PlcRuntimeError, capped
-from .dump import render_dump
 from .safetext import printable
+
+if TYPE_CHECKING:
+    from .engine.runtime import Plc
 
 EXIT_OK = 0
 EXIT_ERROR = 1
@@ -207,6 +208,10 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
     accepts a program without OB1 (for ``check`` and ``dump``)."""
     data = getattr(args, "data", None)
     plant = getattr(args, "plant", None)
+    # perf: the engine (the compiler, lark) is imported when a command runs
+    # a program, never for --help or a usage error
+    from .engine.runtime import load
+
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
     # Path objects make load() read files, never take the argument as text.
     return load([Path(p) for p in args.programs],
@@ -307,6 +312,7 @@ def cmd_dump(args: argparse.Namespace) -> int:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR
     print_diagnostics(plc.diagnostics)
+    from .dump import render_dump
     sys.stdout.write(render_dump(plc))
     return EXIT_OK
 
@@ -746,6 +752,14 @@ def _silence_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
     except (OSError, ValueError, AttributeError):
         pass
+
+
+def __getattr__(name: str) -> Any:
+    # perf: render_dump needs the engine; imported on first use (PEP 562)
+    if name == "render_dump":
+        from .dump import render_dump
+        return render_dump
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = ["EXIT_WALL", "SET_HELP", "SetItem", "add_long_run_args", "add_program_args",

@@ -365,7 +365,8 @@ def add_set_args(p: argparse.ArgumentParser, *, help: str = SET_HELP) -> None:
 
 
 def check_run_length(args: argparse.Namespace) -> None:
-    """Reject a negative ``--scans`` and a negative or infinite ``--seconds``.
+    """Reject a negative ``--scans``, a negative or infinite ``--seconds``
+    and a run longer than plcrt counts (:func:`plcrt.trace.progress.check_run_span`).
 
     Raises:
         PlcConfigError: naming the option.
@@ -374,7 +375,8 @@ def check_run_length(args: argparse.Namespace) -> None:
         raise PlcConfigError(f"--scans must not be negative, got {args.scans}")
     if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
         raise PlcConfigError(f"--seconds must be a non-negative number, got {args.seconds}")
-    from .trace.progress import check_max_wall
+    from .trace.progress import check_max_wall, check_run_span
+    check_run_span(args.seconds, args.scans, max(1, round(getattr(args, "scan_ms", 10.0) * 1000)))
     check_max_wall(getattr(args, "max_wall", None))
 
 

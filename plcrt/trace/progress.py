@@ -124,8 +124,8 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
 
 
 def _stopped(plc: Any, done: int, total: int, max_wall: float) -> WallTimeExceeded:
-    # a count past a dozen digits reads better as a magnitude (1e+14 scans)
-    of = str(total) if total < 10**12 else f"{total:.3g}"
+    # a count past fifteen digits reads better as a magnitude (9.22e+17 scans)
+    of = str(total) if total < 10**15 else f"{total:.3g}"
     return WallTimeExceeded(
         f"stopped by --max-wall after {max_wall:g} s of wall-clock time, at {plc.time:g} s "
         f"simulated ({done} of {of} scans run); the results are those of that moment")

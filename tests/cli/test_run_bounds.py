@@ -64,10 +64,12 @@ def test_a_span_that_cannot_be_counted_is_refused(
 
 def test_the_longest_countable_run_is_accepted(capsys: pytest.CaptureFixture[str]) -> None:
     """The limit is inclusive; such a run stops at the wall limit, and the
-    message gives the planned count as a magnitude, not 18 digits."""
+    message gives the planned count (9.2e17 scans of 10 µs) as a
+    magnitude, not 18 digits."""
     seconds = str(MAX_RUN_US // 10**6)
-    code, out, err, _ = _run(capsys, "run", SEAL_IN, "--seconds", seconds, "--max-wall", "0.2")
+    code, out, err, _ = _run(capsys, "run", SEAL_IN, "--seconds", seconds, "--scan-ms", "0.01",
+                             "--max-wall", "0.2")
     assert code == 3
     assert " scans run); the results are those of that moment" in err
-    assert "of 9.22e+14 scans run" in err
+    assert "of 9.22e+17 scans run" in err
     assert len(err.splitlines()[0]) < 200

@@ -139,6 +139,10 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="refuse program, symbol and data files larger than this "
                         "(default 16 MB, far above any S7-200 program)")
+    p.add_argument("--entry", metavar="BLOCK",
+                   help="run this block as the main program each scan instead of OB1: "
+                        "SBR0 or a subroutine's name (a subroutine-only export; "
+                        "docs/decisions.md says what its parameters are)")
 
 
 #: Subcommands defined beside the feature they present; each module has
@@ -223,7 +227,7 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
                 max_file_mb=getattr(args, "max_file_mb", None),
                 auto_symbols=getattr(args, "auto_symbols", False),
                 clock=getattr(args, "clock", None),
-                backend=getattr(args, "backend", None))
+                backend=getattr(args, "backend", None), entry=getattr(args, "entry", None))
 
 
 def cmd_check(args: argparse.Namespace) -> int:

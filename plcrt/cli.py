@@ -134,8 +134,8 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
                         "their symbol table)")
     p.add_argument("--backend", choices=BACKENDS, default=None,
                    help="code generator: python (default; or $PLCRT_BACKEND) or native "
-                        "(machine code through llvmlite for the pieces it covers, "
-                        "pip install 'plcrt[native]'; docs/native.md)")
+                        "(machine code through llvmlite for the pieces it covers: "
+                        "the 'native' extra, docs/native.md)")
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="refuse program, symbol and data files larger than this "
                         "(default 16 MB, far above any S7-200 program)")

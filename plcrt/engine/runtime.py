@@ -88,8 +88,9 @@ class Plc(AddressAccess):
         if backend == "native":
             from ..compiler.native.jit import available
             if not available():
-                raise PlcConfigError("backend 'native' needs llvmlite: pip install "
-                                     "'plcrt[native]' (or pip install llvmlite)")
+                from ..extras import install_hint
+                raise PlcConfigError(install_hint("backend 'native' needs llvmlite, which is "
+                                                  "not installed", "native"))
         if not isinstance(program, ir.Program):
             raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
                                  f"plcrt.load(), got {type(program).__name__}")

@@ -38,5 +38,11 @@ def test_every_skip_is_on_a_line_and_the_counts_add_up() -> None:
     assert sum(int(line.split()[0]) for line in lines) == len(reports)
 
 
+def test_with_the_corpus_a_skip_gives_its_own_reason() -> None:
+    reports = [_skipped("tests/lang/test_fastparse.py::test_b[None]", "no corpus files")]
+    assert skip_lines(reports, None) == [
+        "1 other test skipped: no corpus files (tests/lang/test_fastparse.py)"]
+
+
 def test_no_skip_no_line() -> None:
     assert skip_lines([], "the real-file corpus is not at /x") == []

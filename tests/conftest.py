@@ -1,8 +1,9 @@
 """Shared test set-up: makes the helper modules in ``tests/`` importable
 (``stl_helpers``, ``reference_interp``) from the mirrored sub-folders, says
 in the report header and the summary when the tests of the shared real-file
-corpus were skipped because the corpus is not there, and makes the property
-tests deterministic under CI.
+corpus were skipped because the corpus is not there (and, on a line of its
+own, every other reason a test skipped for, so that the lines account for
+pytest's count), and makes the property tests deterministic under CI.
 
 Property tests (hypothesis) explore new random examples on every developer
 run and keep the failures they find in ``.hypothesis/``.  Under CI (the
@@ -48,13 +49,29 @@ def pytest_report_header(config: pytest.Config) -> str | None:
 
 def pytest_terminal_summary(terminalreporter, exitstatus: int,  # noqa: ANN001
                             config: pytest.Config) -> None:
-    note = corpus_note()
-    if note is None:
-        return
-    skipped = [rep for rep in terminalreporter.stats.get("skipped", [])
-               if "corpus" in _skip_reason(rep)]
-    if skipped:
-        terminalreporter.write_line(f"{len(skipped)} corpus tests skipped: {note}")
+    for line in skip_lines(terminalreporter.stats.get("skipped", []), corpus_note()):
+        terminalreporter.write_line(line)
+
+
+def skip_lines(reports: list, note: str | None) -> list[str]:
+    """One line per reason that accounts for every skipped test: the corpus
+    tests with ``note`` (where the corpus is looked for), then each other
+    reason with the files of its tests, so that the lines add up to
+    pytest's count of skipped tests."""
+    # with the corpus in place, a corpus test that skips has its own reason
+    corpus = [r for r in reports if note is not None and "corpus" in _skip_reason(r)]
+    others: dict[str, list] = {}
+    for r in reports:
+        if r not in corpus:
+            others.setdefault(_skip_reason(r).removeprefix("Skipped: "), []).append(r)
+    lines = []
+    if corpus:
+        lines.append(f"{len(corpus)} corpus tests skipped: {note}")
+    for reason, reps in others.items():
+        files = sorted({r.nodeid.split("::")[0] for r in reps})
+        lines.append(f"{len(reps)} other test{'s' if len(reps) != 1 else ''} skipped: "
+                     f"{reason} ({', '.join(files[:3])}{', ...' if len(files) > 3 else ''})")
+    return lines
 
 
 def _skip_reason(report: pytest.TestReport) -> str:

@@ -808,9 +808,12 @@ def build_unit(program: ir.Program, model: CpuModel, symbols: Any,
                 "note", "no main program block (OB1): checked as a subroutine library, "
                         "which cannot run on its own", where, "no-ob1"))
         else:
+            from .entry import block_list
             diag.error("the program has no main program block (OB1), so there is nothing "
-                       "to run; give the file with OB1 as well (plcrt check accepts a "
-                       "subroutine library on its own)", where, "no-ob1")
+                       "to run; give the file with OB1 as well, or choose the block to run "
+                       "as the main program (plcrt run --entry BLOCK, plcrt.load(..., "
+                       f"entry=BLOCK)); its blocks: {block_list(program.pous)}", where,
+                       "no-ob1")
     for info in unit.pous.values():
         split_pieces(info, diag)
         for net in info.pou.networks:

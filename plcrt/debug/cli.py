@@ -13,8 +13,9 @@ outside world: it loads the program with instrumentation, applies
   plain text only.
 
 Exit status: 0 every command succeeded, 1 a command reported an error (or
-the program or options are bad), 2 the PLC faulted.  What the commands do
-is the session's business, not this module's.
+the program or options are bad), 2 the PLC faulted, 3 a command was stopped
+by ``--max-wall``.  What the commands do is the session's business, not this
+module's.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ def register(sub: Any) -> None:
                     "the terminal, from --script FILE or from a pipe (type 'help' for "
                     "the list; docs/debugger.md describes them).",
         epilog="Exit status: 0 ok, 1 a command or the input had an error, "
-               "2 run-time fault of the PLC program.")
+               "2 run-time fault of the PLC program, 3 a command stopped by --max-wall.")
     add_program_args(p)
     add_scan_ms_arg(p)
     p.add_argument("--script", metavar="FILE",
@@ -52,6 +53,10 @@ def register(sub: Any) -> None:
                    help="breakpoint before network NET (OB1/3, SBR0/1, or 3 for OB1/3)")
     p.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="watch this address from the start; ADDR:REAL reads a float")
+    p.add_argument("--max-wall", type=float, metavar="SECONDS",
+                   help="stop each command that runs scans (scan, run, pulse) after this "
+                        "many wall-clock seconds, between two scans (exit status 3); "
+                        "time paused at a breakpoint does not count")
     p.set_defaults(func=cmd_debug)
 
 
@@ -59,6 +64,13 @@ def cmd_debug(args: argparse.Namespace) -> int:
     """Load, set up, run the session; returns the exit status."""
     from .session import CommandError, Session
 
+    from ..trace.progress import check_max_wall
+
+    try:
+        check_max_wall(args.max_wall)
+    except PlcError as e:
+        print(printable(f"{PROG}: error: {e.message}"), file=sys.stderr)
+        return EXIT_ERROR
     script: list[str] | None = None
     if args.script is not None:
         from ..lang.limits import file_limit, read_capped
@@ -84,7 +96,7 @@ def cmd_debug(args: argparse.Namespace) -> int:
         _tolerate_bad_bytes(sys.stdin)
     session = Session(plc, sys.stdout, echo=not interactive,
                       color=interactive and _isatty(sys.stdout),
-                      handle_interrupt=interactive)
+                      handle_interrupt=interactive, max_wall=args.max_wall)
     for option, values, apply in (("--break", args.breaks, session.add_breakpoint),
                                   ("--watch", args.watch, session.add_watch)):
         for value in values:

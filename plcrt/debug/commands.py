@@ -35,6 +35,11 @@ if TYPE_CHECKING:
 #: ``run until`` gives up after this much simulated time unless told otherwise
 DEFAULT_UNTIL_TIMEOUT = "10s"
 
+#: the most scans one command runs (scan, run, run until's timeout, pulse):
+#: a few minutes of wall-clock time at the debugger's scan-by-scan pace;
+#: plcrt run takes longer runs (with --max-wall)
+MAX_COMMAND_SCANS = 10_000_000
+
 
 # ---------------------------------------------------------------------------
 # The handlers
@@ -56,7 +61,7 @@ def _cmd_run(s: Session, args: list[str]) -> None:
     if len(args) > 1:
         raise CommandError(f"run takes one duration, got '{' '.join(args)}'")
     us = round(_seconds(args[0]) * 1e6)
-    n = -(-us // s.plc.scan_us)   # as Plc.run: whole scans covering the time
+    n = _bounded(-(-us // s.plc.scan_us), "run", s)   # as Plc.run: whole scans covering it
     with s._scanning():
         s._scan(n)
 
@@ -70,7 +75,7 @@ def _run_until(s: Session, args: list[str]) -> None:
             raise CommandError("write 'run until COND timeout DURATION'")
         timeout = args[-1]
         args = args[:i]
-    _seconds(timeout)
+    _bounded(-(-round(_seconds(timeout) * 1e6) // s.plc.scan_us), "run until's timeout", s)
     text = " ".join(args)
     if not text:
         raise CommandError("run until needs a condition: Q0.0, not M0.1, VW100 >= 5")
@@ -82,7 +87,7 @@ def _run_until(s: Session, args: list[str]) -> None:
     # The harness names a callable condition by its __name__ in its
     # messages; the wrapper also ends the run on finish or Ctrl-C.
     def until() -> bool:
-        return s._abort is not None or pred()
+        return s._abort is not None or s._past_wall() or pred()
 
     until.__name__ = what
     with s._scanning():
@@ -415,9 +420,21 @@ def _pairs(text: str) -> list[tuple[str, str]]:
 def _count(args: list[str], cmd: str, default: int) -> int:
     if not args:
         return default
-    if len(args) > 1 or not re.fullmatch(r"\d+", args[0]):
-        raise CommandError(f"{cmd} takes a number of scans, got '{' '.join(args)}'")
-    return int(args[0])
+    # at most 20 digits: int() of a longer string is refused before any check
+    if len(args) > 1 or not re.fullmatch(r"\d{1,20}", args[0]):
+        raise CommandError(f"{cmd} takes a number of scans (at most {MAX_COMMAND_SCANS}), "
+                           f"got '{' '.join(args)[:40]}'")
+    return _bounded(int(args[0]), cmd)
+
+
+def _bounded(n: int, what: str, s: Session | None = None) -> int:
+    """``n`` scans, refused above :data:`MAX_COMMAND_SCANS`."""
+    if n > MAX_COMMAND_SCANS:
+        span = f" ({n:.3g} scans of {ms(s.plc.scan_us)} ms)" if s is not None else ""
+        raise CommandError(f"{what} would run {n} scans{span}: a command runs at most "
+                           f"{MAX_COMMAND_SCANS}; use several commands, or plcrt run "
+                           f"(with --max-wall) for long runs")
+    return n
 
 
 def _no_args(args: list[str], cmd: str) -> None:

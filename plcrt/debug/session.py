@@ -39,6 +39,7 @@ import re
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -85,10 +86,14 @@ class Session:
         handle_interrupt: Ctrl-C during a run stops it between two scans
             instead of killing the program (interactive sessions; needs
             the main thread).
+        max_wall: each command that runs scans stops between two scans
+            after this many wall-clock seconds (time paused at a
+            breakpoint does not count); None: no limit.
     """
 
     def __init__(self, plc: Plc, out: TextIO | None = None, *, echo: bool = False,
-                 color: bool = False, handle_interrupt: bool = False) -> None:
+                 color: bool = False, handle_interrupt: bool = False,
+                 max_wall: float | None = None) -> None:
         if plc.coverage is None:
             raise PlcConfigError("the debugger needs a program loaded with instrument=True "
                                  "(breakpoints use the network probes)")
@@ -97,6 +102,10 @@ class Session:
         self.echo = echo
         self.color = color
         self.handle_interrupt = handle_interrupt
+        self.max_wall = max_wall
+        self._deadline: float | None = None     # wall-clock end of the running command
+        #: a command was stopped by ``max_wall`` at least once in this session
+        self.walled = False
         self.harness = Harness(plc)
         self.coverage = plc.coverage
         self.coverage.on_break = self._on_break
@@ -134,10 +143,11 @@ class Session:
     @property
     def exit_status(self) -> int:
         """0 every command succeeded, 1 some command reported an error,
-        2 the PLC faulted (the CLI's exit codes)."""
+        2 the PLC faulted, 3 a command was stopped by ``max_wall`` (the
+        CLI's exit codes)."""
         if self.faulted:
             return 2
-        return 1 if self.errors else 0
+        return 1 if self.errors else 3 if self.walled else 0
 
     @property
     def paused(self) -> NetworkRef | None:
@@ -372,6 +382,7 @@ class Session:
             for row in self._watch_table():
                 self._print(row)
         self._resume = None
+        paused_at = time.monotonic()
         while self._resume is None:
             line = self._read(self._prompt())
             if line is None:
@@ -381,6 +392,8 @@ class Session:
                 break
             self.execute(line)
         action, self._resume, self._paused = self._resume, None, None
+        if self._deadline is not None:   # the time spent paused is not the run's
+            self._deadline += time.monotonic() - paused_at
         if action == "next":
             # Every network's probe on, until the first one fires (above).
             self._stepping = True
@@ -409,7 +422,9 @@ class Session:
             why = "after a fault" if plc.fault is not None else "(a STOP instruction ran)"
             self._print(f"note: the CPU is in STOP mode {why}: scans do nothing")
         self._abort = None
-        start = plc.scans
+        start, wall_start = plc.scans, time.monotonic()
+        if self.max_wall is not None:
+            self._deadline = wall_start + self.max_wall
         try:
             with self._interruptible():
                 yield
@@ -417,7 +432,7 @@ class Session:
             self._new_diagnostics()
             self._fault(e)
         finally:
-            reason, self._abort = self._abort, None
+            reason, self._abort, self._deadline = self._abort, None, None
             self._stepping = False
             self._apply_breaks()
         self._new_diagnostics()
@@ -425,6 +440,11 @@ class Session:
             self._print(f"scan {plc.scans} finished; the rest of the command is skipped")
         elif reason == "interrupt":
             self._print(f"interrupted after {plc.scans - start} scan(s)")
+        elif reason == "wall":
+            self.walled = True
+            self._print(f"stopped by --max-wall after {self.max_wall:g} s of wall-clock time, "
+                        f"at t={sim_time(plc)} s ({plc.scans - start} scan(s) run); the rest "
+                        f"of the command is skipped")
         self._report()
 
     @contextmanager
@@ -451,9 +471,16 @@ class Session:
         end the run between two of them."""
         plc = self.plc
         for _ in range(n):
-            if plc.mode != "RUN" or self._abort is not None:
+            if plc.mode != "RUN" or self._abort is not None or self._past_wall():
                 break
             plc.scan(1)
+
+    def _past_wall(self) -> bool:
+        """The running command reached ``max_wall`` (it then ends as by Ctrl-C)."""
+        if self._deadline is not None and time.monotonic() >= self._deadline:
+            self._abort = self._abort or "wall"
+            return True
+        return False
 
     # ------------------------------------------------------------------
     # Showing networks

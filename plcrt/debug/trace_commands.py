@@ -221,7 +221,7 @@ TRACE_COMMANDS: tuple[Command, ...] = (
     Command("plot", _cmd_plot, "plot FILE.png|FILE.svg",
             "plot the recorded signals to a PNG or SVG file (needs matplotlib)",
             "One subplot per signal on a shared time axis; bits and integers as steps.\n"
-            "matplotlib is optional: pip install 'plcrt[plot]'."),
+            "matplotlib is optional: the 'plot' extra (README.md, 'Quick start')."),
 )
 
 

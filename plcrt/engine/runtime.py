@@ -42,6 +42,7 @@ from .access import AddressAccess
 from .events import Scheduler
 from .interrupts import Interrupts
 from .edges import SignalEdges
+from ..compiler.entry import check_entry, main_block
 from .hsc import Encoder, make_counters
 from .pid import make_loops
 from .pulse import make_outputs
@@ -72,6 +73,7 @@ class Plc(AddressAccess):
                  watchdog_ms: float = WATCHDOG_MS, pace: str = "simulated",
                  plant: Any = None, instrument: bool = False, library: bool = False,
                  auto_symbols: bool = False, clock: Any = None, backend: str | None = None,
+                 entry: str | None = None,
                  _entry: Any = None, _template: bool = False) -> None:
         if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
                                              and 0.001 <= scan_ms <= 60000):
@@ -86,8 +88,9 @@ class Plc(AddressAccess):
         if backend == "native":
             from ..compiler.native.jit import available
             if not available():
-                raise PlcConfigError("backend 'native' needs llvmlite: pip install "
-                                     "'plcrt[native]' (or pip install llvmlite)")
+                from ..extras import install_hint
+                raise PlcConfigError(install_hint("backend 'native' needs llvmlite, which is "
+                                                  "not installed", "native"))
         if not isinstance(program, ir.Program):
             raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
                                  f"plcrt.load(), got {type(program).__name__}")
@@ -107,11 +110,14 @@ class Plc(AddressAccess):
             symbols, auto_diags = assign_symbols(program, self.model, symbols,
                                                  system_symbols, data)
         self.symbols = symbols
+        if entry is not None:
+            check_entry(entry)
+            library = True   # compiled as a library; the chosen block runs as OB1 does
         # what fork() needs to build a twin (the data block is in V already)
         self._config = dict(symbols=symbols, scan_ms=scan_ms, cpu=cpu,
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
                             pace=pace, plant=plant, instrument=instrument, library=library,
-                            clock=clock, backend=backend)
+                            clock=clock, backend=backend, entry=entry)
         #: the native segments' context over this PLC's buffers, or None
         self._native: Any = None
         #: network/output coverage and breakpoints (``instrument=True`` only)
@@ -218,7 +224,13 @@ class Plc(AddressAccess):
         self._wd_used = self.unit.uses_wd
         self._bufs_end = (a["PI"], a["Q"], a["PQ"])
         ns = self._ns
-        self._ob1 = ns["pou_OB1"] if "OB1" in self.unit.pous else None
+        #: the block each scan runs as the main program (OB1, or ``entry``)
+        self.main_block: str | None = "OB1" if "OB1" in self.unit.pous else None
+        if entry is not None:
+            self.main_block = main_block(self.unit, entry)
+            self.diagnostics = [d for d in self.diagnostics if d.code != "no-ob1"]
+        self._ob1 = (ns[self.unit.pous[self.main_block].fname]
+                     if self.main_block is not None else None)
         self._int_fns = {p.number: ns[f"pou_INT{p.number}"] for p in program.pous
                          if p.kind == "INT" and f"pou_INT{p.number}" in ns}
         if data is not None:

@@ -372,7 +372,7 @@ def scan_total(scan_us: int, seconds: Any = None, scans: Any = None) -> int:
 
 #: the keyword options of load() besides symbols, data, scan_ms and cpu
 LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols", "library",
-                "max_file_mb", "auto_symbols", "clock", "backend")
+                "max_file_mb", "auto_symbols", "clock", "backend", "entry")
 
 #: the code generators a program can be loaded with (plcrt.compiler.native)
 BACKENDS = ("python", "native")

@@ -23,9 +23,28 @@ See docs/traces.md.  matplotlib and rich are imported only when used.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
+# plot is light (matplotlib is imported when a plot is made) and shares its
+# name with its module: imported here, the package's ``plot`` is the function
 from .plot import plot
-from .progress import run_with_progress
-from .recorder import Trace
-from .spark import sparkline, trend
+
+if TYPE_CHECKING:
+    from .progress import run_with_progress
+    from .recorder import Trace
+    from .spark import sparkline, trend
 
 __all__ = ["Trace", "plot", "run_with_progress", "sparkline", "trend"]
+
+#: public name -> the module that defines it (imported on first use)
+_LAZY = {"Trace": "recorder", "run_with_progress": "progress",
+         "sparkline": "spark", "trend": "spark"}
+
+
+def __getattr__(name: str) -> Any:
+    # perf: `plcrt --help` imports plcrt.trace.cli to register `trace`; the
+    # recorder (numpy) and the engine load only when a trace is made
+    if name in _LAZY:
+        import importlib
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -7,7 +7,8 @@ and the PLC's memory does not change between scans, so an instantaneous
 change must never be drawn as a ramp.  REAL values and axis speeds are
 drawn as lines.
 
-matplotlib is an optional dependency (``pip install 'plcrt[plot]'``),
+matplotlib is an optional dependency (the ``plot`` extra; the error names the
+install command for this installation, :mod:`plcrt.extras`),
 imported only when a plot is made, and only its Agg canvas is used: no
 window, no pyplot state, no change of the user's backend.  The files are
 reproducible: SVG ids are salted with a fixed string and no date is
@@ -33,7 +34,8 @@ _RC = {
     "font.size": 9,
 }
 
-_INSTALL_HINT = "plotting needs matplotlib, which is not installed: pip install 'plcrt[plot]'"
+#: what the hint says before the install command (plcrt.extras.install_hint)
+_MISSING = "plotting needs matplotlib, which is not installed"
 
 
 def plot_format(path: str | Path) -> str:
@@ -60,7 +62,8 @@ def require_matplotlib() -> Any:
         from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: F401
         from matplotlib.figure import Figure  # noqa: F401
     except ImportError:
-        raise PlcConfigError(_INSTALL_HINT) from None
+        from ..extras import install_hint
+        raise PlcConfigError(install_hint(_MISSING, "plot")) from None
     return matplotlib
 
 

@@ -35,6 +35,29 @@ PROGRESS_EVERY_S = 5.0
 _CHUNK_S = 0.05
 
 
+#: the longest run the command line accepts, in simulated µs: times are
+#: counted in whole microseconds, and beyond a signed 64-bit count (about
+#: 292 000 years) a span is not something any tool of plcrt can count
+MAX_RUN_US = 2**63 - 1
+
+
+def check_run_span(seconds: float | None, scans: int | None, scan_us: int,
+                   options: tuple[str, str] = ("--seconds", "--scans")) -> None:
+    """Refuse a run longer than :data:`MAX_RUN_US` of simulated time.
+
+    Raises:
+        PlcConfigError: naming the option and the longest run.
+    """
+    longest = f"{MAX_RUN_US / 1e6:.3g} s of simulated time (2^63 µs, about 292 000 years)"
+    if seconds is not None and seconds * 1e6 > MAX_RUN_US:
+        raise PlcConfigError(f"{options[0]} {seconds:g} is longer than a run can be counted: "
+                             f"at most {longest}")
+    if scans is not None and scans * scan_us > MAX_RUN_US:
+        shown = str(scans) if scans < 10**12 else f"{scans:.3g}"
+        raise PlcConfigError(f"{options[1]} {shown} is longer than a run can be counted: "
+                             f"at most {longest} ({scan_us / 1000:g} ms a scan)")
+
+
 class WallTimeExceeded(PlcError):
     """The run reached its wall-clock limit (``max_wall``) and was stopped
     between two scans; the PLC is in the state of the last full scan."""
@@ -69,7 +92,8 @@ def check_max_wall(max_wall: float | None) -> None:
 def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | None = None,
                       quiet: bool = False, stream: TextIO | None = None,
                       max_wall: float | None = None, progress: bool = False,
-                      clock: Callable[[], float] = time.monotonic) -> None:
+                      clock: Callable[[], float] = time.monotonic,
+                      sleep: Callable[[float], None] = time.sleep) -> None:
     """Run ``plc`` like ``plc.run(seconds=..., scans=...)``.
 
     A progress bar is drawn on ``stream`` (default: stderr) only if it is a
@@ -78,7 +102,8 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
     terminal, ``progress`` prints a plain line every
     :data:`PROGRESS_EVERY_S` seconds (and one at the end); it is printed
     even when ``quiet``, since it was asked for.  ``max_wall`` stops the run
-    after that many wall-clock seconds.
+    after that many wall-clock seconds, at real-time pace too (the sleeps
+    between scans end at the limit).
 
     Raises:
         PlcConfigError: neither or both of seconds/scans, or a negative one,
@@ -91,25 +116,56 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
     out = sys.stderr if stream is None else stream
     terminal = _is_terminal(out)
     if terminal and (progress or not quiet and total > MIN_SCANS_FOR_BAR):
-        _run_with_bar(plc, total, out, max_wall=max_wall, clock=clock)
+        _run_with_bar(plc, total, out, max_wall=max_wall, clock=clock, sleep=sleep)
     elif max_wall is not None or progress:
-        _run_watched(plc, total, out if progress else None, max_wall, clock)
+        _run_watched(plc, total, out if progress else None, max_wall, clock, sleep)
     else:
         plc.run(seconds=seconds, scans=scans)   # the plain run, by construction
 
 
 def _stopped(plc: Any, done: int, total: int, max_wall: float) -> WallTimeExceeded:
+    # a count past fifteen digits reads better as a magnitude (9.22e+17 scans)
+    of = str(total) if total < 10**15 else f"{total:.3g}"
     return WallTimeExceeded(
         f"stopped by --max-wall after {max_wall:g} s of wall-clock time, at {plc.time:g} s "
-        f"simulated ({done} of {total} scans run); the results are those of that moment")
+        f"simulated ({done} of {of} scans run); the results are those of that moment")
+
+
+def _scan(plc: Any, n: int, deadline: float | None, clock: Callable[[], float],
+          sleep: Callable[[float], None]) -> None:
+    """``n`` scans, as ``plc.scan(n)``.  A PLC at real-time pace is paced
+    here, scan by scan, so that the wall-clock ``deadline`` also ends its
+    sleeps: the engine's own pacing would sleep through a whole chunk."""
+    if plc.pace != "realtime":
+        plc.scan(n)
+        return
+    period = plc.scan_us / 1e6
+    plc.pace = "simulated"   # the same scans; only who sleeps changes
+    try:
+        for _ in range(n):
+            if plc.mode != "RUN":
+                return
+            end = clock() + period
+            plc.scan(1)
+            if deadline is not None:
+                end = min(end, deadline)
+            left = end - clock()
+            if left > 0:
+                sleep(left)
+            if deadline is not None and clock() >= deadline:
+                return
+    finally:
+        plc.pace = "realtime"
 
 
 def _run_watched(plc: Any, total: int, out: TextIO | None, max_wall: float | None,
-                 clock: Callable[[], float]) -> None:
+                 clock: Callable[[], float],
+                 sleep: Callable[[float], None] = time.sleep) -> None:
     """Run ``total`` scans in chunks sized to take about :data:`_CHUNK_S`,
     printing a progress line to ``out`` (if any) every few seconds and
     stopping at ``max_wall``."""
     start = clock()
+    deadline = None if max_wall is None else start + max_wall
     next_line = start + PROGRESS_EVERY_S
     first = plc.scans
     done = 0
@@ -117,7 +173,7 @@ def _run_watched(plc: Any, total: int, out: TextIO | None, max_wall: float | Non
     while done < total and plc.mode == "RUN":
         n = min(chunk, total - done)
         t0 = clock()
-        plc.scan(n)
+        _scan(plc, n, deadline, clock, sleep)
         done = plc.scans - first   # fewer than asked when a STOP ended the run
         now = clock()
         took = now - t0
@@ -144,7 +200,8 @@ def _line(out: TextIO, plc: Any, done: int, total: int, elapsed: float) -> None:
 
 
 def _run_with_bar(plc: Any, total: int, out: TextIO, *, max_wall: float | None = None,
-                  clock: Callable[[], float] = time.monotonic) -> None:
+                  clock: Callable[[], float] = time.monotonic,
+                  sleep: Callable[[float], None] = time.sleep) -> None:
     from rich.console import Console
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
                                TimeElapsedColumn, TimeRemainingColumn)
@@ -156,18 +213,23 @@ def _run_with_bar(plc: Any, total: int, out: TextIO, *, max_wall: float | None =
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                TextColumn("scans"), TextColumn("{task.fields[sim]}"),
                TimeElapsedColumn(), TimeRemainingColumn())
+    if plc.pace == "realtime":
+        # a chunk at real-time pace lasts its simulated time: keep it short
+        chunk = max(1, min(chunk, int(_CHUNK_S * 1e6 // plc.scan_us)))
     start = clock()
+    deadline = None if max_wall is None else start + max_wall
+    first = plc.scans
     with Progress(*columns, console=console, transient=True) as bar:
         task = bar.add_task("running", total=total, sim=f"{plc.time:.3f} s")
         done = 0
         while done < total and plc.mode == "RUN":
             n = min(chunk, total - done)
-            plc.scan(n)
-            done += n
+            _scan(plc, n, deadline, clock, sleep)
+            done = plc.scans - first
             bar.update(task, completed=done, sim=f"{plc.time:.3f} s")
             if max_wall is not None and clock() - start >= max_wall and done < total:
                 raise _stopped(plc, done, total, max_wall)
 
 
-__all__ = ["MIN_SCANS_FOR_BAR", "PROGRESS_EVERY_S", "WallTimeExceeded", "check_max_wall",
+__all__ = ["MAX_RUN_US", "MIN_SCANS_FOR_BAR", "check_run_span", "PROGRESS_EVERY_S", "WallTimeExceeded", "check_max_wall",
            "run_with_progress", "scan_count"]

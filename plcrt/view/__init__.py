@@ -10,7 +10,22 @@ a program runs.
 
 from __future__ import annotations
 
-from .ladder import Ladder, to_ladder
-from .status import PlcStatus
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .ladder import Ladder, to_ladder
+    from .status import PlcStatus
 
 __all__ = ["Ladder", "PlcStatus", "to_ladder"]
+
+#: public name -> the module that defines it (imported on first use)
+_LAZY = {"Ladder": "ladder", "to_ladder": "ladder", "PlcStatus": "status"}
+
+
+def __getattr__(name: str) -> Any:
+    # perf: `plcrt --help` imports plcrt.view.cli to register `show`; the
+    # ladder model needs the compiler (and lark), loaded only when drawing
+    if name in _LAZY:
+        import importlib
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -49,22 +49,21 @@ def cmd_show(args: argparse.Namespace) -> int:
     running for --status (the drawing then shows the state at the fault)."""
     from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
                        load_for_run, parse_sets, print_diagnostics)
-    from ..engine.runtime import parse_sources
     from ..errors import PlcConfigError, PlcError, PlcRuntimeError, PlcSyntaxError
 
     fault: PlcError | None = None
     broken: PlcError | None = None
+    symbols: Any = None
     try:
         _check_options(args, PlcConfigError)
         check_run_length(args)
         if args.status:
             writes = parse_sets(args.set)
             plc = load_for_run(args, writes)
-            program = plc.program
+            program, symbols = plc.program, plc.symbols
         else:
             try:
-                program = parse_sources([Path(p) for p in args.programs],
-                                        encoding=args.encoding)
+                program, symbols = _parse(args)
             except PlcSyntaxError as e:
                 # draw every block that parsed; the errors are listed first
                 if e.partial is None or not e.partial.pous or args.network:
@@ -110,7 +109,7 @@ def cmd_show(args: argparse.Namespace) -> int:
         console.print(f"status after {plc.scans} scan(s), {plc.time:g} s simulated, "
                       f"mode {plc.mode}", markup=False)
     texts = render_program(program, status=status, networks=selected,
-                           styled=console.is_terminal, stl=args.stl)
+                           styled=console.is_terminal, stl=args.stl, names=_names(symbols))
     for i, text in enumerate(texts):
         console.print(text)
         if i + 1 < len(texts):
@@ -124,6 +123,28 @@ def cmd_show(args: argparse.Namespace) -> int:
         print_diagnostics(stopped.diagnostics)
         return EXIT_WALL
     return EXIT_OK
+
+
+def _parse(args: argparse.Namespace) -> tuple[Any, Any]:
+    """(program, symbol table or None) of the command line, parsed only."""
+    from ..lang.limits import file_limit
+    from ..lang.sources import read_program
+
+    program, symbols, _ = read_program(
+        [Path(p) for p in args.programs], Path(args.symbols) if args.symbols else None,
+        encoding=args.encoding, max_bytes=file_limit(args.max_file_mb))
+    return program, symbols
+
+
+def _names(symbols: Any) -> Any:
+    """Operand text -> the text drawn, as the browser panel names operands:
+    ``Start_PB:I0.0`` for an address or a symbol of the table; None
+    without a table."""
+    if symbols is None or not getattr(symbols, "entries", None):
+        return None
+    from ..web.present import symbol_names
+    names = symbol_names(symbols)
+    return lambda text: names(text)[0]
 
 
 def _check_options(args: argparse.Namespace, error: type) -> None:

@@ -138,18 +138,27 @@ def vstack(blocks: list[Block], left: Power, right: list[Power] | None) -> Block
     return hcat([_stub(left), out, _stub(or3(right))])
 
 
-class _Ctx:
-    """The block being drawn and where its status values come from."""
+#: operand text -> the text drawn (``Start_PB:I0.0`` with a symbol table)
+Names = Callable[[str], str]
 
-    def __init__(self, pou: str, status: Status | None) -> None:
-        self.pou, self.status = pou, status
+
+class _Ctx:
+    """The block being drawn, where its status values come from and how its
+    operands are named."""
+
+    def __init__(self, pou: str, status: Status | None, names: Names | None = None) -> None:
+        self.pou, self.status, self._names = pou, status, names
+
+    def name(self, text: str) -> str:
+        """The operand as drawn: ``name:address`` when a symbol is involved."""
+        return self._names(text) if self._names is not None and text else text
 
     def label(self, text: str, kind: str | None = None) -> tuple[str, str]:
-        """(operand, "=value" or "") of an address in status mode."""
+        """(operand as drawn, "=value" or "") of an address in status mode."""
         if self.status is None or not text:
-            return text, ""
+            return self.name(text), ""
         v = self.status.value(self.pou, text, kind)
-        return text, "" if v is None else "=" + fmt_value(v, text, kind)
+        return self.name(text), "" if v is None else "=" + fmt_value(v, text, kind)
 
 
 _BYTE_RE = re.compile(r"(SM|[IQMVSL])B\d+$", re.I)
@@ -195,7 +204,7 @@ def _contact(c: Contact, p_in: Power, ctx: _Ctx) -> tuple[Block, Power]:
         closed = contact_state(c, ctx.pou, ctx.status)
         p_out = and3(p_in, closed)
     kind = "REAL" if shp.compare.startswith("R") else None
-    above = ctx.label(c.above, kind) if shp.compare else (c.above, "")
+    above = ctx.label(c.above, kind) if shp.compare else (ctx.name(c.above), "")
     below = ctx.label(c.below, kind) if shp.compare else ("", "")
     inside = shp.lad
     if closed is True:
@@ -237,7 +246,7 @@ def _coil(c: Coil, p: Power, ctx: _Ctx) -> Block:
     sym = c.symbol
     if p is True:
         sym = sym.replace(" ", "█")
-    above, below = (c.above, ""), (c.below, "")
+    above, below = (ctx.name(c.above), ""), (c.below, "")
     sw = cell_len(sym)
     width = max(sw + 2, _width(above) + 1, _width(below) + 1)
     lead = width - sw
@@ -266,13 +275,15 @@ def _box(box: Box, powers: list[Power], ctx: _Ctx,
     pin_rows = max(len(lefts), len(rights))
     lname = max([cell_len(p.name) for p in lefts] + [cell_len(n) for n in power_names] + [0])
     rname = max([cell_len(p.name) for p in rights] + [3 if box.eno else 0])
-    inner = max(_cells(box.title) + 2, lname + rname + 2, cell_len(box.note) + 2, 6)
+    above = (ctx.name(box.above), "")
+    if box.above:  # timer / counter: its current value; SCR bit: its state
+        above = ctx.label(box.above, "BIT" if not box.eno and not box.power else None)
+    # the box is at least as wide as the name above it (Jam_Timer:T37)
+    inner = max(_cells(box.title) + 2, lname + rname + 2, cell_len(box.note) + 2, 6,
+                _width(above) - 2)
     # a blank between an operand and the next element's (chained boxes)
     lm = max([_width(v) + 2 for v in lvals] + [3])
     rm = max([_width(v) + 2 for v in rvals] + [0])
-    above = (box.above, "")
-    if box.above:  # timer / counter: its current value; SCR bit: its state
-        above = ctx.label(box.above, "BIT" if not box.eno and not box.power else None)
     top = 1 if box.above else 0
     first = top + 2                                 # first power pin (or title) row
     prow = [first]
@@ -383,7 +394,8 @@ def _stl_lines(network: ir.Network, ctx: _Ctx) -> Block:
     followed by the values of its addresses."""
     lines = []
     for insn in network.insns:
-        stl = f"{insn.mnemonic:<6} {', '.join(o.text for o in insn.operands)}".rstrip()
+        stl = f"{insn.mnemonic:<6} {', '.join(ctx.name(o.text) for o in insn.operands)}"
+        stl = stl.rstrip()
         shp = shape(insn.mnemonic)
         bit = shp.kind in ("contact", "coil", "rail") and not shp.compare
         kind = "REAL" if shp.compare.startswith("R") else None
@@ -403,8 +415,9 @@ def _stl_lines(network: ir.Network, ctx: _Ctx) -> Block:
 
 
 def _network_block(pou: ir.Pou, network: ir.Network, status: Status | None,
-                   program: ir.Program | None, stl: bool) -> tuple[Block, str]:
-    ctx = _Ctx(pou.ident, status)
+                   program: ir.Program | None, stl: bool,
+                   names: Names | None = None) -> tuple[Block, str]:
+    ctx = _Ctx(pou.ident, status, names)
     p_rail: Power = True if status is not None else None
     lad = to_ladder(network, program=program)
     if stl or not lad.ok:
@@ -449,11 +462,12 @@ def _to_text(block: Block, styled: bool, status: bool) -> Text:
 
 def render_network(pou: ir.Pou, network: ir.Network, *, status: Status | None = None,
                    styled: bool = True, program: ir.Program | None = None,
-                   stl: bool = False) -> Text:
+                   stl: bool = False, names: Names | None = None) -> Text:
     """One network: a ``Network n  title`` line, then the rung in LAD, or
     the STL (``stl=True``, or when the network has no LAD form, saying why).
-    ``status`` gives live values; ``program`` names CALL box pins."""
-    block, reason = _network_block(pou, network, status, program, stl)
+    ``status`` gives live values; ``program`` names CALL box pins;
+    ``names`` gives the text drawn for an operand (symbol names)."""
+    block, reason = _network_block(pou, network, status, program, stl, names)
     style: Callable[[str], str | None] = (lambda k: _STYLES[k]) if styled else (lambda k: None)
     out = Text()
     out.append(f"Network {network.number}", style("hdr"))
@@ -470,9 +484,11 @@ def render_network(pou: ir.Pou, network: ir.Network, *, status: Status | None = 
 
 def render_program(program: ir.Program, *, status: Status | None = None,
                    networks: Iterable[tuple[str, int]] | None = None,
-                   styled: bool = True, stl: bool = False) -> list[Text]:
+                   styled: bool = True, stl: bool = False,
+                   names: Names | None = None) -> list[Text]:
     """Every network (or those in ``networks``, as ``(block id, number)``),
-    each block introduced by a ``OB1 (MAIN)  title`` line."""
+    each block introduced by a ``OB1 (MAIN)  title`` line; ``names`` as in
+    :func:`render_network`."""
     wanted = None if networks is None else set(networks)
     out: list[Text] = []
     for pou in program.pous:
@@ -484,14 +500,15 @@ def render_program(program: ir.Program, *, status: Status | None = None,
                         _STYLES["pou"] if styled else ""))
         for n in nets:
             out.append(render_network(pou, n, status=status, styled=styled,
-                                      program=program, stl=stl))
+                                      program=program, stl=stl, names=names))
     return out
 
 
 def ladder_text(pou: ir.Pou, network: ir.Network, status: Status | None = None, *,
-                program: ir.Program | None = None) -> str:
+                program: ir.Program | None = None, names: Names | None = None) -> str:
     """The plain text of :func:`render_network` (for tests and logs)."""
-    return render_network(pou, network, status=status, styled=False, program=program).plain
+    return render_network(pou, network, status=status, styled=False, program=program,
+                          names=names).plain
 
 
 __all__ = ["Block", "fmt_value", "hcat", "ladder_text", "render_network", "render_program",

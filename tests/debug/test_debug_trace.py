@@ -161,8 +161,8 @@ def test_plot_without_matplotlib_is_an_error_line(tmp_path: Path,
     monkeypatch.setitem(sys.modules, "matplotlib", None)   # import matplotlib fails
     status = s.run(["trace Q0.0", "scan", "plot q.png", "csv q.csv"])
     text = out.getvalue()
-    assert ("(plcrt) plot q.png\nerror: plotting needs matplotlib, which is not installed: "
-            "pip install 'plcrt[plot]'\n") in text
+    assert ("(plcrt) plot q.png\nerror: plotting needs matplotlib, which is not installed; "
+            "install the 'plot' extra: ") in text
     assert "Traceback" not in text and "internal error" not in text
     assert text.endswith("wrote 1 sample of Q0.0 to q.csv\n")
     assert not (tmp_path / "q.png").exists()

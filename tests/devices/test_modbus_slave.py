@@ -334,7 +334,8 @@ def test_export_protected_blocks_run_the_library():
     plc.run(0.05)
     assert answers(plc)[0]["values"] == [5]
     warns = [d.message for d in plc.diagnostics]
-    assert sum("Modbus RTU slave library" in w and "Error 9" in w for w in warns) == 1
+    assert sum("Modbus RTU slave library" in w and "Error 4, 6, 7, 9, 10" in w
+               for w in warns) == 1
     assert not any("no code" in w or "own subroutine" in w for w in warns)
 
 

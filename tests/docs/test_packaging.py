@@ -1,4 +1,6 @@
-"""``make setup`` installs plcrt without setuptools deprecation warnings.
+"""What ``make`` installs: plcrt without setuptools deprecation warnings;
+``make demo`` only what running needs, ``make test`` the test extra too
+(after a ``make demo``, only the test extra).
 
 setuptools 77 deprecated ``project.license`` as a TOML table
 (``{ text = "MIT" }``) in favour of an SPDX expression string, and warns
@@ -41,3 +43,55 @@ def test_make_setup_keeps_pip_quiet() -> None:
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     installs = re.findall(r"^\t.*pip install.*$", makefile, flags=re.M)
     assert installs and all(" -qq " in line for line in installs)
+
+
+# ---------------------------------------------------------------------------
+# What each make target installs (make -n: the commands, none of them run)
+# ---------------------------------------------------------------------------
+
+def _make_n(target: str, venv: Path) -> list[str]:
+    import subprocess
+    out = subprocess.run(["make", "-n", "-C", str(ROOT), f"VENV={venv}", target],
+                         capture_output=True, text=True, check=True).stdout
+    return [line for line in out.splitlines() if "pip install" in line]
+
+
+def _stamp(venv: Path, name: str) -> None:
+    import os
+    path = venv / "bin" / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.touch()
+    later = (ROOT / "pyproject.toml").stat().st_mtime + 10
+    os.utime(path, (later, later))
+
+
+def test_make_demo_installs_what_running_needs(tmp_path: Path) -> None:
+    """The demo installs plcrt and its dependencies, not the test extra
+    (pytest, hypothesis, matplotlib, llvmlite, playwright: hundreds of MB)."""
+    installs = _make_n("demo", tmp_path / "venv")
+    assert any(line.endswith("pip install -qq -e .") for line in installs)
+    assert not any("[test]" in line or "[native]" in line for line in installs)
+
+
+def test_make_demo_runs_only_what_it_installed() -> None:
+    """The native backend is the optional 'native' extra: the demo has no
+    line that needs it."""
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    demo = makefile.split("\ndemo:", 1)[1].split("\n\n", 1)[0]
+    assert "plcrt run" in demo and "--backend native" not in demo
+
+
+def test_make_test_from_a_fresh_clone_installs_the_test_extra(tmp_path: Path) -> None:
+    installs = _make_n("test", tmp_path / "venv")
+    assert any(line.endswith("pip install -qq -e .") for line in installs)
+    assert any(line.endswith("pip install -qq -e '.[test]'") for line in installs)
+
+
+def test_make_test_after_make_demo_adds_only_the_test_extra(tmp_path: Path) -> None:
+    venv = tmp_path / "venv"
+    _stamp(venv, ".installed")          # what make demo left
+    installs = _make_n("test", venv)
+    assert installs and all(line.endswith("pip install -qq -e '.[test]'")
+                            for line in installs)
+    _stamp(venv, ".installed-test")     # and after make test: nothing to install
+    assert _make_n("test", venv) == [] and _make_n("demo", venv) == []

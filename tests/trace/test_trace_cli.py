@@ -98,7 +98,7 @@ def test_trace_missing_matplotlib_fails_before_running(
     code, out, err = run_cli(capsys, "trace", TIMERS, "--signal", "T37", "--scans", "5",
                              "--csv", csv, "--plot", tmp_path / "t.png")
     assert code == 1 and out == ""
-    assert "pip install 'plcrt[plot]'" in err
+    assert "-m pip install -e '" in err and "[plot]' (README.md, 'Quick start')" in err
     assert not csv.exists()
 
 

@@ -32,6 +32,7 @@ export named MBUS_INIT / MBUS_SLAVE runs these (``register_protected``).
 
 from __future__ import annotations
 
+import re
 from collections import deque
 from typing import Any, Optional
 
@@ -54,6 +55,9 @@ ERRORS = {0: "no error", 1: "memory range error", 2: "illegal baud rate or parit
           9: "illegal memory address in request", 10: "slave function not enabled",
           11: "invalid port number", 12: "port 1 missing or not configured"}
 #: what plcrt decided where the manual has no word (docs/modbus.md)
+#: the Error numbers a choice names ("Error 6 / 7" names 6 and 7)
+_ERROR_NUMBER = re.compile(r"(?<=Error )\d+|(?<=Error \d / )\d+")
+
 PLCRT_CHOICES = {
     "MBUS_INIT": ("Error 4 for Mode not 0 or 1 and for Delay above 32767 ms",),
     "MBUS_SLAVE": ("Error 9 also for an illegal data value (a count, coil value or "
@@ -212,10 +216,12 @@ class _Block(LibraryBlock):
 
     @classmethod
     def notice(cls, itf: Any) -> str:
-        choices = "; ".join(f"{k}: {c}" for k, cs in PLCRT_CHOICES.items() for c in cs)
-        return (f"{itf.name}: the Modbus RTU slave library (MBUS_INIT, MBUS_SLAVE) is "
-                f"emulated; its library memory and interrupt routines are not simulated; "
-                f"plcrt's choices where the manual has no word: {choices} (docs/modbus.md)")
+        # one short line naming the Error numbers; what was chosen is in the docs
+        numbers = {int(n) for cs in PLCRT_CHOICES.values() for c in cs
+                   for n in _ERROR_NUMBER.findall(c)}
+        codes = ", ".join(map(str, sorted(numbers)))
+        return (f"{itf.name}: the Modbus RTU slave library is emulated (no library memory, "
+                f"no interrupt routines); plcrt's choices: Error {codes} (docs/modbus.md)")
 
 
 @register_block("MBUS_INIT")

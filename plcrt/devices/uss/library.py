@@ -262,11 +262,10 @@ class _Block(LibraryBlock):
 
     @classmethod
     def notice(cls, itf: Any) -> str:
-        msg = ", ".join(f"{k} ({ERRORS[k]})" for k in PLCRT_CHOICES["USS_INIT"])
-        return (f"{itf.name}: the USS protocol library (USS_INIT, USS_CTRL, USS_RPM_x, "
-                f"USS_WPM_x) is emulated; its library memory and interrupt routines are not "
-                f"simulated; Error numbers not confirmed from the manual are plcrt's choice: "
-                f"USS_INIT {msg} (docs/uss.md)")
+        # one short line: the details are in the docs' error table
+        codes = ", ".join(str(k) for k in PLCRT_CHOICES["USS_INIT"])
+        return (f"{itf.name}: the USS protocol library is emulated (no library memory, no "
+                f"interrupt routines); plcrt's choice: Error {codes} (docs/uss.md)")
 
     def refuse(self, code: int, why: str = "") -> int:
         self.warn(f"Error {code}: {ERRORS[code]}{why}", f"err{code}")

@@ -230,6 +230,15 @@ def test_the_force_marker_needs_no_emoji_font(serve, page) -> None:
     assert float(marker["width"].removesuffix("px")) > 4
 
 
+def _outside(page) -> list[dict]:
+    """The visible controls, lamps and canvases not inside the screen's width."""
+    return page.evaluate(
+        "() => [...document.querySelectorAll('button, input, select, [data-lamp], canvas')]"
+        ".filter(e => e.offsetParent !== null).map(e => { const r = e.getBoundingClientRect();"
+        " return {what: e.outerHTML.slice(0, 60), l: r.left, r: r.right}; })"
+        ".filter(x => x.l < 0 || x.r > innerWidth)")
+
+
 def test_a_600_px_screen_reaches_every_control(serve, page) -> None:
     """At 600 px every button, field and lamp lies inside the width of the
     screen (the page scrolls down, never sideways)."""
@@ -237,15 +246,24 @@ def test_a_600_px_screen_reaches_every_control(serve, page) -> None:
     served = serve()
     open_panel(page, served)
     force_in_watch(page, "VW0", "7")
-    out = page.evaluate(
-        "() => [...document.querySelectorAll('button, input, select, [data-lamp], canvas')]"
-        ".filter(e => e.offsetParent !== null).map(e => { const r = e.getBoundingClientRect();"
-        " return {what: e.outerHTML.slice(0, 60), l: r.left, r: r.right}; })"
-        ".filter(x => x.l < 0 || x.r > innerWidth)")
-    assert out == []
+    assert _outside(page) == []
     assert page.evaluate("() => document.documentElement.scrollWidth") <= 600
     page.locator('[data-input="I0.1"]').scroll_into_view_if_needed()
     page.locator('[data-input="I0.1"]').click()     # Stop_PB: a push-button, reachable
+
+
+def test_a_phone_screen_shows_a_lesson_in_one_column(serve, page) -> None:
+    """360 px with a lesson open (its list of lessons, text, axis slide and
+    trends): still nothing beyond the right edge."""
+    les = course.lesson(REPO / "examples/course/05-jog-and-position")
+    plc = plcrt.load(les.program, plant=les.plant)
+    served = serve(panel=Panel(PanelSession(plc), lessons=course.lessons(les.dir.parent),
+                               current=les))
+    page.set_viewport_size({"width": 360, "height": 740})
+    open_panel(page, served)
+    assert page.locator("#lessons").is_visible() and page.locator(".axis canvas").is_visible()
+    assert _outside(page) == []
+    assert page.evaluate("() => document.documentElement.scrollWidth") <= 360
 
 
 def test_inputs_and_lamps_have_accessible_names_and_states(serve, page) -> None:

@@ -114,6 +114,8 @@ SERVER: dict[str, str] = {
     "notice": "something the user should read: a breakpoint reached, a condition met, "
               "a fault",
     "check": "the result of check: each test with its outcome, and the pytest output",
+    "diagnostics": "the program's warnings at load and while running, and a fault, as the "
+                   "CLI prints them, each with its network (the whole list, again when it grows)",
 }
 
 

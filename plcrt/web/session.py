@@ -50,6 +50,7 @@ from ..safetext import printable
 from ..testing.harness import Harness, condition, reader
 from ..view.ladder import Ladder, to_ladder
 from ..view.status import PlcStatus
+from .diagnostics import DiagnosticLog
 from .mailbox import Client, Mailbox
 from .present import INPUT_KINDS, axis_marks, drive_marks, format_value, input_kinds, io_bits, \
     symbol_names
@@ -165,6 +166,9 @@ class PanelSession:
         self._hello: dict[str, Any] | None = None
         #: the error of the last command applied without a client (tests)
         self.last_error: dict[str, Any] | None = None
+        #: load-time and run-time diagnostics, for the pages
+        self.diagnostics = DiagnosticLog(self._blocks, set(self._nets))
+        self.diagnostics.sync(plc)
 
     # ------------------------------------------------------------------
     # Clients
@@ -202,7 +206,7 @@ class PanelSession:
         """What a page needs to draw the program (sent once per connection)."""
         if self._hello is None:
             self._hello = self._make_hello()
-        return self._hello
+        return {**self._hello, "diagnostics": self.diagnostics.shown}
 
     def _make_hello(self) -> dict[str, Any]:
         plc, prog = self.plc, self.plc.program
@@ -387,6 +391,9 @@ class PanelSession:
         self._apply_breaks()
         self.state, self._left, self._until = "stopped", None, None
         self._clear_trend()
+        if self.trend.signals:   # the pages' trends start again too (their time went back)
+            self._broadcast(self._trend_message())
+            self.trend.sent = self.trend.count
         self._broadcast({"type": "notice", "level": "info", "message": "power-up reset"})
 
     def _do_set(self, client: Client | None, msg: dict[str, Any]) -> None:
@@ -711,6 +718,8 @@ class PanelSession:
             self._publish()
 
     def _publish(self) -> None:
+        if self.diagnostics.sync(self.plc):
+            self._broadcast(self.diagnostics.message())
         frame = self.frame()
         with self._lock:
             clients = list(self.clients.values())

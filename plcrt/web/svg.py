@@ -38,6 +38,13 @@ CH = 7.3
 ROW = 20
 #: the pitch of a box's operand pins: an operand and its live value below it
 PIN_ROW = 26
+#: width of one character of the 10 px texts inside contacts and coils
+CH_IN = 6.1
+#: width of one character of the 11 px live values
+CH_VAL = 6.7
+#: the longest value text of a compare contact's operands, by compared type
+#: (``-32768``, ``-2147483648``, ``+1.234568e+38``); strings are not reserved
+_CMP_VALUE = {"B": 3, "W": 6, "D": 11, "R": 14}
 
 
 def esc(text: str) -> str:
@@ -116,41 +123,48 @@ class _Walk:
             p_out = and3(p_in, closed)
         kind = "REAL" if shp.compare.startswith("R") else None
         below = bool(c.below)
-        w = max(70.0, self.width(c.above) + 14, self.width(c.below) + 14 if below else 0)
-        wire = 36.0
-        h = 72.0 if below else 50.0
+        inside = shp.lad.strip()
+        # The inside (``I``, ``/I``, ``>=I``) is written between the bars,
+        # which move apart to hold it; a compare contact also makes room for
+        # the values above and below it, so no two texts overlap.
+        written = inside if inside != "/" else ""
+        half = max(8.0, len(written) * CH_IN / 2 + 4)
+        cmp = _CMP_VALUE.get(shp.compare[:1], 0) * CH_VAL if shp.compare else 0.0
+        w = max(70.0, self.width(c.above) + 14, self.width(c.below) + 14 if below else 0,
+                2 * half + 30, cmp + 10)
+        wire = 42.0 if shp.compare else 36.0
+        h = wire + 42 if below else (wire + 14 if shp.compare else 50.0)
         cx = w / 2
         f = Fig(w, h, wire)
         kin, kc, kout = self.k(p_in), self.k(closed), self.k(p_out)
-        f.parts.append(self.line(kin, 0, wire, cx - 8, wire))
-        f.parts.append(self.line(kout, cx + 8, wire, w, wire))
-        inside = shp.lad.strip()
         if shp.kind == "modifier":
+            f.parts.append(self.line(kin, 0, wire, cx - 10, wire))
+            f.parts.append(self.line(kout, cx + 10, wire, w, wire))
             f.parts.append(f'<rect class="ct" data-k="{kc}" x="{cx - 10:g}" y="{wire - 9:g}" '
                            f'width="20" height="18" rx="3"/>')
             f.parts.append(f'<text class="in" x="{cx:g}" y="{wire + 4:g}" '
                            f'text-anchor="middle">{esc(inside)}</text>')
-            f.parts[0] = self.line(kin, 0, wire, cx - 10, wire)
-            f.parts[1] = self.line(kout, cx + 10, wire, w, wire)
             return f, p_out
-        f.parts.append(f'<path class="ct" data-k="{kc}" d="M{cx - 8:g},{wire - 11:g}v22'
-                       f'M{cx + 8:g},{wire - 11:g}v22"/>')
-        f.parts.append(f'<rect class="cf" data-k="{kc}" x="{cx - 6:g}" y="{wire - 9:g}" '
-                       f'width="12" height="18"/>')
+        f.parts.append(self.line(kin, 0, wire, cx - half, wire))
+        f.parts.append(self.line(kout, cx + half, wire, w, wire))
+        f.parts.append(f'<path class="ct" data-k="{kc}" d="M{cx - half:g},{wire - 11:g}v22'
+                       f'M{cx + half:g},{wire - 11:g}v22"/>')
+        f.parts.append(f'<rect class="cf" data-k="{kc}" x="{cx - half + 2:g}" y="{wire - 9:g}" '
+                       f'width="{2 * half - 4:g}" height="18"/>')
         if inside == "/":
             f.parts.append(f'<path class="nc" d="M{cx - 6:g},{wire + 9:g}L{cx + 6:g},'
                            f'{wire - 9:g}"/>')
-        elif inside:
-            f.parts.append(f'<text class="in" x="{cx:g}" y="{wire + 24:g}" '
-                           f'text-anchor="middle">{esc(inside)}</text>')
+        elif written:   # coloured with the contact, so it stays readable when closed
+            f.parts.append(f'<text class="in" data-k="{kc}" x="{cx:g}" y="{wire + 4:g}" '
+                           f'text-anchor="middle">{esc(written)}</text>')
         f.parts.append(self.label(c.above, cx, 12))
         if shp.compare:
-            f.parts.append(self.value(self.v(c.above, kind), cx, 24))
+            f.parts.append(self.value(self.v(c.above, kind), cx, 27))
         else:
             self.v("")  # keeps the numbering independent of the contact kind
         if below:
-            f.parts.append(self.label(c.below, cx, h - 12))
-            f.parts.append(self.value(self.v(c.below, kind), cx, h - 1))
+            f.parts.append(self.label(c.below, cx, wire + 25))
+            f.parts.append(self.value(self.v(c.below, kind), cx, wire + 39))
         return f, p_out
 
     def logic(self, e: Logic, p_in: Power) -> tuple[Fig, Power]:
@@ -206,8 +220,8 @@ class _Walk:
                        f'width="{2 * r - 6:g}" height="18" rx="9"/>')
         f.parts.append(f'<path class="co" data-k="{kp}" d="M{cx - r + 6:g},{wire - 11:g}'
                        f'q-7,11 0,22M{cx + r - 6:g},{wire - 11:g}q7,11 0,22"/>')
-        if inner:
-            f.parts.append(f'<text class="in" x="{cx:g}" y="{wire + 4:g}" '
+        if inner:   # coloured with the coil: white on the powered fill
+            f.parts.append(f'<text class="in" data-k="{kp}" x="{cx:g}" y="{wire + 4:g}" '
                            f'text-anchor="middle">{esc(inner)}</text>')
         if c.above:  # centred on the coil, kept inside the element
             f.parts.append(self.label(c.above, min(cx, w - self.width(c.above) / 2 - 2), 12))

@@ -92,6 +92,9 @@ class Served:
         return f"http://127.0.0.1:{self.port}/"
 
     def close(self) -> None:
+        """Stop the session and the server (again: nothing)."""
+        if not self.thread.is_alive():
+            return
         self.panel.session.close()
         fut = asyncio.run_coroutine_threadsafe(self.runner.cleanup(), self.loop)
         try:

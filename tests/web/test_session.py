@@ -346,3 +346,104 @@ def test_the_lessons_own_kinds_win_over_the_symbol_comment() -> None:
     kinds = {io["addr"]: io["kind"] for io in s.hello()["inputs"]}
     assert kinds == {"I0.0": "button_nc", "I0.1": "switch", "I0.2": "switch_nc"}
     assert s.plc.read("I0.0") == 1 and s.plc.read("I0.1") == 0
+
+
+RECURSION = """\
+ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1 // Call the subroutine
+LD     SM0.0
+CALL   SBR0
+END_ORGANIZATION_BLOCK
+SUBROUTINE_BLOCK SBR_0:SBR0
+BEGIN
+Network 1 // Count the depth
+LD     SM0.0
+INCW   VW0
+Network 2 // Again
+LD     SM0.0
+CALL   SBR0
+END_SUBROUTINE_BLOCK
+"""
+
+
+def _diagnostics(c) -> list[dict]:
+    return [m for m in c.mailbox.take() if m["type"] == "diagnostics"]
+
+
+def test_diagnostics_at_load_and_while_running_reach_the_pages_with_their_network() -> None:
+    """What ``plcrt run`` prints on stderr: the recursion warning at load
+    (in ``hello``) and the CALL that is not executed while running (a
+    ``diagnostics`` message with both), each naming network SBR0/2; the
+    same warning after a power-up reset is not listed again."""
+    s = PanelSession(load_sample(RECURSION, symbols=None))
+    c = s.connect()
+    (load,) = s.hello()["diagnostics"]["items"]
+    assert load["severity"] == "warning" and load["network"] == "SBR0/2"
+    assert load["message"].startswith("recursion: SBR0 -> SBR0")
+    assert load["text"] == str(s.plc.diagnostics[0]) and load["where"] == "<string>:14:1"
+    s.apply({"type": "step"})
+    finish(s)
+    s._publish()
+    (msg,) = _diagnostics(c)
+    assert [d["network"] for d in msg["items"]] == ["SBR0/2", "SBR0/2"]
+    assert msg["items"][1]["message"].startswith("CALL not executed")
+    assert msg["more"] is None
+    assert len(s.hello()["diagnostics"]["items"]) == 2     # a page that connects later
+    s.apply({"type": "reset"})
+    s.apply({"type": "step"})
+    finish(s)
+    s._publish()
+    assert _diagnostics(c) == []
+
+
+def test_a_fault_is_a_diagnostic_of_its_network() -> None:
+    prog = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD SM0.0\nMOVB 200, VB0\n"
+            "Network 2 // past the end\nLD SM0.0\nFILL +0, VW10200, VB0\n"
+            "END_ORGANIZATION_BLOCK\n")
+    s = PanelSession(load_sample(prog, symbols=None))
+    c = s.connect()
+    assert s.hello()["diagnostics"] == {"items": [], "more": None}
+    s.apply({"type": "step"})
+    finish(s)
+    s._publish()
+    (msg,) = _diagnostics(c)
+    (fault,) = msg["items"]
+    assert fault["severity"] == "error" and fault["network"] == "OB1/2"
+    assert fault["message"] == "FILL runs past the end of its memory area"
+
+
+def test_the_list_of_diagnostics_is_bounded() -> None:
+    """A program that warns without end: the session keeps KEEP of them,
+    the pages get the first MAX_LISTED and a count of the rest."""
+    from plcrt.errors import MAX_LISTED, Diagnostic
+    from plcrt.web.diagnostics import KEEP
+    s = PanelSession(load_sample())
+    c = s.connect()
+    for i in range(KEEP + 50):
+        s.plc.diagnostics.append(Diagnostic("warning", f"warning {i}", None, "runtime"))
+    s._publish()
+    (msg,) = _diagnostics(c)
+    assert len(msg["items"]) == MAX_LISTED
+    assert msg["more"] == f"... and {KEEP - MAX_LISTED} more warnings not listed (the first " \
+                          f"{MAX_LISTED} are shown); 50 more not kept"
+    assert msg["items"][0]["network"] is None and msg["items"][0]["where"] == ""
+
+
+def test_a_power_up_reset_sends_the_new_trend() -> None:
+    """The trend starts again at the reset: every page gets it whole (one
+    sample at the time of power-up), and frames go on after it."""
+    s = session()
+    c = s.connect()
+    s.apply({"type": "trend", "signals": ["Q0.0"]})
+    s.apply({"type": "step", "scans": 20})
+    finish(s)
+    s._publish()
+    c.mailbox.take()
+    s.apply({"type": "reset"})
+    msgs = c.mailbox.take()
+    (tr,) = [m for m in msgs if m["type"] == "trend"]
+    assert tr["t"] == [0.0] and tr["end"] == 1
+    s._publish()     # the next frame does not carry that sample again
+    (f,) = [m for m in c.mailbox.take() if m["type"] == "frame"]
+    assert f["trend"]["start"] == 1 and f["trend"]["end"] == 1 and f["trend"]["t"] == []

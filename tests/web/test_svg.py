@@ -100,3 +100,48 @@ def test_hostile_symbols_and_comments_stay_text_in_the_svg() -> None:
     assert all(not a.startswith("on") for e in root.iter() for a in e.attrib)
     tips = ["".join(t.itertext()) for t in root.iter(NS + "title")]
     assert any("<script>x()</script>" in t for t in tips)      # shown as text
+
+
+def _texts(root: ET.Element) -> dict[str, ET.Element]:
+    return {"".join(t.itertext()): t for t in root.iter(NS + "text")}
+
+
+def test_a_compare_contact_writes_its_operator_between_its_bars() -> None:
+    """``>=I`` sits between the two bars on the wire, the operands and their
+    values above and below, one text line apart (it was drawn on the second
+    operand)."""
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLDW>= VW0, VW2\n"
+            "= Q0.0\nEND_ORGANIZATION_BLOCK\n")
+    plc, pou = nets(text)
+    root = ET.fromstring(network_svg(pou, pou.networks[0], program=plc.program))
+    group = next(g for g in root.iter(NS + "g")
+                 if any("".join(t.itertext()) == ">=I" for t in g.findall(NS + "text")))
+    bars = [float(v) for v in re.findall(r"M([\d.]+),", group.find(NS + "path").get("d"))]
+    top = float(re.search(r",([\d.]+)v22", group.find(NS + "path").get("d")).group(1))
+    texts = _texts(group)
+    op = texts[">=I"]
+    assert bars[0] < float(op.get("x")) < bars[1]
+    assert top < float(op.get("y")) < top + 22          # on the wire, inside the bars
+    assert (bars[1] - bars[0]) > 3 * 6.0                 # wide enough for 3 characters
+    ys = sorted([float(t.get("y")) for t in group.findall(NS + "text")])
+    assert all(b - a >= 12 for a, b in zip(ys, ys[1:])), ys   # VW0, value, >=I, VW2, value
+
+
+def test_letters_of_coils_and_compares_are_coloured_with_their_fill() -> None:
+    """The letters of R, S and SCRE coils and a compare's operator carry the
+    number of the fill they sit on, so the page can turn them white when it
+    is filled."""
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLDB= VB0, VB1\nS Q0.0, 1\n"
+            "Network 2\nLD I0.0\nR Q0.1, 1\nNetwork 3\nLSCR S0.0\nNetwork 4\nSCRE\n"
+            "END_ORGANIZATION_BLOCK\n")
+    plc, pou = nets(text)
+    seen = set()
+    for n in pou.networks:
+        root = ET.fromstring(network_svg(pou, n, program=plc.program))
+        for g in root.iter(NS + "g"):
+            fills = {r.get("data-k") for r in g.findall(NS + "rect") if r.get("class") == "cf"}
+            for t in g.findall(NS + "text"):
+                if t.get("class") == "in":
+                    seen.add("".join(t.itertext()))
+                    assert t.get("data-k") in fills, "".join(t.itertext())
+    assert {"==B", "S", "R", "SCRE"} <= seen

@@ -39,7 +39,7 @@ function connect() {
   P.ws = ws;
   ws.onopen = () => { $("conn").textContent = "connected"; };
   ws.onclose = () => {
-    $("conn").textContent = "disconnected";
+    offline();
     setTimeout(connect, 1000);
   };
   ws.onmessage = (ev) => {
@@ -57,10 +57,31 @@ const HANDLERS = {
   error: (m) => log((m.request ? m.request + ": " : "") + m.message, "error"),
   notice: (m) => log(m.message, m.level),
   check: onCheck,
+  diagnostics: onDiagnostics,
 };
+
+// The server stopped or the connection dropped: say so (the last frame's
+// "running" is no longer true) until a new hello arrives.
+function offline() {
+  const was = !document.body.classList.contains("offline");
+  document.body.classList.add("offline");
+  $("conn").textContent = "disconnected";
+  $("conn").classList.add("offline");
+  $("runstate").textContent = "disconnected";
+  $("runstate").className = "offline";
+  $("rate").textContent = "";
+  if (was) log("disconnected from the panel server: reconnecting ...", "error");
+}
+
+function online() {
+  document.body.classList.remove("offline");
+  $("conn").classList.remove("offline");
+  $("runstate").classList.remove("offline");
+}
 
 // ---------------------------------------------------------------- hello
 function onHello(h) {
+  online();
   P.hello = h;
   P.nets = {};
   P.axisHist = [];
@@ -76,6 +97,8 @@ function onHello(h) {
   P.axisEls = [];
   for (const a of h.axes) P.axisEls.push(buildAxis("EM253 slot " + a.slot + " axis " + a.axis, a));
   for (const d of h.drives) P.axisEls.push(buildAxis("drive " + d.node + " (" + d.model + ")", d));
+  onDiagnostics(h.diagnostics || { items: [], more: null });
+  ariaIO(P.frame);
 }
 
 function buildTabs(h) {
@@ -295,6 +318,7 @@ function onFrame(f) {
   for (const lamp of document.querySelectorAll("[data-lamp]")) {
     lamp.classList.toggle("on", !!f.io[lamp.dataset.lamp]);
   }
+  ariaIO(f);
   renderWatch(f);
   trendFrame(f.trend);
   axesFrame(f);
@@ -373,7 +397,11 @@ function trendFrame(t) {
     return;
   }
   if (t.end > tr.end) {
-    tr.t.push(...t.t); tr.v.push(...t.v); tr.end = t.end;
+    // only the samples after the ones held (a history answer may overlap a frame)
+    const last = tr.t.length ? tr.t[tr.t.length - 1] : -Infinity;
+    let from = 0;
+    while (from < t.t.length && t.t[from] <= last) from++;
+    tr.t.push(...t.t.slice(from)); tr.v.push(...t.v.slice(from)); tr.end = t.end;
     if (tr.t.length > 20000) { tr.t.splice(0, tr.t.length - 20000); tr.v.splice(0, tr.v.length - 20000); }
     drawTrend();
   }
@@ -395,6 +423,7 @@ function drawTrend() {
   const t0 = tr.t[0], t1 = Math.max(tr.t[tr.t.length - 1], t0 + 1e-6);
   const left = 70, w = c.width - left - 6, lane = (c.height - 14) / n;
   g.font = "11px sans-serif";
+  g.save(); g.beginPath(); g.rect(0, 0, c.width, c.height); g.clip();
   for (let s = 0; s < n; s++) {
     const vals = tr.v.map((r) => (typeof r[s] === "number" ? r[s] : NaN));
     const fin = vals.filter((x) => Number.isFinite(x));
@@ -415,6 +444,7 @@ function drawTrend() {
     }
     g.stroke();
   }
+  g.restore();
   g.fillStyle = "#555";
   g.fillText(t0.toFixed(2) + " s", left, c.height - 2);
   g.fillText(t1.toFixed(2) + " s", c.width - 60, c.height - 2);
@@ -461,6 +491,8 @@ function axesFrame(f) {
     .concat(f.drives.map((d) => ({ pos: d.position, txt: "position " + d.position + "  velocity " +
       d.velocity + "  " + d.state })));
   items.forEach((it, i) => { if (P.axisEls[i]) drawSlide(P.axisEls[i], it); });
+  const last = P.axisHist[P.axisHist.length - 1];
+  if (last && f.t < last.t) P.axisHist = [];   // power-up reset: the time went back
   P.axisHist.push({ t: f.t, pos: items.map((x) => x.pos),
                     spd: f.axes.map((a) => a.speed).concat(f.drives.map((d) => d.velocity)) });
   if (P.axisHist.length > 600) P.axisHist.shift();
@@ -504,6 +536,7 @@ function drawAxisTrend() {
   if (hist.length < 2) return;
   const t0 = hist[0].t, t1 = Math.max(hist[hist.length - 1].t, t0 + 1e-6);
   const series = [["pos", c.height / 2 - 4, 2], ["spd", c.height / 2 - 4, c.height / 2 + 2]];
+  g.save(); g.beginPath(); g.rect(0, 0, c.width, c.height); g.clip();
   for (const [key, h, y0] of series) {
     const n = hist[0][key].length;
     for (let s = 0; s < n; s++) {
@@ -521,7 +554,75 @@ function drawAxisTrend() {
     g.fillStyle = "#555"; g.font = "10px sans-serif";
     g.fillText(key === "pos" ? "position" : "speed", 6, y0 + 10);
   }
+  g.restore();
 }
+
+// ---------------------------------------------------------------- diagnostics
+// What `plcrt run` prints on stderr (warnings at load and while running, a
+// fault), each with its network: a click shows that network.
+function onDiagnostics(d) {
+  const ul = $("diags");
+  ul.replaceChildren();
+  for (const it of d.items) {
+    const li = el("li", { class: it.severity });
+    const b = el("button", { type: "button", title: it.text });
+    const where = it.network ? it.block + " network " + it.network.slice(it.block.length + 1)
+      : (it.block || "");
+    if (where) b.append(el("span", { class: "where" }, where + ":"), " ");
+    b.append(document.createTextNode(it.severity + ": " + it.message +
+                                     (it.where ? " (" + it.where + ")" : "")));
+    if (it.network) b.dataset.shows = it.network;
+    b.addEventListener("click", () => showNetwork(it.network, it.block));
+    li.append(b);
+    ul.append(li);
+  }
+  if (d.more) ul.append(el("li", {}, d.more));
+}
+
+function showNetwork(id, block) {
+  if (block && block !== P.block && P.hello.blocks.some((b) => b.id === block)) showBlock(block);
+  for (const e of document.querySelectorAll(".net.flash")) e.classList.remove("flash");
+  const entry = id && P.nets[id];
+  if (!entry) return;
+  entry.div.classList.add("flash");
+  entry.div.scrollIntoView({ block: "center" });
+}
+
+// ---------------------------------------------------------------- accessibility
+// Inputs are switches (role switch, aria-checked) or push-buttons
+// (aria-pressed while held), lamps images named "Q0.0 Motor: on"; names
+// are the address and the symbol.
+function ioLabel(io) { return io.addr + (io.name ? " " + io.name.split(":")[0] : ""); }
+
+function attr(e, name, value) { if (e.getAttribute(name) !== value) e.setAttribute(name, value); }
+
+function ariaIO(f) {
+  if (!P.hello) return;
+  const io = f ? f.io : {};
+  const byAddr = new Map(P.hello.inputs.concat(P.hello.outputs).map((x) => [x.addr, x]));
+  for (const sw of document.querySelectorAll("[data-input]")) {
+    const x = byAddr.get(sw.dataset.input);
+    if (!x) continue;
+    attr(sw, "aria-label", ioLabel(x));
+    if (P.kinds[x.addr] === "switch") {
+      attr(sw, "role", "switch");
+      sw.removeAttribute("aria-pressed");
+      attr(sw, "aria-checked", String(!!io[x.addr]));
+    } else {
+      sw.removeAttribute("role");
+      sw.removeAttribute("aria-checked");
+      attr(sw, "aria-pressed", String(!!P.pressed[x.addr]));
+    }
+  }
+  for (const lamp of document.querySelectorAll("[data-lamp]")) {
+    const x = byAddr.get(lamp.dataset.lamp);
+    if (!x) continue;
+    attr(lamp, "role", "img");
+    attr(lamp, "aria-label", ioLabel(x) + ": " + (io[x.addr] ? "on" : "off"));
+  }
+}
+// a switch turned into a push-button (or back) is announced as one at once
+$("inputs").addEventListener("click", (e) => { if (e.target.closest(".kind")) ariaIO(P.frame); });
 
 // ---------------------------------------------------------------- the course
 function buildLesson(h) {

@@ -71,7 +71,8 @@ def _picker(at: list) -> Callable[[object], tuple]:
 class ProcessData:
     """The process data of a :class:`~.drive.Drive` (see the module docstring)."""
 
-    # what it uses of the drive (set by Drive.__init__)
+    # the attributes it reads of the drive (set by Drive.__init__; it also
+    # calls the drive's methods)
     now: int
     controlword: int
     mode_number: int

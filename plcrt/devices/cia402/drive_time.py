@@ -29,7 +29,8 @@ _MAX_EVENTS = 100_000  # per advance: a homing plan that never moves on is an er
 class Timeline:
     """The events of a :class:`~.drive.Drive` in time (see the module docstring)."""
 
-    # what it uses of the drive (set by Drive.__init__)
+    # the attributes it reads of the drive (set by Drive.__init__; it also
+    # calls the drive's methods)
     now: int
     mode_number: int
     engines: dict[int, Any]

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .blocks import add_library_loader as _add_library_loader
 from .errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError,
                      PlcError, PlcRuntimeError, PlcSyntaxError, SourceLoc)
 
@@ -38,6 +39,17 @@ def __getattr__(name: str) -> Any:
         from .engine import link
         return getattr(link, name)
     raise AttributeError(f"module 'plcrt' has no attribute {name!r}")
+
+
+def _load_device_libraries() -> None:
+    """The library blocks of plcrt's devices, for the block registry, which
+    sits below them and never imports them (plcrt.blocks)."""
+    # perf: imported by the first compiled call that needs a library block,
+    # not by `import plcrt`
+    from .devices import libraries  # noqa: F401
+
+
+_add_library_loader(_load_device_libraries)
 
 __all__ = [
     "load", "Plc", "link", "Network", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",

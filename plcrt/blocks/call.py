@@ -34,7 +34,7 @@ from ..compiler.operands import Addr, Const, Indirect
 from ..compiler.resolve import ResolveError, check_role
 from ..isa.registry import Role
 from ..safetext import excerpt
-from . import BLOCK_FACTORIES
+from . import BLOCK_FACTORIES, PROTECTED, load_libraries
 from .interface import interfaces
 
 _READ = {"BOOL": Role.BIT_R, "BYTE": Role.B_R, "WORD": Role.W_R, "INT": Role.W_R,
@@ -57,7 +57,7 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         name, itf = smart.name.upper(), smart     # the SMART variant (an extra input)
     factory = BLOCK_FACTORIES.get(name)
     if factory is None:
-        _load_implementations()
+        load_libraries()
         factory = BLOCK_FACTORIES.get(name)
     if factory is None:
         g.fail(f"library instruction {itf.name} has no implementation")
@@ -159,26 +159,14 @@ def _bit_reads(g: Any, reads: list[Any]) -> list[str]:
     return out
 
 
-#: export block name -> (the interfaces it may stand for, in the order tried;
-#: the family named in warnings), filled by :func:`register_protected`
-PROTECTED: dict[str, tuple[tuple[str, ...], str]] = {}
-
-
-def register_protected(family: str, names: dict[str, tuple[str, ...]]) -> None:
-    """Declare library blocks that an export holds as protected subroutines
-    (an interface and an empty body): a CALL of a program subroutine named
-    like one of *names* runs the built-in block whose interface matches."""
-    for name, variants in names.items():
-        PROTECTED[name.upper()] = (variants, family)
-
-
 def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
     """CALL of a program subroutine named like a registered library block:
     emit the built-in block when the body is empty (a protected block of the
     export) and the interface matches one of the block's (directions and
     types in order; names may differ); else False, with a warning once that
-    the program's own subroutine runs."""
-    _load_implementations()
+    the program's own subroutine runs (the blocks are those registered with
+    :func:`plcrt.blocks.register_protected`)."""
+    load_libraries()
     name = (callee.pou.name or "").strip().upper()
     entry = PROTECTED.get(name)
     if entry is None:
@@ -230,10 +218,3 @@ def _check_in(g: Any, itf: Any, p: Any, op: Any, role: Role, text: str) -> tuple
 
 _WIDTH = {"BYTE": 1, "WORD": 2, "INT": 2, "DINT": 4, "DWORD": 4, "REAL": 4}
 
-
-def _load_implementations() -> None:
-    from ..devices.em253 import blocks  # noqa: F401  (registers the EM253 library)
-    from ..devices.ptowizard import blocks as _wizard  # noqa: F401  (PTOx_*, PWMx_RUN)
-    from ..devices.modbus import master as _modbus  # noqa: F401  (MBUS_CTRL, MBUS_MSG)
-    from ..devices.uss import library as _uss  # noqa: F401  (USS_INIT, USS_CTRL, USS_xPM_x)
-    from ..devices.modbus import slavelib as _mbslave  # noqa: F401  (MBUS_INIT, MBUS_SLAVE)

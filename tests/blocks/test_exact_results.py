@@ -21,8 +21,7 @@ from typing import Any, Iterator
 import pytest
 
 import plcrt
-from plcrt.blocks import BLOCK_FACTORIES
-from plcrt.blocks.call import _load_implementations
+from plcrt.blocks import BLOCK_FACTORIES, load_libraries
 from plcrt.blocks.interface import interfaces
 from plcrt.compiler.rt import BITS
 
@@ -65,7 +64,7 @@ class _Fixed:
 def stand_in(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
     """``stand_in(NAME, out, exact)``: NAME's calls return ``out``;
     ``exact`` is its exact_results (None: the block declares nothing)."""
-    _load_implementations()
+    load_libraries()
 
     def make(name: str, out: tuple, exact: tuple[str, ...] | None) -> None:
         cls = type("Fixed", (_Fixed,), {"exact_results": exact, "out": out})
@@ -199,7 +198,7 @@ def checked(monkeypatch: pytest.MonkeyPatch) -> Iterator[list[str]]:
     """Every EM253 block checks each call's results against its
     exact_results; the names of the blocks called are collected."""
     from plcrt.devices.em253.base import MotionBlock
-    _load_implementations()
+    load_libraries()
     _SEEN.clear()
     for name, factory in list(BLOCK_FACTORIES.items()):
         if not (isinstance(factory, type) and issubclass(factory, MotionBlock)):
@@ -304,7 +303,7 @@ def test_written_back_bits_of_one_byte_are_those_returned(
     the returned bits and its other bits as they are after the call, also
     when the call itself changed the byte (the store is skipped only when
     the byte already holds the returned bits)."""
-    _load_implementations()
+    load_libraries()
     attrs = {"exact_results": ("Clr0", "Clr1", "Status"), "out": (*clr, 1),
              "byte": before if during is None else during}
     monkeypatch.setitem(BLOCK_FACTORIES, "MOTION_EN3", type("W", (_Writer,), attrs))

@@ -58,6 +58,7 @@ from canopen.objectdictionary import ODRecord, ODVariable, datatypes
 
 from ...engine.values import Duration, duration
 from ...errors import PlcConfigError
+from .canopen_od import object_dictionary
 from .drive import Drive
 from .esm import EsmState
 from .od import SdoAbort
@@ -117,7 +118,6 @@ class CanopenDrive:
                                  "(call network.connect(interface='virtual', channel=...) first)")
         if node_id in network:
             raise PlcConfigError(f"cia402.attach: node {node_id} is already on the network")
-        from ...cia402 import object_dictionary
         self.clock: Clock = clock
         self.drive = Drive(model, plant=plant, node_id=node_id)
         self.period_us = self.drive.bus_period_us()

@@ -72,7 +72,7 @@ import struct
 from typing import Any, Optional
 
 from ...errors import PlcConfigError, PlcError
-from .. import AxisState, DriveState
+from ..state import AxisState, DriveState
 from .drive import Drive
 from .esm import EsmState
 from .od import DTYPES, SdoAbort

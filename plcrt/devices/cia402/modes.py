@@ -12,19 +12,19 @@ What it is not: no power state machine and no time loop.  The
 ``controlword``, ``parameter``, ``cycle``), tells it when the axis comes to
 rest (``motion_end``) or reaches a limit switch (``limit``), and asks it for
 its bits.  Engines read objects through ``drive.param`` and log through
-``drive.note`` (every refusal names the object, the value and the section).
+``drive.note`` (every refusal names the object, the value and the section);
+what they use of the drive is :class:`~.drive_view.ModeDrive`.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Optional
+from typing import Optional
 
+from .drive_view import ModeDrive
 from .homing import homing_status
 from .homing_plan import HomingPlan, HomingRequest, HomingStep, Watch
 from .store import key
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .drive import Drive
 
 __all__ = ["Mode", "NoMode", "ProfilePosition", "ProfileVelocity", "Homing",
            "CyclicPosition", "MODE_NAMES"]
@@ -50,7 +50,7 @@ class Mode:
         # when the engine has no parameter() of its own
         cls.takes_parameters = cls.parameter is not Mode.parameter
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: ModeDrive) -> None:
         self.d = drive
         self.limit_stop = False
 
@@ -102,7 +102,7 @@ class ProfilePosition(Mode):
 
     number = 1
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: ModeDrive) -> None:
         super().__init__(drive)
         self.target = 0
         self.pending: Optional[tuple[int, int, int, int]] = None
@@ -230,7 +230,7 @@ class ProfileVelocity(Mode):
 
     number = 3
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: ModeDrive) -> None:
         super().__init__(drive)
         self.v_target = 0
         self._key: Optional[tuple[int, int, int]] = None
@@ -287,7 +287,7 @@ class CyclicPosition(Mode):
 
     number = 8
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: ModeDrive) -> None:
         super().__init__(drive)
         self.demand = 0
         self.following_error = 0
@@ -366,7 +366,7 @@ class Homing(Mode):
 
     number = 6
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: ModeDrive) -> None:
         super().__init__(drive)
         self.plan: Optional[HomingPlan] = None
         self.status = "idle"       # idle running attained error interrupted halted

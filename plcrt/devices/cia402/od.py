@@ -6,14 +6,15 @@ An object dictionary is one TOML file per drive model under
 (index, subindex), each row citing the manual section it comes from.
 :class:`ObjectDictionary` loads and checks such a file (a malformed row is a
 :class:`~plcrt.errors.PlcConfigError` naming the file, the line and the
-entry); :class:`Store` holds the values a drive has and answers SDO uploads
-and downloads with the abort codes of ETG.1000.6 / CiA 301 (digest §6.3).
+entry); :class:`~.store.Store` (in :mod:`.store`, which builds on this
+module) holds the values a drive has and answers SDO uploads and downloads
+with the abort codes of ETG.1000.6 / CiA 301 (digest §6.3).
 
 This module knows nothing of drive behaviour: the CiA 402 state machine, the
 modes and the EtherCAT state machine subscribe to writes through
-:meth:`Store.on_check` (may refuse) and :meth:`Store.on_write` (is told).
-The canopen ``ObjectDictionary``/EDS view of the same data is in
-:mod:`plcrt.cia402`.
+:meth:`~.store.Store.on_check` (may refuse) and :meth:`~.store.Store.on_write`
+(is told).  The canopen ``ObjectDictionary``/EDS view of the same data is in
+:mod:`.canopen_od` (public as :mod:`plcrt.cia402`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
+from ...blocks.interface import library_dirs as block_dirs
 from ...errors import PlcConfigError, PlcError, SourceLoc
 
 #: dtype -> (bits, minimum, maximum); the CoE basic data types (ETG.1000.6).
@@ -80,7 +82,6 @@ _KEYS_OPTIONAL = ("pdo", "min", "max", "unit", "effect", "when", "values")
 def library_dirs() -> list[Path]:
     """Folders searched for ``<model>.toml``: ``cia402/`` under each plcrt
     library folder (``$PLCRT_LIBRARY_PATH``, then the project's ``library/``)."""
-    from ...blocks.interface import library_dirs as block_dirs
     return [d / "cia402" for d in block_dirs()]
 
 
@@ -439,14 +440,5 @@ def _entry(row: Any, i: int, loc: SourceLoc) -> Entry:
                  source=row["source"], values=tuple(values) if values is not None else None)
 
 
-def __getattr__(name: str) -> Any:
-    """:class:`Store`, :class:`StoreEvent` and :class:`Write` live in
-    :mod:`.store` (which builds on this module) and are re-exported here."""
-    if name in ("Store", "StoreEvent", "Write"):
-        from . import store
-        return getattr(store, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-__all__ = ["ABORT_CODES", "DTYPES", "Entry", "ObjectDictionary", "SdoAbort", "Store",
-           "StoreEvent", "Write", "is_assign", "is_map", "obj"]
+__all__ = ["ABORT_CODES", "DTYPES", "Entry", "ObjectDictionary", "SdoAbort", "is_assign",
+           "is_map", "obj"]

@@ -24,19 +24,19 @@ the mode (the axis did not get there: PP target reached, bit 10, stays 0).
 
 What it is not: it plans no motion and knows no mode's bits; the drive
 calls :meth:`events` from its event search and :meth:`on_event` when one is
-due.  Decisions: docs/cia402.md, "Mechanical ends".
+due; what this module uses of the drive is :class:`~.drive_view.StopsDrive`.
+Decisions: docs/cia402.md, "Mechanical ends".
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Optional
+from typing import Optional
 
+from .drive_view import StopsDrive
 from .homing_plan import Watch
 from .statemachine import State
 from .states import Cia402Error
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .drive import Drive
 
 __all__ = ["HardStops", "FOLLOWING_ERROR", "STALL_METHODS"]
 
@@ -50,7 +50,7 @@ NAMES = {-1: "neg_stop", 1: "pos_stop"}
 class HardStops:
     """The mechanical ends of one drive's axis (see the module docstring)."""
 
-    def __init__(self, drive: Drive) -> None:
+    def __init__(self, drive: StopsDrive) -> None:
         self.d = drive
         plant = drive.plant
         self.ends = {s: e for s, e in ((-1, plant.neg_stop), (1, plant.pos_stop))

@@ -308,6 +308,5 @@ class PosRun(MotionBlock):
 
 
 def _last(t0, x, v, v_ss, top, length, ra, rd):
-    from ..motion import plan_distance
     return plan_distance(t0, x, v if v > 0 else Fraction(v_ss), Fraction(top),
                          Fraction(v_ss), length, ra, rd)

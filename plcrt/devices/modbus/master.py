@@ -19,15 +19,15 @@ memory Micro/WIN asks for) and its interrupt routines are not simulated;
 the Error numbers are the manual's tables, plcrt's own choice where the
 manual has none (PLCRT_CHOICES; a load-time warning names them).
 A protected, empty SUBROUTINE_BLOCK of the export named like one of these
-blocks runs it (``register_protected``; plcrt.blocks.call.protected_call).
+blocks runs it (``plcrt.blocks.register_protected``;
+plcrt.blocks.call.protected_call).
 """
 
 from __future__ import annotations
 
 from typing import Any, Optional
 
-from ...blocks import register_block
-from ...blocks.call import register_protected
+from ...blocks import register_block, register_protected
 from ...blocks.library import LibraryBlock, per_cpu_state
 from ...engine.serial import BAUD_CODE
 from ...safetext import excerpt

@@ -27,7 +27,8 @@ routines are not simulated (so Error 5, holding registers overlapping the
 library's symbols, never occurs); forced Q points are written like others.
 The numbers plcrt decided are :data:`PLCRT_CHOICES` (a load-time warning
 names them; docs/modbus.md).  A protected, empty SUBROUTINE_BLOCK of the
-export named MBUS_INIT / MBUS_SLAVE runs these (``register_protected``).
+export named MBUS_INIT / MBUS_SLAVE runs these
+(``plcrt.blocks.register_protected``).
 """
 
 from __future__ import annotations
@@ -36,8 +37,7 @@ import re
 from collections import deque
 from typing import Any, Optional
 
-from ...blocks import register_block
-from ...blocks.call import register_protected
+from ...blocks import register_block, register_protected
 from ...blocks.library import LibraryBlock, per_cpu_state
 from ...safetext import excerpt
 from .master import BAUD_CODE, PARITY_BITS

@@ -14,7 +14,8 @@ What it is not: the wizard's code.  Its error numbers, ramp algorithm and
 V-memory table are not public; plcrt's choices (the ERRORS table below,
 docs/pto-wizard.md) are announced by a warning when the program loads.
 A protected, empty SUBROUTINE_BLOCK of the export named like one of these
-blocks runs it (``register_protected``; plcrt.blocks.call.protected_call).
+blocks runs it (``plcrt.blocks.register_protected``;
+plcrt.blocks.call.protected_call).
 """
 
 from __future__ import annotations
@@ -22,8 +23,7 @@ from __future__ import annotations
 import weakref
 from typing import Any, Optional
 
-from ...blocks import register_block
-from ...blocks.call import register_protected
+from ...blocks import register_block, register_protected
 from .plan import change_trains, continuous_trains, profile_trains, stop_trains
 
 #: Error output codes (plcrt's own: the wizard's numbers are not public)

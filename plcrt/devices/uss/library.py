@@ -26,7 +26,7 @@ not written.  The Error numbers are the manual's table "USS protocol
 library execution error codes"; numbers the manual does not give are
 plcrt's choice (PLCRT_CHOICES; a load-time warning names them).  A
 protected, empty SUBROUTINE_BLOCK of the export named like one of these
-blocks runs it (``register_protected``).
+blocks runs it (``plcrt.blocks.register_protected``).
 """
 
 from __future__ import annotations
@@ -34,8 +34,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from ...blocks import register_block
-from ...blocks.call import register_protected
+from ...blocks import register_block, register_protected
 from ...blocks.library import LibraryBlock, per_cpu_state
 from ...engine.serial import BAUD_CODE
 from .telegram import (STW, STX, TASK, ZSW, Telegram, bits_real, decode, encode,

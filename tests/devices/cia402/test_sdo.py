@@ -9,7 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from plcrt.devices.cia402.od import ObjectDictionary, SdoAbort, Store, Write
+from plcrt.devices.cia402.od import ObjectDictionary, SdoAbort
+from plcrt.devices.cia402.store import Store, Write
 from plcrt.errors import PlcConfigError, PlcError
 
 

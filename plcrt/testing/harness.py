@@ -81,7 +81,9 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
             takes_arg = len(inspect.signature(cond).parameters) >= 1
         except (TypeError, ValueError):
             takes_arg = False
-        name = getattr(cond, "__name__", "condition")
+        name = getattr(cond, "__name__", "")
+        if not name or name == "<lambda>":
+            name = describe_function(cond)
         if takes_arg:
             return (lambda: bool(cond(h))), name   # type: ignore[call-arg]
         return (lambda: bool(cond())), name        # type: ignore[call-arg]
@@ -104,6 +106,48 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
     if neg:
         return (lambda: not fn(rd(), v)), str(cond).strip()
     return (lambda: fn(rd(), v)), str(cond).strip()
+
+
+#: longest condition text a message quotes
+SHOWN_CONDITION = 120
+
+
+def describe_function(fn: Callable[..., Any]) -> str:
+    """A condition function as a message shows it: the text of a lambda
+    from its source line (``lambda: h["Q0.0"] and h["VW10"] > 5``), else
+    "the condition" (no source, e.g. typed at a prompt)."""
+    import inspect
+    try:
+        src = inspect.getsource(fn)
+    except (OSError, TypeError):
+        return UNNAMED
+    start = src.find("lambda")
+    if start < 0:
+        return UNNAMED
+    depth, end = 0, len(src)
+    for k in range(start, len(src)):
+        ch = src[k]
+        if ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            depth -= 1
+            if depth < 0:     # the bracket that closes the call around the lambda
+                end = k
+                break
+        elif depth == 0 and (ch == "\n" or (ch == "," and ":" in src[start:k])):
+            end = k           # the next argument, or the end of the line
+            break
+    text = " ".join(src[start:end].split())
+    return text if len(text) <= SHOWN_CONDITION else text[:SHOWN_CONDITION - 1] + "\u2026"
+
+
+#: how a message names a condition function whose text is unknown
+UNNAMED = "the condition"
+
+
+def _quoted(what: str) -> str:
+    """A condition's description in a message: quoted, but for "the condition"."""
+    return what if what == UNNAMED else repr(what)
 
 
 class Harness:
@@ -279,35 +323,50 @@ class Harness:
         for _ in range(limit):
             plc.scan(1)
             if plc.mode != "RUN":
-                self._timeout(f"the CPU went to STOP before {what!r} became true", message)
+                self._timeout(f"the CPU went to STOP before {_quoted(what)} became true",
+                              message, cond)
             if self._check(pred, what):
                 return (plc.now_us - t0) / 1e6
-        self._timeout(f"{what!r} did not become true within {seconds(timeout):g} s of "
-                      f"simulated time ({limit} scans)", message)
+        self._timeout(f"{_quoted(what)} did not become true within {seconds(timeout):g} s of "
+                      f"simulated time ({limit} scans)", message, cond)
         raise AssertionError  # pragma: no cover - _timeout raises
 
     def run_while(self, cond: Condition, *, timeout: Duration = 10.0, message: str = "") -> float:
         """Scan while ``cond`` holds (the opposite of :meth:`run_until`)."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
-        return self.run_until(lambda: not pred(), timeout=timeout,
-                              message=message or f"{what!r} stayed true")
+        t0 = self.plc.now_us
+        limit = self._scans_for(timeout)
+        plc = self.plc
+        for _ in range(limit):
+            plc.scan(1)
+            if plc.mode != "RUN":
+                self._timeout(f"the CPU went to STOP while {_quoted(what)} was still true",
+                              message, cond)
+            if not self._check(pred, what):
+                return (plc.now_us - t0) / 1e6
+        self._timeout(f"{_quoted(what)} stayed true for the whole {seconds(timeout):g} s "
+                      f"of simulated time ({limit} scans)", message, cond)
+        raise AssertionError  # pragma: no cover - _timeout raises
 
     def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
         """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         plc = self.plc
+        t0 = plc.time
+        expected = (f"expected {_quoted(what)} to stay true for {seconds(duration):g} s "
+                    f"from t = {t0:.3f} s")
         for _ in range(self._scans_for(duration)):
             plc.scan(1)
             if plc.mode != "RUN":
                 # time stands still in STOP: the duration would never pass
-                self._timeout(f"the CPU went to STOP before {seconds(duration):g} s had "
-                              f"passed, so {what!r} was not seen to stay true", message,
+                self._timeout(f"{expected}; the CPU went to STOP before {seconds(duration):g} s "
+                              f"had passed, so it was not seen to stay true", message, cond,
                               exc=AssertionError)
             if not self._check(pred, what):
-                self._timeout(f"{what!r} became false at t = {plc.time:.3f} s", message,
-                              exc=AssertionError)
+                self._timeout(f"{expected}; it became false {plc.time - t0:.3f} s later",
+                              message, cond, exc=AssertionError)
         return self
 
     def _check(self, pred: Callable[[], bool], what: str) -> bool:
@@ -317,15 +376,33 @@ class Harness:
             return pred()
         except Exception as e:
             if hasattr(e, "add_note"):
-                e.add_note(f"while checking the condition {what!r} after scan {self.scans} "
-                           f"(t = {self.time:.3f} s)")
+                e.add_note(f"while checking the condition {_quoted(what)} after scan "
+                           f"{self.scans} (t = {self.time:.3f} s)")
             raise
 
-    def _timeout(self, text: str, message: str, exc: type[AssertionError] = PlcTimeout) -> None:
+    def _timeout(self, text: str, message: str, cond: Condition | None = None,
+                 exc: type[AssertionError] = PlcTimeout, shown: Sequence[str] = ()) -> None:
+        """Raise ``exc``: the test's message, what was expected and what
+        happened (*text*), when, and the values of the condition's address,
+        of *shown* and of the watched addresses at that moment."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         parts = [message, text] if message else [text]
         parts.append(f"at t = {self.time:.3f} s, scan {self.scans}")
+        values = self._values_now([*_addresses_of(cond), *shown, *self.watched])
+        if values:
+            parts.append(values)
         raise exc("; ".join(parts))
+
+    def _values_now(self, specs: Sequence[str]) -> str:
+        """``"VW100 = 3, Q0.0 = 0"`` for the addresses and signals *specs*
+        (each once, in order; one that cannot be read is left out)."""
+        shown = []
+        for spec in dict.fromkeys(specs):
+            try:
+                shown.append(f"{spec} = {_fmt(reader(self.plc, spec)())}")
+            except PlcError:
+                continue
+        return ", ".join(shown)
 
     # -- stimuli ----------------------------------------------------------
     def __getitem__(self, address: str) -> Value:
@@ -509,16 +586,42 @@ class Harness:
 
     def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
         """Assert a move that is running (or about to start within a few
-        scans) ends within ``limit`` simulated seconds; returns its time."""
+        scans) ends within ``limit`` simulated seconds; returns the seconds
+        until the axis stood still.  One more scan follows, so the outputs of
+        the block that commanded the move (its Done, C_Status, C_Pos) are
+        current when this returns."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        seconds(limit)   # a bad limit is reported before anything runs
-        t0 = self.time
+        total = seconds(limit)   # a bad limit is reported before anything runs
+        plc = self.plc
+        t0 = plc.now_us
+        who = f"axis {slot}.{axis}"
+        expected = f"expected the move of {who} to be done within {total:g} s"
+        signals = [f"axis{slot}.{axis}.position", f"axis{slot}.{axis}.speed"]
         if not self.axis(slot, axis).moving:
-            self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))
-        self.run_until(lambda: not self.axis(slot, axis).moving, timeout=seconds(limit) -
-                       (self.time - t0), message=f"the move of axis {slot}.{axis} was not "
-                       f"done within {seconds(limit):g} s")
-        return self.time - t0
+            start = min(total, 1.0)
+            for _ in range(self._scans_for(start)):
+                plc.scan(1)
+                self._axis_running(expected, signals)
+                if self.axis(slot, axis).moving:
+                    break
+            else:
+                self._timeout(f"{expected}; the axis did not start moving within {start:g} s",
+                              "", shown=signals)
+        for _ in range(self._scans_for(total - (plc.now_us - t0) / 1e6)):
+            plc.scan(1)
+            self._axis_running(expected, signals)
+            if not self.axis(slot, axis).moving:
+                took = (plc.now_us - t0) / 1e6
+                plc.scan(1)     # the block sees the axis stopped and reports it
+                return took
+        self._timeout(f"{expected}; it was still moving {(plc.now_us - t0) / 1e6:g} s later",
+                      "", shown=signals)
+        raise AssertionError  # pragma: no cover - _timeout raises
+
+    def _axis_running(self, expected: str, signals: list[str]) -> None:
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
+        if self.plc.mode != "RUN":
+            self._timeout(f"{expected}; the CPU went to STOP", "", shown=signals)
 
     # -- results ----------------------------------------------------------
     @property
@@ -662,6 +765,15 @@ def _mapping(values: Any, method: str) -> Mapping[str, Any]:
         raise PlcConfigError(f"{method}() takes a dict of address -> value, got "
                              f"{type(values).__name__}")
     return values
+
+
+def _addresses_of(cond: Condition | None) -> list[str]:
+    """The address or signal a comparison such as ``"VW100 >= 25"`` reads
+    (none for a bit condition, whose value its failure says, or a function)."""
+    if not isinstance(cond, str):
+        return []
+    m = _COND_RE.match(cond)
+    return [m.group(2)] if m is not None and m.group(3) else []
 
 
 def _fmt(v: Value) -> str:

@@ -16,7 +16,6 @@ here, so calls chain.
 
 from __future__ import annotations
 
-import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -24,14 +23,13 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..devices import AxisState, DriveState
-from ..trace.recorder import is_device_signal, parse_signal
 from ..engine.runtime import Plc, load
-from ..engine.values import Duration, check_address, parse_number, scan_number
+from ..engine.values import Duration, check_address, scan_number
 from ..engine.values import duration as parse_duration
 from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
+from .conditions import Condition, addresses_of, condition, quoted, reader
 
 Value = Union[int, float, bool]
-Condition = Union[str, Callable[[], Any], Callable[["Harness"], Any]]
 
 
 class PlcTimeout(AssertionError):
@@ -46,108 +44,6 @@ def seconds(d: Duration) -> float:
     """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``, ``"2min"``
     (:func:`plcrt.engine.values.duration`, as ``Plc.run`` reads it)."""
     return parse_duration(d)
-
-
-# ---------------------------------------------------------------------------
-# Fast readers
-# ---------------------------------------------------------------------------
-
-def reader(plc: Plc, spec: str) -> Callable[[], Value]:
-    """A function reading one address (``VW100``, ``VD4:REAL``, ``T37:BIT``,
-    symbol names) or one device quantity (``axis0.0.position``,
-    ``drive1.statusword``, the signals of ``plcrt trace``) resolved once,
-    for per-scan use (see :meth:`Plc.reader`)."""
-    if isinstance(spec, str) and is_device_signal(spec):
-        return parse_signal(plc, spec).read
-    return plc.reader(spec)[1]
-
-
-_COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"
-                      r"(?:(==|!=|<>|<=|>=|<|>|=)\s*([^\s<>=!]\S*))?\s*$", re.IGNORECASE)
-_OPS: dict[str, Callable[[Any, Any], bool]] = {
-    "==": lambda a, b: a == b, "=": lambda a, b: a == b, "!=": lambda a, b: a != b,
-    "<>": lambda a, b: a != b, "<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
-    ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
-}
-
-
-def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
-    """A no-argument predicate and its description from a condition:
-    ``"Q0.0"``, ``"not M0.1"``, ``"VW100 >= 25"``, ``"VD8:REAL > 1.5"``, a
-    callable taking no argument, or a callable taking the harness."""
-    if callable(cond):
-        import inspect
-        try:
-            takes_arg = len(inspect.signature(cond).parameters) >= 1
-        except (TypeError, ValueError):
-            takes_arg = False
-        name = getattr(cond, "__name__", "")
-        if not name or name == "<lambda>":
-            name = describe_function(cond)
-        if takes_arg:
-            return (lambda: bool(cond(h))), name   # type: ignore[call-arg]
-        return (lambda: bool(cond())), name        # type: ignore[call-arg]
-    if not isinstance(cond, str):
-        raise PlcConfigError(f"a condition is a string such as 'Q0.0' or 'VW100 >= 25', or a "
-                             f"function; got {type(cond).__name__} {cond!r}")
-    m = _COND_RE.match(cond)
-    if m is None:
-        raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
-                             f"or 'ADDR <op> value' with op one of == != < <= > >=")
-    neg, addr, op, value = m.groups()
-    rd = reader(h.plc, addr)
-    if op is None:
-        return ((lambda: not rd()) if neg else (lambda: bool(rd()))), str(cond).strip()
-    try:
-        v = parse_number(value)
-    except PlcConfigError:
-        raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
-    fn = _OPS[op]
-    if neg:
-        return (lambda: not fn(rd(), v)), str(cond).strip()
-    return (lambda: fn(rd(), v)), str(cond).strip()
-
-
-#: longest condition text a message quotes
-SHOWN_CONDITION = 120
-
-
-def describe_function(fn: Callable[..., Any]) -> str:
-    """A condition function as a message shows it: the text of a lambda
-    from its source line (``lambda: h["Q0.0"] and h["VW10"] > 5``), else
-    "the condition" (no source, e.g. typed at a prompt)."""
-    import inspect
-    try:
-        src = inspect.getsource(fn)
-    except (OSError, TypeError):
-        return UNNAMED
-    start = src.find("lambda")
-    if start < 0:
-        return UNNAMED
-    depth, end = 0, len(src)
-    for k in range(start, len(src)):
-        ch = src[k]
-        if ch in "([{":
-            depth += 1
-        elif ch in ")]}":
-            depth -= 1
-            if depth < 0:     # the bracket that closes the call around the lambda
-                end = k
-                break
-        elif depth == 0 and (ch == "\n" or (ch == "," and ":" in src[start:k])):
-            end = k           # the next argument, or the end of the line
-            break
-    text = " ".join(src[start:end].split())
-    return text if len(text) <= SHOWN_CONDITION else text[:SHOWN_CONDITION - 1] + "\u2026"
-
-
-#: how a message names a condition function whose text is unknown
-UNNAMED = "the condition"
-
-
-def _quoted(what: str) -> str:
-    """A condition's description in a message: quoted, but for "the condition"."""
-    return what if what == UNNAMED else repr(what)
 
 
 class Harness:
@@ -323,11 +219,11 @@ class Harness:
         for _ in range(limit):
             plc.scan(1)
             if plc.mode != "RUN":
-                self._timeout(f"the CPU went to STOP before {_quoted(what)} became true",
+                self._timeout(f"the CPU went to STOP before {quoted(what)} became true",
                               message, cond)
             if self._check(pred, what):
                 return (plc.now_us - t0) / 1e6
-        self._timeout(f"{_quoted(what)} did not become true within {seconds(timeout):g} s of "
+        self._timeout(f"{quoted(what)} did not become true within {seconds(timeout):g} s of "
                       f"simulated time ({limit} scans)", message, cond)
         raise AssertionError  # pragma: no cover - _timeout raises
 
@@ -341,11 +237,11 @@ class Harness:
         for _ in range(limit):
             plc.scan(1)
             if plc.mode != "RUN":
-                self._timeout(f"the CPU went to STOP while {_quoted(what)} was still true",
+                self._timeout(f"the CPU went to STOP while {quoted(what)} was still true",
                               message, cond)
             if not self._check(pred, what):
                 return (plc.now_us - t0) / 1e6
-        self._timeout(f"{_quoted(what)} stayed true for the whole {seconds(timeout):g} s "
+        self._timeout(f"{quoted(what)} stayed true for the whole {seconds(timeout):g} s "
                       f"of simulated time ({limit} scans)", message, cond)
         raise AssertionError  # pragma: no cover - _timeout raises
 
@@ -355,7 +251,7 @@ class Harness:
         pred, what = condition(self, cond)
         plc = self.plc
         t0 = plc.time
-        expected = (f"expected {_quoted(what)} to stay true for {seconds(duration):g} s "
+        expected = (f"expected {quoted(what)} to stay true for {seconds(duration):g} s "
                     f"from t = {t0:.3f} s")
         for _ in range(self._scans_for(duration)):
             plc.scan(1)
@@ -376,7 +272,7 @@ class Harness:
             return pred()
         except Exception as e:
             if hasattr(e, "add_note"):
-                e.add_note(f"while checking the condition {_quoted(what)} after scan "
+                e.add_note(f"while checking the condition {quoted(what)} after scan "
                            f"{self.scans} (t = {self.time:.3f} s)")
             raise
 
@@ -388,7 +284,7 @@ class Harness:
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         parts = [message, text] if message else [text]
         parts.append(f"at t = {self.time:.3f} s, scan {self.scans}")
-        values = self._values_now([*_addresses_of(cond), *shown, *self.watched])
+        values = self._values_now([*addresses_of(cond), *shown, *self.watched])
         if values:
             parts.append(values)
         raise exc("; ".join(parts))
@@ -574,15 +470,23 @@ class Harness:
                          timeout: Duration = 1.0) -> float:
         """Run until the axis moves; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
-                              message=f"axis {slot}.{axis} did not start")
+
+        def moving() -> bool:
+            return self.axis(slot, axis).moving
+
+        moving.__name__ = f"axis {slot}.{axis} is moving"   # as messages name it
+        return self.run_until(moving, timeout=timeout, message=f"axis {slot}.{axis} did not start")
 
     def wait_axis_stopped(self, slot: int = 0, axis: int = 0, *,
                           timeout: Duration = 60.0) -> float:
         """Run until the axis stands still; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
-                              message=f"axis {slot}.{axis} did not stop")
+
+        def stopped() -> bool:
+            return not self.axis(slot, axis).moving
+
+        stopped.__name__ = f"axis {slot}.{axis} stands still"   # as messages name it
+        return self.run_until(stopped, timeout=timeout, message=f"axis {slot}.{axis} did not stop")
 
     def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
         """Assert a move that is running (or about to start within a few
@@ -765,15 +669,6 @@ def _mapping(values: Any, method: str) -> Mapping[str, Any]:
         raise PlcConfigError(f"{method}() takes a dict of address -> value, got "
                              f"{type(values).__name__}")
     return values
-
-
-def _addresses_of(cond: Condition | None) -> list[str]:
-    """The address or signal a comparison such as ``"VW100 >= 25"`` reads
-    (none for a bit condition, whose value its failure says, or a function)."""
-    if not isinstance(cond, str):
-        return []
-    m = _COND_RE.match(cond)
-    return [m.group(2)] if m is not None and m.group(3) else []
 
 
 def _fmt(v: Value) -> str:

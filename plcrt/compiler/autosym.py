@@ -98,7 +98,7 @@ def auto_symbols(program: ir.Program, model: CpuModel, symbols: SymbolTable | No
     alloc = _Allocator(model, used)
     for name, use in sorted(uses.items(), key=lambda kv: (kv[1].loc.line, kv[1].loc.column)):
         shown = excerpt(name)
-        pin = pinned.get(name) or pinned.get(_base(name) or "")
+        pin = pinned.get(name)      # Name:ADDR, or a plain use of a Name given so
         if pin is not None:
             entries[name] = Symbol(name, pin, "assigned by auto-symbols", use.loc)
             base = _base(name)
@@ -216,7 +216,7 @@ def _note(uses: dict[str, _Use], name: str, kind: str | int | None, bits: int | 
         elif not (kind == "bit" and use.kind in ("I", "Q")) and use.clash is None:
             use.clash = loc
     if kind is not None:
-        need = bits or 1 if kind in _BIT_KINDS else max(int(kind), ((bits or 0) + 7) // 8)
+        need = (bits or 1) if kind in _BIT_KINDS else max(int(kind), ((bits or 0) + 7) // 8)
         use.size = max(use.size, need)
 
 

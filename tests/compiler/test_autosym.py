@@ -159,3 +159,32 @@ def test_a_symbol_written_with_its_address_gets_that_address() -> None:
     plc.write("M2.0", 1)
     plc.scan()
     assert plc.read("Motor") == 1 and plc.read("Q0.0") == 1
+
+
+#: a plain operand for each role, for instructions whose other operands
+#: only need to be valid (counts are 8: the constant-count case)
+_PLAIN = {"BIT_R": "M0.0", "BIT_W": "M0.1", "BIT_TC": "M0.2", "IBIT": "I0.0", "QBIT": "Q0.0",
+          "B_R": "8", "B_W": "VB0", "W_R": "+8", "W_W": "VW2", "D_R": "+8", "D_W": "VD4",
+          "R_R": "1.0", "R_W": "VD8", "N": "8"}
+
+
+def _span_cases() -> list[tuple[str, int]]:
+    from plcrt.isa.registry import REGISTRY, load_families
+    load_families()
+    return [(m, span.at) for m, spec in sorted(REGISTRY.items()) for span in spec.spans]
+
+
+@pytest.mark.parametrize("mnemonic, at", _span_cases())
+def test_every_run_an_instruction_declares_fits_where_its_symbol_is_placed(
+        mnemonic: str, at: int) -> None:
+    """For each instruction with a run (its Span), a symbol at the run's
+    start is placed where the run fits: the program loads and scans."""
+    from plcrt.isa.registry import lookup
+    spec = lookup(mnemonic)
+    assert spec is not None
+    runs = {span.at for span in spec.spans}
+    ops = [("Run" if i == at else f"Other{i}" if i in runs else _PLAIN[role.name])
+           for i, role in enumerate(spec.roles)]
+    plc = plcrt.load(ob1(f"LD SM0.0\n{mnemonic} {', '.join(ops)}"), auto_symbols=True)
+    assert "Run" in assigned(plc)
+    plc.scan()

@@ -24,6 +24,7 @@ from ..lang import ir
 from ..lang.codepage import program_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
+from .constpower import ConstantPower, contact_value
 from .emit import CodegenError, Gen
 from .locs import LineLocs, LocTable
 from .resolve import LocalVar, ResolveError, Resolver, layout_locals
@@ -580,10 +581,14 @@ def _network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:
             gen.line(f"{hit}({k})")
 
 
-def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: SourceLoc) -> None:
-    """Record whether a coil or box is reached with or without power flow."""
+def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: SourceLoc,
+                  power: ConstantPower) -> None:
+    """Record whether a coil or box is reached with or without power flow
+    (not when its power is constant: SM0.0, see :mod:`.constpower`)."""
     shp = shape(insn.mnemonic)
     if shp.kind not in ("coil", "box") or shp.inputs < 1 or gen.depth < shp.inputs:
+        return
+    if power.level(shp.inputs - 1) is not None:
         return
     net = piece.network
     k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
@@ -613,6 +618,8 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     shp = shape(insn.mnemonic)
     if shp.kind != "contact" or gen.depth >= MAX_STACK_LEVELS:
         return False
+    if contact_value(insn.mnemonic, ops) is not None:
+        return False            # a constant bit (SM0.0) is no coverage goal
     m = insn.mnemonic
     load = m if shp.op == "load" else "LD" + m[1:]
     load_spec = lookup(load)
@@ -674,6 +681,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
     """
     block = piece.pou.ident
     broken = False
+    power = ConstantPower(gen.depth)    # probes only: which outcomes are constant
     for insn in piece.insns:
         loc = insn.loc.within(block, piece.network.number) if insn.loc.block is None else insn.loc
         spec = lookup(insn.mnemonic)
@@ -698,7 +706,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         # made it a third longer to compile and keep)
         gen.line_map.append((len(gen.lines), insn_id, gen.indent))
         if unit.probes is not None and not broken:
-            _output_probe(unit, gen, piece, insn, loc)
+            _output_probe(unit, gen, piece, insn, loc, power)
         # perf: emitters only append lines, so the length is what to restore
         saved = (len(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
@@ -712,6 +720,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             if piece.resolved is not None:
                 site = len(unit.hooks["edges"]) - 1 if insn.mnemonic in ("EU", "ED") else -1
                 piece.resolved.append((insn.mnemonic, ops, site))
+            if unit.probes is not None:
+                power.step(insn.mnemonic, ops, gen.depth)
         except (CodegenError, ResolveError) as e:
             del gen.lines[saved[0]:]
             _, gen.depth, gen.indent, gen.pending = saved

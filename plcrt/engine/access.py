@@ -44,7 +44,7 @@ class AddressAccess:
             except Exception as e:  # noqa: BLE001 - reported as an address error
                 raise PlcAddressError(f"{excerpt(address)!r}: {e}") from None
         if not isinstance(op, Addr):
-            raise PlcAddressError(f"{excerpt(address)!r} is not an address")
+            raise PlcAddressError(_unknown_name(text, self.symbols))
         return op
 
     def locate(self, spec: str) -> tuple[bytearray, int, int, int, str]:
@@ -269,6 +269,20 @@ def _store(b: bytearray, off: int, width: int, bit: int, value: int | float) -> 
         CODECS["_wf"](b, off, value)
     else:
         b[off:off + width] = (value & ((1 << 8 * width) - 1)).to_bytes(width, "big")
+
+
+def _unknown_name(name: str, symbols: Any) -> str:
+    """What to say of a name that is neither an address nor a symbol: the
+    table it is missing from and the closest names there (a typo is the
+    usual cause)."""
+    import difflib
+    names = list(symbols.entries) if symbols is not None else []
+    names += [n for n in _system_symbols() if n not in names]
+    close = difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+    where = "is not an address and not in the symbol table" if symbols is not None else \
+        "is not an address"
+    hint = ("; did you mean " + " or ".join(repr(excerpt(c)) for c in close) + "?") if close else ""
+    return f"{excerpt(name)!r} {where}{hint}"
 
 
 def _system_symbols() -> dict[str, str]:

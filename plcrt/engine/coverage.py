@@ -15,6 +15,10 @@ two kinds of probes (and nothing else changes in what the program does):
   open, bit 1 = closed.  A parallel branch whose contact was never closed
   never conducted: the ladder form of condition coverage.
 
+A contact on a bit that is constant in RUN (SM0.0) and an output whose
+power is constant because of such contacts get no probe: they are not
+coverage goals (:mod:`plcrt.compiler.constpower` decides which).
+
 The first piece of every network also checks ``_BP[k]`` and calls the
 break handler, which the debugger uses for breakpoints on networks.
 

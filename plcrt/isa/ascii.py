@@ -37,7 +37,7 @@ from typing import Callable
 
 from ..compiler.emit import Gen
 from .region import region, runtime_error
-from .registry import Role, insn
+from .registry import Role, Span, insn
 
 F = "ascii"
 
@@ -147,6 +147,13 @@ def _helper(g: Gen, mn: str) -> str:
     return g.bind(hooks["ascii"][mn], mn.lower())
 
 
+#: the most characters RTA writes (FMT's ssss)
+RTA_MAX = 15
+#: mnemonic -> characters written at OUT (at most)
+OUT_CHARS = {"ITA": 8, "DTA": 12, "RTA": RTA_MAX}
+#: ATH / HTA: LEN characters or nibbles at IN and at OUT (bits each)
+HEX_UNITS = {"ATH": (8, 4), "HTA": (4, 8)}
+
 #: mnemonic -> (IN role, IN kind, bytes checked at OUT at compile time, summary)
 NUMBER: dict[str, tuple[Role, str, int, str]] = {
     "ITA": (Role.W_R, "W", 8, "8 characters at OUT := INT IN formatted by FMT"),
@@ -164,7 +171,8 @@ def _make_number(mn: str) -> None:
         with g.box():
             g.eno(f"{fn}({g.rd(value, kind)}, {where}, {g.rd(fmt, 'B')}, {g.insn_id})")
 
-    insn(mn, role, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
+    insn(mn, role, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary,
+         spans=(Span(1, 8, OUT_CHARS[mn]),))(emit)
 
 
 def _make_hex(mn: str, summary: str) -> None:
@@ -175,7 +183,9 @@ def _make_hex(mn: str, summary: str) -> None:
         with g.box():
             g.eno(f"{fn}({a}, {b}, {g.rd(n, 'B')}, {g.insn_id})")
 
-    insn(mn, Role.B_R, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
+    unit_in, unit_out = HEX_UNITS[mn]
+    insn(mn, Role.B_R, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary,
+         spans=(Span(0, unit_in, 255, by=2), Span(1, unit_out, 255, by=2)))(emit)
 
 
 for _mn in NUMBER:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from ..compiler.emit import Gen
 from ..compiler.operands import Addr, Const
 from ..safetext import excerpt
-from .registry import Role, insn
+from .registry import Role, Span, insn
 
 F = "bitlogic"
 
@@ -149,6 +149,10 @@ def _assign_i(g: Gen, op: Addr) -> None:
     g.wbit(Addr("PQ", op.offset, 0, op.bit), top)
 
 
+#: S, R, SI, RI: N bits (1..255) from the first operand
+_N_BITS = (Span(0, 1, 255, by=1),)
+
+
 def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
     """S/R over ``n`` consecutive bits starting at ``op`` (T/C: n timers)."""
     count = int(n.value)
@@ -188,22 +192,25 @@ def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
                 bit += span
 
 
-@insn("S", Role.BIT_TC, Role.N, family=F, summary="set n bits")
+@insn("S", Role.BIT_TC, Role.N, family=F, summary="set n bits", spans=_N_BITS)
 def _s(g: Gen, op: Addr, n: Const) -> None:
     _range(g, op, n, 1)
 
 
-@insn("R", Role.BIT_TC, Role.N, family=F, summary="reset n bits (timers/counters: reset them)")
+@insn("R", Role.BIT_TC, Role.N, family=F, summary="reset n bits (timers/counters: reset them)",
+      spans=_N_BITS)
 def _r(g: Gen, op: Addr, n: Const) -> None:
     _range(g, op, n, 0)
 
 
-@insn("SI", Role.QBIT, Role.N, family=F, summary="set n outputs and their terminals now")
+@insn("SI", Role.QBIT, Role.N, family=F, summary="set n outputs and their terminals now",
+      spans=_N_BITS)
 def _si(g: Gen, op: Addr, n: Const) -> None:
     _range(g, op, n, 1, phys=True)
 
 
-@insn("RI", Role.QBIT, Role.N, family=F, summary="reset n outputs and their terminals now")
+@insn("RI", Role.QBIT, Role.N, family=F, summary="reset n outputs and their terminals now",
+      spans=_N_BITS)
 def _ri(g: Gen, op: Addr, n: Const) -> None:
     _range(g, op, n, 0, phys=True)
 

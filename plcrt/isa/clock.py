@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from ..compiler.emit import Gen
 from .region import region, runtime_error
-from .registry import Role, insn
+from .registry import Role, Span, insn
 
 F = "clock"
 
@@ -57,7 +57,8 @@ def _make(mn: str) -> None:
                 fn = g.bind(getattr(plc.clock, method), mn.lower())
                 g.line(f"{fn}(*{where})")
 
-    insn(mn, Role.B_W, family=F, summary=summary, may_fail=sets)(emit)
+    insn(mn, Role.B_W, family=F, summary=summary, may_fail=sets,
+         spans=(Span(0, 8, nbytes),))(emit)
 
 
 for _mn in TOD:

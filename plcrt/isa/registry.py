@@ -52,6 +52,21 @@ class Role(enum.Enum):
 
 
 @dataclass(frozen=True, slots=True)
+class Span:
+    """Operand *at* is the first of a run of memory: *count* elements of
+    *unit* bits each, where the count is the value of operand *by* (its
+    magnitude) when that is a constant, and *count* (the most it may be)
+    when it is not or when *by* is None (a fixed run).  What memory an
+    instruction reaches from an operand, for passes that place addresses
+    (``--auto-symbols``); the emitters check the runs themselves."""
+
+    at: int
+    unit: int
+    count: int
+    by: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class InsnSpec:
     """Static description of one mnemonic."""
 
@@ -63,6 +78,7 @@ class InsnSpec:
     variadic: bool = False   #: CALL: any number of trailing operands
     may_fail: bool = False   #: sets ENO = 0 on errors (for AENO)
     flow: str = ""           #: control-flow kind, see compiler.codegen
+    spans: tuple[Span, ...] = ()   #: operands that start a run of memory
 
 
 REGISTRY: dict[str, InsnSpec] = {}
@@ -74,14 +90,15 @@ KNOWN_UNIMPLEMENTED: frozenset[str] = frozenset()
 
 def insn(mnemonic: str, *roles: Role, family: str, summary: str,
          variadic: bool = False, may_fail: bool = False,
-         flow: str = "") -> Callable[[Callable[..., None]], Callable[..., None]]:
+         flow: str = "", spans: tuple[Span, ...] = ()
+         ) -> Callable[[Callable[..., None]], Callable[..., None]]:
     """Register an emitter for ``mnemonic`` (decorator)."""
 
     def register(fn: Callable[..., None]) -> Callable[..., None]:
         if mnemonic in REGISTRY:
             raise ValueError(f"instruction {mnemonic!r} registered twice")
         REGISTRY[mnemonic] = InsnSpec(mnemonic, roles, fn, family, summary,
-                                      variadic, may_fail, flow)
+                                      variadic, may_fail, flow, spans)
         return fn
 
     return register

@@ -32,11 +32,12 @@ from typing import Callable
 from ..compiler.emit import Gen
 from ..compiler.rt import s16
 from .region import region, runtime_error
-from .registry import Role, insn
+from .registry import Role, Span, insn
 
 F = "table"
 
 MAX_ENTRIES = 100   #: System Manual: a table holds at most 100 entries
+TABLE_BYTES = 4 + 2 * MAX_ENTRIES   #: TL, EC and the entries of the largest table
 SM1_FULL, SM1_EMPTY = 0x10, 0x20   #: SM1.4, SM1.5
 
 #: FND's compare by mnemonic (CMD 1..4 of the LAD box: =, <>, <, >)
@@ -144,7 +145,7 @@ def _helper(g: Gen, mn: str) -> str:
 
 
 @insn("ATT", Role.W_R, Role.W_W, family=F, may_fail=True,
-      summary="append DATA to the table TBL (SM1.4 when full)")
+      summary="append DATA to the table TBL (SM1.4 when full)", spans=(Span(1, 8, TABLE_BYTES),))
 def _att(g: Gen, data, tbl) -> None:
     fn = _helper(g, "ATT")
     where = region(g, tbl, 4, "the table TBL")
@@ -167,7 +168,8 @@ def _make_take(mn: str) -> None:
 
     which = "first (oldest)" if mn == "FIFO" else "last (newest)"
     insn(mn, Role.W_W, Role.W_W, family=F, may_fail=True,
-         summary=f"DATA := the {which} entry of TBL, removed (SM1.5 when empty)")(emit)
+         summary=f"DATA := the {which} entry of TBL, removed (SM1.5 when empty)",
+         spans=(Span(0, 8, TABLE_BYTES),))(emit)
 
 
 def _make_find(mn: str) -> None:
@@ -185,7 +187,8 @@ def _make_find(mn: str) -> None:
                 g.line("eno = 0")
 
     insn(mn, Role.W_R, Role.W_R, Role.W_W, family=F, may_fail=True,
-         summary=f"INDX := first entry from INDX with entry {mn[3:]} PATRN, else EC")(emit)
+         summary=f"INDX := first entry from INDX with entry {mn[3:]} PATRN, else EC",
+         spans=(Span(0, 8, TABLE_BYTES),))(emit)
 
 
 for _mn in ("FIFO", "LIFO"):

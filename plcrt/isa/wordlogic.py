@@ -26,7 +26,7 @@ from __future__ import annotations
 from ..compiler.emit import BUFFER_NAME, Gen
 from ..compiler.operands import Addr, Const, area_size
 from ..safetext import excerpt
-from .registry import Role, insn
+from .registry import Role, Span, insn
 
 F = "wordlogic"
 
@@ -232,7 +232,8 @@ def _shrb_inline(g: Gen, buf: str, byte: int, sh: int, mask: int, top: int,
 
 
 @insn("SHRB", Role.BIT_R, Role.BIT_W, Role.B_R, family=F, may_fail=True,
-      summary="shift DATA into the bit register S_BIT..S_BIT+|N|-1; SM1.1 bit out")
+      summary="shift DATA into the bit register S_BIT..S_BIT+|N|-1; SM1.1 bit out",
+      spans=(Span(1, 1, SHRB_MAX, by=2),))
 def _shrb(g: Gen, data: Addr, sbit: Addr, count) -> None:
     start = sbit.offset * 8 + sbit.bit
     size = area_size(g.unit.model, sbit.area)

@@ -16,7 +16,6 @@ here, so calls chain.
 
 from __future__ import annotations
 
-import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -24,14 +23,13 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..devices import AxisState, DriveState
-from ..trace.recorder import is_device_signal, parse_signal
 from ..engine.runtime import Plc, load
-from ..engine.values import Duration, check_address, parse_number, scan_number
+from ..engine.values import Duration, check_address, scan_number
 from ..engine.values import duration as parse_duration
 from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
+from .conditions import Condition, addresses_of, condition, quoted, reader
 
 Value = Union[int, float, bool]
-Condition = Union[str, Callable[[], Any], Callable[["Harness"], Any]]
 
 
 class PlcTimeout(AssertionError):
@@ -46,64 +44,6 @@ def seconds(d: Duration) -> float:
     """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``, ``"2min"``
     (:func:`plcrt.engine.values.duration`, as ``Plc.run`` reads it)."""
     return parse_duration(d)
-
-
-# ---------------------------------------------------------------------------
-# Fast readers
-# ---------------------------------------------------------------------------
-
-def reader(plc: Plc, spec: str) -> Callable[[], Value]:
-    """A function reading one address (``VW100``, ``VD4:REAL``, ``T37:BIT``,
-    symbol names) or one device quantity (``axis0.0.position``,
-    ``drive1.statusword``, the signals of ``plcrt trace``) resolved once,
-    for per-scan use (see :meth:`Plc.reader`)."""
-    if isinstance(spec, str) and is_device_signal(spec):
-        return parse_signal(plc, spec).read
-    return plc.reader(spec)[1]
-
-
-_COND_RE = re.compile(r"^\s*(not\s+|!)?\s*([^<>=!]+?)\s*"
-                      r"(?:(==|!=|<>|<=|>=|<|>|=)\s*([^\s<>=!]\S*))?\s*$", re.IGNORECASE)
-_OPS: dict[str, Callable[[Any, Any], bool]] = {
-    "==": lambda a, b: a == b, "=": lambda a, b: a == b, "!=": lambda a, b: a != b,
-    "<>": lambda a, b: a != b, "<": lambda a, b: a < b, "<=": lambda a, b: a <= b,
-    ">": lambda a, b: a > b, ">=": lambda a, b: a >= b,
-}
-
-
-def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
-    """A no-argument predicate and its description from a condition:
-    ``"Q0.0"``, ``"not M0.1"``, ``"VW100 >= 25"``, ``"VD8:REAL > 1.5"``, a
-    callable taking no argument, or a callable taking the harness."""
-    if callable(cond):
-        import inspect
-        try:
-            takes_arg = len(inspect.signature(cond).parameters) >= 1
-        except (TypeError, ValueError):
-            takes_arg = False
-        name = getattr(cond, "__name__", "condition")
-        if takes_arg:
-            return (lambda: bool(cond(h))), name   # type: ignore[call-arg]
-        return (lambda: bool(cond())), name        # type: ignore[call-arg]
-    if not isinstance(cond, str):
-        raise PlcConfigError(f"a condition is a string such as 'Q0.0' or 'VW100 >= 25', or a "
-                             f"function; got {type(cond).__name__} {cond!r}")
-    m = _COND_RE.match(cond)
-    if m is None:
-        raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
-                             f"or 'ADDR <op> value' with op one of == != < <= > >=")
-    neg, addr, op, value = m.groups()
-    rd = reader(h.plc, addr)
-    if op is None:
-        return ((lambda: not rd()) if neg else (lambda: bool(rd()))), str(cond).strip()
-    try:
-        v = parse_number(value)
-    except PlcConfigError:
-        raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
-    fn = _OPS[op]
-    if neg:
-        return (lambda: not fn(rd(), v)), str(cond).strip()
-    return (lambda: fn(rd(), v)), str(cond).strip()
 
 
 class Harness:
@@ -279,35 +219,50 @@ class Harness:
         for _ in range(limit):
             plc.scan(1)
             if plc.mode != "RUN":
-                self._timeout(f"the CPU went to STOP before {what!r} became true", message)
+                self._timeout(f"the CPU went to STOP before {quoted(what)} became true",
+                              message, cond)
             if self._check(pred, what):
                 return (plc.now_us - t0) / 1e6
-        self._timeout(f"{what!r} did not become true within {seconds(timeout):g} s of "
-                      f"simulated time ({limit} scans)", message)
+        self._timeout(f"{quoted(what)} did not become true within {seconds(timeout):g} s of "
+                      f"simulated time ({limit} scans)", message, cond)
         raise AssertionError  # pragma: no cover - _timeout raises
 
     def run_while(self, cond: Condition, *, timeout: Duration = 10.0, message: str = "") -> float:
         """Scan while ``cond`` holds (the opposite of :meth:`run_until`)."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
-        return self.run_until(lambda: not pred(), timeout=timeout,
-                              message=message or f"{what!r} stayed true")
+        t0 = self.plc.now_us
+        limit = self._scans_for(timeout)
+        plc = self.plc
+        for _ in range(limit):
+            plc.scan(1)
+            if plc.mode != "RUN":
+                self._timeout(f"the CPU went to STOP while {quoted(what)} was still true",
+                              message, cond)
+            if not self._check(pred, what):
+                return (plc.now_us - t0) / 1e6
+        self._timeout(f"{quoted(what)} stayed true for the whole {seconds(timeout):g} s "
+                      f"of simulated time ({limit} scans)", message, cond)
+        raise AssertionError  # pragma: no cover - _timeout raises
 
     def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
         """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         plc = self.plc
+        t0 = plc.time
+        expected = (f"expected {quoted(what)} to stay true for {seconds(duration):g} s "
+                    f"from t = {t0:.3f} s")
         for _ in range(self._scans_for(duration)):
             plc.scan(1)
             if plc.mode != "RUN":
                 # time stands still in STOP: the duration would never pass
-                self._timeout(f"the CPU went to STOP before {seconds(duration):g} s had "
-                              f"passed, so {what!r} was not seen to stay true", message,
+                self._timeout(f"{expected}; the CPU went to STOP before {seconds(duration):g} s "
+                              f"had passed, so it was not seen to stay true", message, cond,
                               exc=AssertionError)
             if not self._check(pred, what):
-                self._timeout(f"{what!r} became false at t = {plc.time:.3f} s", message,
-                              exc=AssertionError)
+                self._timeout(f"{expected}; it became false {plc.time - t0:.3f} s later",
+                              message, cond, exc=AssertionError)
         return self
 
     def _check(self, pred: Callable[[], bool], what: str) -> bool:
@@ -317,15 +272,33 @@ class Harness:
             return pred()
         except Exception as e:
             if hasattr(e, "add_note"):
-                e.add_note(f"while checking the condition {what!r} after scan {self.scans} "
-                           f"(t = {self.time:.3f} s)")
+                e.add_note(f"while checking the condition {quoted(what)} after scan "
+                           f"{self.scans} (t = {self.time:.3f} s)")
             raise
 
-    def _timeout(self, text: str, message: str, exc: type[AssertionError] = PlcTimeout) -> None:
+    def _timeout(self, text: str, message: str, cond: Condition | None = None,
+                 exc: type[AssertionError] = PlcTimeout, shown: Sequence[str] = ()) -> None:
+        """Raise ``exc``: the test's message, what was expected and what
+        happened (*text*), when, and the values of the condition's address,
+        of *shown* and of the watched addresses at that moment."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         parts = [message, text] if message else [text]
         parts.append(f"at t = {self.time:.3f} s, scan {self.scans}")
+        values = self._values_now([*addresses_of(cond), *shown, *self.watched])
+        if values:
+            parts.append(values)
         raise exc("; ".join(parts))
+
+    def _values_now(self, specs: Sequence[str]) -> str:
+        """``"VW100 = 3, Q0.0 = 0"`` for the addresses and signals *specs*
+        (each once, in order; one that cannot be read is left out)."""
+        shown = []
+        for spec in dict.fromkeys(specs):
+            try:
+                shown.append(f"{spec} = {_fmt(reader(self.plc, spec)())}")
+            except PlcError:
+                continue
+        return ", ".join(shown)
 
     # -- stimuli ----------------------------------------------------------
     def __getitem__(self, address: str) -> Value:
@@ -497,28 +470,62 @@ class Harness:
                          timeout: Duration = 1.0) -> float:
         """Run until the axis moves; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
-                              message=f"axis {slot}.{axis} did not start")
+
+        def moving() -> bool:
+            return self.axis(slot, axis).moving
+
+        moving.__name__ = f"axis {slot}.{axis} is moving"   # as messages name it
+        return self.run_until(moving, timeout=timeout, message=f"axis {slot}.{axis} did not start")
 
     def wait_axis_stopped(self, slot: int = 0, axis: int = 0, *,
                           timeout: Duration = 60.0) -> float:
         """Run until the axis stands still; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
-                              message=f"axis {slot}.{axis} did not stop")
+
+        def stopped() -> bool:
+            return not self.axis(slot, axis).moving
+
+        stopped.__name__ = f"axis {slot}.{axis} stands still"   # as messages name it
+        return self.run_until(stopped, timeout=timeout, message=f"axis {slot}.{axis} did not stop")
 
     def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
         """Assert a move that is running (or about to start within a few
-        scans) ends within ``limit`` simulated seconds; returns its time."""
+        scans) ends within ``limit`` simulated seconds; returns the seconds
+        until the axis stood still.  One more scan follows, so the outputs of
+        the block that commanded the move (its Done, C_Status, C_Pos) are
+        current when this returns."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        seconds(limit)   # a bad limit is reported before anything runs
-        t0 = self.time
+        total = seconds(limit)   # a bad limit is reported before anything runs
+        plc = self.plc
+        t0 = plc.now_us
+        who = f"axis {slot}.{axis}"
+        expected = f"expected the move of {who} to be done within {total:g} s"
+        signals = [f"axis{slot}.{axis}.position", f"axis{slot}.{axis}.speed"]
         if not self.axis(slot, axis).moving:
-            self.wait_axis_moving(slot, axis, timeout=min(seconds(limit), 1.0))
-        self.run_until(lambda: not self.axis(slot, axis).moving, timeout=seconds(limit) -
-                       (self.time - t0), message=f"the move of axis {slot}.{axis} was not "
-                       f"done within {seconds(limit):g} s")
-        return self.time - t0
+            start = min(total, 1.0)
+            for _ in range(self._scans_for(start)):
+                plc.scan(1)
+                self._axis_running(expected, signals)
+                if self.axis(slot, axis).moving:
+                    break
+            else:
+                self._timeout(f"{expected}; the axis did not start moving within {start:g} s",
+                              "", shown=signals)
+        for _ in range(self._scans_for(total - (plc.now_us - t0) / 1e6)):
+            plc.scan(1)
+            self._axis_running(expected, signals)
+            if not self.axis(slot, axis).moving:
+                took = (plc.now_us - t0) / 1e6
+                plc.scan(1)     # the block sees the axis stopped and reports it
+                return took
+        self._timeout(f"{expected}; it was still moving {(plc.now_us - t0) / 1e6:g} s later",
+                      "", shown=signals)
+        raise AssertionError  # pragma: no cover - _timeout raises
+
+    def _axis_running(self, expected: str, signals: list[str]) -> None:
+        __tracebackhide__ = True  # pytest: report the test's line, not ours
+        if self.plc.mode != "RUN":
+            self._timeout(f"{expected}; the CPU went to STOP", "", shown=signals)
 
     # -- results ----------------------------------------------------------
     @property

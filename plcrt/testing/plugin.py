@@ -521,6 +521,13 @@ def trace_text(used: list[tuple[Any, Harness]]) -> str:
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]
                               ) -> Iterator[None]:
     # tryfirst on a wrapper: outermost, so xfail has already been decided
+    excinfo = call.excinfo
+    if (call.when == "call" and excinfo is not None and item.stash.get(_USED, None)
+            and not item.config.option.fulltrace):
+        from .frames import drop_plcrt_frames, meant_for_the_test
+        if meant_for_the_test(excinfo.value):
+            # the test's line and plcrt's message, not plcrt's internals
+            drop_plcrt_frames(excinfo.tb)
     report = yield
     if report.when == "call" and report.failed:
         used = item.stash.get(_USED, None)

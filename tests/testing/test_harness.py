@@ -121,8 +121,35 @@ def test_string_conditions() -> None:
 def test_stays() -> None:
     h = Harness.load(COUNTER)
     h.stays("not Q0.0", "20ms")
-    with pytest.raises(AssertionError, match=r"'not Q0.0' became false at t = 0.030 s"):
+    with pytest.raises(AssertionError) as info:
         h.stays("not Q0.0", "1s")
+    assert str(info.value) == ("expected 'not Q0.0' to stay true for 1 s from t = 0.020 s; "
+                               "it became false 0.010 s later; at t = 0.030 s, scan 3")
+
+
+def test_stays_names_a_lambda_by_its_text_and_shows_the_watched_values() -> None:
+    h = Harness.load(COUNTER, watch=["VW100", "Q0.0"])
+    with pytest.raises(AssertionError) as info:
+        h.stays(lambda: h["VW100"] < 2, "1s", message="counter too fast")
+    assert str(info.value) == (
+        "counter too fast; expected 'lambda: h[\"VW100\"] < 2' to stay true for 1 s from "
+        "t = 0.000 s; it became false 0.020 s later; at t = 0.020 s, scan 2; "
+        "VW100 = 2, Q0.0 = 0")
+
+
+def test_a_comparison_that_never_holds_shows_its_value() -> None:
+    h = Harness.load(COUNTER)
+    with pytest.raises(PlcTimeout) as info:
+        h.run_until("VW100 >= 500", timeout="50ms")
+    assert str(info.value) == ("'VW100 >= 500' did not become true within 0.05 s of simulated "
+                               "time (5 scans); at t = 0.050 s, scan 5; VW100 = 5")
+
+
+def test_a_function_without_source_is_the_condition() -> None:
+    h = Harness.load(COUNTER)
+    cond = eval("lambda: False")        # no source file to quote
+    with pytest.raises(PlcTimeout, match=r"^the condition did not become true within 0.02 s"):
+        h.run_until(cond, timeout="20ms")
 
 
 # -- stimuli -------------------------------------------------------------------
@@ -255,11 +282,25 @@ def test_em253_point_to_point_move_ends_at_17_s() -> None:
     assert took == pytest.approx(17.0, abs=1e-9)
     ax = h.axis(0, 0)
     assert (ax.position, ax.mechanical, ax.speed, ax.moving) == (1_000_000, 1_000_000, 0, False)
-    h.scan()                        # the block reports at the start of the next scan
+    # one scan more has run: the block has reported the end (C_Status 8, C_Pos)
+    assert h.time == pytest.approx(17.001)
     assert (h["VW106"], h["VD108"]) == (8, 1_000_000)
     # the same move cannot be done 0.1 s sooner
-    with pytest.raises(PlcTimeout, match="was not done within 6.9 s"):
+    with pytest.raises(PlcTimeout) as info:
         at_10s.axis_done_within("6.9s")
+    assert str(info.value) == (
+        "expected the move of axis 0.0 to be done within 6.9 s; it was still moving 6.9 s "
+        "later; at t = 16.900 s, scan 16900; axis0.0.position = 999421, axis0.0.speed = 6562, "
+        "VW106 = 1, VD108 = 999415")
+
+
+def test_axis_done_within_a_move_that_never_starts_says_so() -> None:
+    h = Harness.load(EM253 / "pos_goto_r.awl", plant=EM253 / "plant.toml", scan_ms=1)
+    with pytest.raises(PlcTimeout) as info:
+        h.axis_done_within("5s")
+    assert str(info.value) == (
+        "expected the move of axis 0.0 to be done within 5 s; the axis did not start moving "
+        "within 1 s; at t = 1.000 s, scan 1000; axis0.0.position = 0, axis0.0.speed = 0")
 
 
 # -- property: forking mid-way changes nothing -----------------------------------

@@ -337,7 +337,7 @@ def test_fork_counts_too(plc):
     result.assert_outcomes(passed=2)
     result.stdout.fnmatch_lines([
         "*= plcrt coverage =*",
-        "cov.awl: networks 5/7 (71.4 %), branches 5/12 (41.7 %), contacts 9/16 (56.2 %)",
+        "cov.awl: networks 5/7 (71.4 %), branches 5/10 (50.0 %), contacts 9/14 (64.3 %)",
         '  not run: OB1/3 "Horn" (line 11)',
         '  not run: SBR0/1 "Count service calls" (line 25)',
         "  OB1/2 line 9: LDN I0.7 never open",

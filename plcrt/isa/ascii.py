@@ -164,7 +164,7 @@ def _make_number(mn: str) -> None:
         with g.box():
             g.eno(f"{fn}({g.rd(value, kind)}, {where}, {g.rd(fmt, 'B')}, {g.insn_id})")
 
-    insn(mn, role, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
+    insn(mn, role, Role.B_MW, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
 
 
 def _make_hex(mn: str, summary: str) -> None:
@@ -175,7 +175,7 @@ def _make_hex(mn: str, summary: str) -> None:
         with g.box():
             g.eno(f"{fn}({a}, {b}, {g.rd(n, 'B')}, {g.insn_id})")
 
-    insn(mn, Role.B_R, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
+    insn(mn, Role.B_M, Role.B_MW, Role.B_R, family=F, may_fail=True, summary=summary)(emit)
 
 
 for _mn in NUMBER:

@@ -350,22 +350,40 @@ def mutant(i: int, seed: str = SEED) -> tuple[Sample, str, list[str]]:
     return sample, m.mutate(), m.done
 
 
+class PlcrtBug(Exception):
+    """A PlcError that reports a bug of plcrt's own instead of the program's."""
+
+
+#: words of the messages that report plcrt's own bugs (last-resort wrappers)
+BUG_MARKS = ("internal error", "bug in plcrt")
+
+
+def _check_not_a_bug(e: plcrt.PlcError) -> None:
+    for d in e.diagnostics:
+        if any(mark in d.message for mark in BUG_MARKS):
+            raise PlcrtBug(str(d)) from e
+
+
 def exercise(sample: Sample, text: str, backend: str, with_plant: bool) -> str:
     """Load *text* as *sample* is loaded; scan and fork it if it loads.
     Returns what happened ("refused", "fault", "ran"); any exception but a
-    PlcError propagates."""
+    PlcError propagates, and a PlcError that reports a plcrt bug raises
+    :class:`PlcrtBug`."""
     try:
         plc = plcrt.load(text, symbols=sample.symbols, data=sample.data,
                          plant=sample.plant if with_plant else None,
                          backend=backend, library=True)
-    except plcrt.PlcError:
+    except plcrt.PlcError as e:
+        _check_not_a_bug(e)
         return "refused"
     try:
         plc.run(scans=SCANS)
         twin = plc.fork()
         twin.run(scans=1)
-    except plcrt.PlcError:
+    except plcrt.PlcError as e:
+        _check_not_a_bug(e)
         return "fault"
+    _check_not_a_bug(plcrt.PlcError("", None, plc.diagnostics))
     return "ran"
 
 

@@ -234,6 +234,20 @@ class Mutant:
             ops[self.rng.randrange(len(ops))] = self.operand()
         self._insert(f"{mn:6} {', '.join(ops)}".rstrip())
 
+    def signature_batch(self) -> None:
+        """Several instructions of one family with one odd operand each
+        (refused lines do not stop the others from being compiled)."""
+        family = REGISTRY[self.rng.choice(MNEMONICS)].family
+        same = [m for m in MNEMONICS if REGISTRY[m].family == family]
+        for _ in range(self.rng.randint(3, 12)):
+            mn = self.rng.choice(same)
+            spec = REGISTRY[mn]
+            ops = list(VARIADIC.get(mn, [])) if spec.variadic else \
+                [TYPICAL[r] for r in spec.roles]
+            if ops:
+                ops[self.rng.randrange(len(ops))] = self.operand()
+            self._insert(f"{mn:6} {', '.join(ops)}".rstrip())
+
     def stack_op(self) -> None:
         self._insert(self.rng.choice(STACK_OPS))
 
@@ -275,8 +289,8 @@ class Mutant:
 
     MUTATIONS = ("replace_operand", "replace_operand", "replace_operand",
                  "replace_all_operands", "add_or_drop_operand", "huge_constants",
-                 "other_mnemonic", "signature_insn", "signature_insn", "signature_insn",
-                 "stack_op", "stack_op", "recursion", "delete_line", "duplicate_line",
+                 "other_mnemonic", "signature_insn", "signature_insn", "signature_batch",
+                 "signature_batch", "stack_op", "stack_op", "recursion", "delete_line", "duplicate_line",
                  "truncate_network")
 
     def mutate(self) -> str:

@@ -138,3 +138,24 @@ def test_a_plcrt_bug_in_operand_resolution_is_a_located_compile_error(
     at = [str(d) for d in info.value.diagnostics if d.loc.line == 7]
     assert at[0].startswith("prog.awl:7:8: error: INCW operand 1: plcrt cannot compile this "
                             "(OverflowError: too big)"), at
+
+
+def test_a_plcrt_bug_between_instructions_is_a_located_compile_error(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """The same for an exception of plcrt's code outside one instruction
+    (here the native backend's planning of a block): a PlcCompileError at
+    the network being compiled, never the bare exception."""
+    pytest.importorskip("llvmlite")
+    from plcrt.compiler import native
+
+    def broken(*args, **kwargs):  # noqa: ANN002, ANN003
+        raise KeyError("segment")
+
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(native, "plan_pou", broken)
+    with pytest.raises(plcrt.PlcCompileError) as info:
+        plcrt.Plc(parse_program(_prog("INCW   VW0"), "prog.awl"), backend="native")
+    first = str(info.value.diagnostics[0])
+    assert first.startswith("prog.awl:5:1: error: this network: plcrt cannot compile this "
+                            "(KeyError: 'segment'); this is a bug in plcrt"), first
+    assert first.endswith("[OB1 network 2]"), first

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import DiagnosticSink, PlcCompileError
+from ..errors import DiagnosticSink, PlcCompileError, PlcError
 from ..lang import ir
 from ..lang.limits import MAX_INSTRUCTIONS, MAX_NETWORKS
 from ..memory.cpu import CpuModel
@@ -50,6 +50,8 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
         setup(unit)
     try:
         source, line_locs = generate(unit)
+    except PlcError:
+        raise
     except Exception as e:  # noqa: BLE001 - a plcrt bug outside one instruction
         # (an instruction's own is reported at it by emit_piece): at the
         # network being compiled, with everything found before it

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from ..errors import Diagnostic, DiagnosticSink, SourceLoc
+from ..errors import Diagnostic, DiagnosticSink, PlcError, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
@@ -137,20 +137,35 @@ class Unit:
 
     def bind(self, obj: object, hint: str = "o", constant: bool = False) -> str:
         """The generated name of run-time object ``obj`` (one name per
-        object); ``constant``: the generated code only reads it."""
+        object); ``constant``: the generated code only reads it.  An
+        immutable value (bytes, a tuple of numbers ...) is a constant
+        whoever binds it."""
         key = id(obj)
         name = self._ids.get(key)
         if name is None:
             name = self.fresh(hint)
             self._ids[key] = name
             self.bindings[name] = obj
-        if constant:
+        if constant or _immutable(obj):
             self.constants.add(name)
         return name
 
     def callee(self, name: str) -> PouInfo | None:
         key = name.strip().upper()
         return self.pous.get(key) or self.by_name.get(key)
+
+
+_IMMUTABLE = (bytes, str, int, float, complex, bool, type(None), range)
+
+
+def _immutable(obj: object, depth: int = 0) -> bool:
+    """``obj`` can never change: an immutable scalar, or a tuple or
+    frozenset of such (a few levels deep)."""
+    if isinstance(obj, _IMMUTABLE):
+        return True
+    if isinstance(obj, (tuple, frozenset)) and depth < 4:
+        return all(_immutable(x, depth + 1) for x in obj)
+    return False
 
 
 def _pou_fname(p: ir.Pou) -> str:
@@ -720,6 +735,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             if piece.resolved is not None:
                 site = len(unit.hooks["edges"]) - 1 if insn.mnemonic in ("EU", "ED") else -1
                 piece.resolved.append((insn.mnemonic, ops, site))
+        except PlcError:
+            raise   # a problem outside the program (a library description file)
         except Exception as e:  # noqa: BLE001 - a plcrt bug is reported at its instruction
             del gen.lines[saved[0]:]
             _, gen.depth, gen.indent, gen.pending = saved
@@ -766,6 +783,8 @@ def _resolve_ops(unit: Unit, spec: InsnSpec, insn: ir.Insn, resolver: Resolver,
         except ResolveError as e:
             unit.diag.error(f"{insn.mnemonic} operand {i + 1}: {e}", where)
             ok = False
+        except PlcError:
+            raise
         except Exception as e:  # noqa: BLE001 - a plcrt bug is reported at its operand
             unit.diag.error(plcrt_bug(f"{insn.mnemonic} operand {i + 1}", e), where,
                             "plcrt-bug")

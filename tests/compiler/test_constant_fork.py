@@ -96,3 +96,18 @@ def test_a_string_constant_program_is_served(backend: str) -> None:
         assert bytes(twin.read(f"VB{100 + i}") for i in range(7)) == b"\x06Pump 1"
     plc.restore(power_up)
     assert plc["VB100"] == 0
+
+
+def test_an_immutable_binding_is_a_constant_whoever_binds_it() -> None:
+    """The compiler takes bytes and tuples of numbers for constants even
+    when an emitter binds them as objects (so a fork never meets them as
+    state), and never a tuple holding a buffer."""
+    from plcrt.compiler.codegen import Unit
+    from plcrt.errors import DiagnosticSink
+    from plcrt.lang import ir
+    from plcrt.memory.cpu import cpu_model
+
+    unit = Unit(ir.Program((), "<test>"), cpu_model(None), None, {}, DiagnosticSink())
+    table, text, state = (1, 2, (3, b"x")), b"\x06Pump 1", (bytearray(2), 0)
+    names = [unit.bind(table), unit.bind(text), unit.bind(state), unit.bind(bytearray(1))]
+    assert unit.constants == set(names[:2])

@@ -34,7 +34,8 @@ from pathlib import Path
 import pytest
 
 import plcrt
-from plcrt.isa.registry import REGISTRY, Role, load_families
+from plcrt.isa.registry import REGISTRY, load_families
+from test_operand_kinds import TYPICAL  # an operand that fits each role
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus"
@@ -81,17 +82,6 @@ LABELS = ["0", "1", "255", "256", "-1"]
 GENERAL = (BITS + BYTES + WORDS + DWORDS + INTS + REALS + CHARS + STRINGS + POINTERS
            + INDIRECT + ODD)
 
-#: an operand that fits each role, for instructions built from their signature
-TYPICAL = {
-    Role.BIT_R: "V0.0", Role.BIT_W: "M0.0", Role.BIT_TC: "M0.1", Role.IBIT: "I0.0",
-    Role.QBIT: "Q0.0", Role.B_R: "VB0", Role.W_R: "VW2", Role.D_R: "VD4",
-    Role.R_R: "VD8", Role.B_W: "VB12", Role.W_W: "VW14", Role.D_W: "VD16",
-    Role.R_W: "VD20", Role.D_PTR: "&VB100", Role.B_IB: "IB0", Role.B_QB: "QB0",
-    Role.B_M: "VB24", Role.W_M: "VW26", Role.D_M: "VD28", Role.B_MW: "VB40",
-    Role.W_MW: "VW42", Role.D_MW: "VD44", Role.N: "4", Role.TIMER: "T37", Role.COUNTER: "C1", Role.LABEL: "1",
-    Role.SBIT: "S0.1", Role.STR_R: '"AB"', Role.STR_M: "VB200", Role.STR_W: "VB300",
-    Role.NONE: "",
-}
 #: operands of the instructions that take theirs as written
 VARIADIC = {
     "ATCH": ["INT0", "10"], "DTCH": ["10"], "CEVNT": ["10"], "PLS": ["0"],

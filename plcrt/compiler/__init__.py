@@ -9,11 +9,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..errors import DiagnosticSink, PlcCompileError
+from ..errors import DiagnosticSink, PlcCompileError, PlcError
 from ..lang import ir
 from ..lang.limits import MAX_INSTRUCTIONS, MAX_NETWORKS
 from ..memory.cpu import CpuModel
-from .codegen import Compiled, Unit, build_unit, generate
+from .codegen import Compiled, Unit, build_unit, generate, plcrt_bug
 
 
 def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None,
@@ -48,7 +48,19 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
         unit.native = NativePlan()
     if setup is not None:
         setup(unit)
-    source, line_locs = generate(unit)
+    try:
+        source, line_locs = generate(unit)
+    except PlcError:
+        raise
+    except Exception as e:  # noqa: BLE001 - a plcrt bug outside one instruction
+        # (an instruction's own is reported at it by emit_piece): at the
+        # network being compiled, with everything found before it
+        piece = unit.current_piece
+        loc = None if piece is None else \
+            piece.network.loc.within(piece.pou.ident, piece.network.number)
+        diag.error(plcrt_bug("this network", e), loc, "plcrt-bug")
+        diag.raise_if_errors(PlcCompileError)
+        raise   # unreachable: the error above is raised
     diag.raise_if_errors(PlcCompileError)
     return unit, source, line_locs
 

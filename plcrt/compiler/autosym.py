@@ -62,6 +62,7 @@ _KIND: dict[Role, str | int] = {
     Role.B_R: 1, Role.B_W: 1,
     Role.W_R: 2, Role.W_W: 2,
     Role.D_R: 4, Role.D_W: 4, Role.R_R: 4, Role.R_W: 4, Role.D_PTR: 4,
+    Role.B_M: 1, Role.B_MW: 1, Role.W_M: 2, Role.W_MW: 2, Role.D_M: 4, Role.D_MW: 4,
 }
 _KIND_NAME: dict[str | int, str] = {"bit": "a bit", "I": "an input bit (immediate)",
                                     "Q": "an output bit (immediate)", 1: "a byte",

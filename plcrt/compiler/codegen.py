@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from ..errors import Diagnostic, DiagnosticSink, SourceLoc
+from ..errors import Diagnostic, DiagnosticSink, PlcError, SourceLoc
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
@@ -98,6 +98,10 @@ class Unit:
         self.system_symbols = system_symbols
         self.diag = diag
         self.bindings: dict[str, Any] = {}
+        #: names of the bindings that are constants (lookup tables, string
+        #: constants): shared by every PLC built from this unit, never
+        #: copied by a fork (only state is)
+        self.constants: set[str] = set()
         self._ids: dict[int, str] = {}
         self._counter = 0
         self.locs = LocTable()                #: instruction id -> location
@@ -132,18 +136,37 @@ class Unit:
         self._counter += 1
         return f"_{hint}{self._counter}"
 
-    def bind(self, obj: object, hint: str = "o") -> str:
+    def bind(self, obj: object, hint: str = "o", constant: bool = False) -> str:
+        """The generated name of run-time object ``obj`` (one name per
+        object); ``constant``: the generated code only reads it.  An
+        immutable value (bytes, a tuple of numbers ...) is a constant
+        whoever binds it."""
         key = id(obj)
         name = self._ids.get(key)
         if name is None:
             name = self.fresh(hint)
             self._ids[key] = name
             self.bindings[name] = obj
+        if constant or _immutable(obj):
+            self.constants.add(name)
         return name
 
     def callee(self, name: str) -> PouInfo | None:
         key = name.strip().upper()
         return self.pous.get(key) or self.by_name.get(key)
+
+
+_IMMUTABLE = (bytes, str, int, float, complex, bool, type(None), range)
+
+
+def _immutable(obj: object, depth: int = 0) -> bool:
+    """``obj`` can never change: an immutable scalar, or a tuple or
+    frozenset of such (a few levels deep)."""
+    if isinstance(obj, _IMMUTABLE):
+        return True
+    if isinstance(obj, (tuple, frozenset)) and depth < 4:
+        return all(_immutable(x, depth + 1) for x in obj)
+    return False
 
 
 def _pou_fname(p: ir.Pou) -> str:
@@ -722,10 +745,14 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
                 piece.resolved.append((insn.mnemonic, ops, site))
             if unit.probes is not None:
                 power.step(insn.mnemonic, ops, gen.depth)
-        except (CodegenError, ResolveError) as e:
+        except PlcError:
+            raise   # a problem outside the program (a library description file)
+        except Exception as e:  # noqa: BLE001 - a plcrt bug is reported at its instruction
             del gen.lines[saved[0]:]
             _, gen.depth, gen.indent, gen.pending = saved
-            if not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):
+            if not isinstance(e, (CodegenError, ResolveError)):
+                unit.diag.error(plcrt_bug(insn.mnemonic, e), loc, "plcrt-bug")
+            elif not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):
                 unit.diag.error(f"{insn.mnemonic}: {e}", getattr(e, "loc", None) or loc)
             broken = True
             _assume_stack_effect(gen, insn.mnemonic)
@@ -759,13 +786,29 @@ def _resolve_ops(unit: Unit, spec: InsnSpec, insn: ir.Insn, resolver: Resolver,
     ops: list[Any] = []
     ok = True
     for i, (operand, role) in enumerate(zip(fixed, roles)):
+        where = operand.loc.within(loc.block, loc.network) if operand.loc.block is None \
+            else operand.loc
         try:
             ops.append(resolver.resolve(operand, role))
         except ResolveError as e:
-            unit.diag.error(f"{insn.mnemonic} operand {i + 1}: {e}", operand.loc.within(
-                loc.block, loc.network) if operand.loc.block is None else operand.loc)
+            unit.diag.error(f"{insn.mnemonic} operand {i + 1}: {e}", where)
+            ok = False
+        except PlcError:
+            raise
+        except Exception as e:  # noqa: BLE001 - a plcrt bug is reported at its operand
+            unit.diag.error(plcrt_bug(f"{insn.mnemonic} operand {i + 1}", e), where,
+                            "plcrt-bug")
             ok = False
     return ops if ok else None
+
+
+def plcrt_bug(what: str, exc: BaseException) -> str:
+    """The message of an error that is plcrt's, not the program's, at the
+    instruction (or operand) *what* that met it: every problem in a program
+    is one the checks name, so anything else is a bug to report."""
+    return (f"{what}: plcrt cannot compile this ({type(exc).__name__}: "
+            f"{excerpt(str(exc))}); this is a bug in plcrt, please report it with the "
+            f"program")
 
 
 def build_unit(program: ir.Program, model: CpuModel, symbols: Any,

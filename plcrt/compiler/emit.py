@@ -140,6 +140,14 @@ class Gen:
         self.used.add(name)
         return name
 
+    def const(self, obj: object, hint: str = "k") -> str:
+        """Bind a constant (a lookup table, a string constant's bytes) that
+        the generated code only reads: every PLC of the program shares it
+        and a fork does not copy it."""
+        name = self.unit.bind(obj, hint, constant=True)
+        self.used.add(name)
+        return name
+
     def tmp(self, hint: str = "t") -> str:
         """A fresh local variable name."""
         return self.unit.fresh(hint)

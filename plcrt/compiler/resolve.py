@@ -9,6 +9,7 @@ Problems become messages that name the operand and what was expected.
 
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 from typing import Any, Mapping
 
@@ -180,11 +181,43 @@ class Resolver:
         return done
 
 
-_READ_BYTE_AREAS = ("I", "Q", "M", "V", "SM", "S", "L")
-_VALUE_WIDTH = {Role.B_R: 1, Role.B_W: 1, Role.W_R: 2, Role.W_W: 2, Role.D_R: 4,
-                Role.D_W: 4, Role.R_R: 4, Role.R_W: 4, Role.D_PTR: 4,
-                Role.B_IB: 1, Role.B_QB: 1}
-_WRITE_ROLES = (Role.B_W, Role.W_W, Role.D_W, Role.R_W, Role.B_QB)
+@dataclass(frozen=True, slots=True)
+class _Value:
+    """What a value role takes: one row of :data:`_VALUES`."""
+
+    width: int                 #: bytes
+    write: bool = False        #: the instruction writes it
+    constant: bool = True      #: a constant may stand here
+    real_constant: bool = False  #: a REAL constant may stand here
+    real: bool = False         #: the value is a REAL (int constants become reals)
+    pointer: bool = False      #: an address ``&VB100`` may stand here
+    indirect: bool = True      #: ``*VD``, ``*LD``, ``*AC``
+    registers: bool = True     #: AC and HC (not memory: no run of bytes follows)
+    area: str = ""             #: only this area (``I`` for BIR, ``Q`` for BIW)
+
+
+def _out(width: int) -> _Value:
+    return _Value(width, write=True, constant=False)
+
+
+#: value roles and what each takes (the bit, string, count, label, timer and
+#: counter roles are checked by their own functions below)
+_VALUES: dict[Role, _Value] = {
+    Role.B_R: _Value(1), Role.W_R: _Value(2), Role.D_R: _Value(4, real_constant=True),
+    Role.R_R: _Value(4, real_constant=True, real=True),
+    Role.B_W: _out(1), Role.W_W: _out(2), Role.D_W: _out(4),
+    Role.R_W: _Value(4, write=True, constant=False, real=True),
+    Role.D_PTR: _Value(4, pointer=True),
+    Role.B_IB: _Value(1, constant=False, indirect=False, registers=False, area="I"),
+    Role.B_QB: _Value(1, write=True, constant=False, indirect=False, registers=False,
+                      area="Q"),
+    Role.B_M: _Value(1, constant=False, registers=False),
+    Role.W_M: _Value(2, constant=False, registers=False),
+    Role.D_M: _Value(4, constant=False, registers=False),
+    Role.B_MW: _Value(1, write=True, constant=False, registers=False),
+    Role.W_MW: _Value(2, write=True, constant=False, registers=False),
+    Role.D_MW: _Value(4, write=True, constant=False, registers=False),
+}
 
 
 def _bad(text: str, role: Role, why: str = "") -> ResolveError:
@@ -194,7 +227,15 @@ def _bad(text: str, role: Role, why: str = "") -> ResolveError:
 
 def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved:
     """Check one resolved operand against a role; returns the operand with
-    its width fixed for context-sized areas (T, C, AC)."""
+    its width fixed for context-sized areas (T, C, AC) and a character
+    constant as the number it stands for.  Every role of the registry is
+    checked here, so an emitter only ever sees the operand kinds its
+    signature names.
+
+    Raises:
+        ResolveError: the operand is of a kind the role does not take, or
+            a constant out of its range; the message says what was expected.
+    """
     if isinstance(op, Name):
         if role in (Role.LABEL,):
             raise _bad(text, role)
@@ -203,7 +244,7 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
     if role is Role.LABEL:
         if isinstance(op, Const) and isinstance(op.value, int) and 0 <= op.value <= 255:
             return op
-        raise _bad(text, role)
+        raise _bad(text, role, "0..255")
     if role is Role.N:
         if isinstance(op, Const) and isinstance(op.value, int) and 1 <= op.value <= 255:
             return op
@@ -217,36 +258,45 @@ def check_role(op: Resolved, role: Role, text: str, model: CpuModel) -> Resolved
         return _check_bit(op, role, text, model)
     if role in (Role.STR_R, Role.STR_M, Role.STR_W):
         return _check_string(op, role, text)
-    width = _VALUE_WIDTH[role]
-    writing = role in _WRITE_ROLES
+    spec = _VALUES.get(role)
+    if spec is None:
+        raise _bad(text, role)
     if isinstance(op, Const):
-        if writing:
-            raise _bad(text, role, "a constant cannot be written")
-        return _check_const(op, role, text)
+        if not spec.constant:
+            raise _bad(text, role, "a constant cannot be written" if spec.write
+                       else "a constant has no address")
+        return _check_const(op, role, spec, text)
     if isinstance(op, Pointer):
-        if role is Role.D_PTR:
+        if spec.pointer:
             return op
         raise _bad(text, role, "an address '&...' is only valid as a double-word input")
     if isinstance(op, Indirect):
-        if role in (Role.B_IB, Role.B_QB):
-            raise _bad(text, role)
-        return op
-    assert isinstance(op, Addr)
+        if spec.indirect:
+            return op
+        raise _bad(text, role)
+    return _check_addr(op, role, spec, text, model)
+
+
+_REGISTERS = {"AC": "an accumulator", "HC": "a high-speed counter value"}
+
+
+def _check_addr(op: Addr, role: Role, spec: _Value, text: str, model: CpuModel) -> Addr:
+    width, writing = spec.width, spec.write
     if op.width == 0:
         raise _bad(text, role, "this is a bit")
+    if op.area in ("AC", "HC") and not spec.registers:
+        raise _bad(text, role, f"{_REGISTERS[op.area]} is a register, not memory")
     if op.area == "AC":
         return Addr("AC", op.offset, width, 0, op.text)
     if op.area in ("T", "C"):
-        if width != 2:
+        if width != 2 or spec.area:
             raise _bad(text, role, "timer and counter values are words")
         return Addr(op.area, op.offset, 2, 0, op.text)
     if op.area == "HC":
-        if writing or width != 4 or role is Role.R_R:
+        if writing or width != 4 or spec.real:
             raise _bad(text, role, "HC is a read-only double word")
         return op
-    if role is Role.B_IB and op.area != "I":
-        raise _bad(text, role)
-    if role is Role.B_QB and op.area != "Q":
+    if spec.area and op.area != spec.area:
         raise _bad(text, role)
     if op.width != width:
         raise _bad(text, role, f"this is a {('byte', 'word', '', 'double word')[op.width - 1]}")
@@ -301,21 +351,43 @@ def _check_string(op: Resolved, role: Role, text: str) -> Resolved:
 
 _CONST_RANGE = {1: (-128, 255), 2: (-32768, 65535), 4: (-2**31, 2**32 - 1)}
 
+#: the largest REAL (IEEE single precision): a constant beyond it has no REAL
+REAL_MAX = 3.4028234663852886e38
 
-def _check_const(op: Const, role: Role, text: str) -> Const:
-    width = _VALUE_WIDTH[role]
+
+def _single(value: float) -> bool:
+    """Whether ``value`` rounds to a finite IEEE single (a REAL)."""
+    try:
+        struct.pack(">f", value)
+    except (OverflowError, struct.error):
+        return False
+    return True
+
+
+def _check_const(op: Const, role: Role, spec: _Value, text: str) -> Const:
+    """A constant in a value role: strings refused, a character constant
+    turned into the number it stands for (its characters as bytes, from the
+    most significant, as ``'AB'`` is the word 16#4142), a REAL checked
+    against the REAL range, an integer against the width."""
+    width = spec.width
     if isinstance(op.value, bytes):
         if op.is_string:
             raise _bad(text, role, "a string constant is only valid where a string is")
+        if spec.real:
+            raise _bad(text, role, "a character constant is not a REAL")
         if len(op.value) > width or not op.value:
-            raise _bad(text, role, "literal too long")
-        return op
+            raise _bad(text, role, f"a character constant of 1 to {width} characters")
+        return Const(int.from_bytes(op.value.ljust(width, b"\0"), "big"), op.text)
     if isinstance(op.value, float):
-        if role in (Role.R_R, Role.D_R):
-            return op
-        raise _bad(text, role, "a real constant needs a real operand")
+        if not spec.real_constant:
+            raise _bad(text, role, "a real constant needs a real operand")
+        if not _single(op.value):
+            raise _bad(text, role, f"outside the REAL range, ±{REAL_MAX:.7G}")
+        return op
     lo, hi = _CONST_RANGE[width]
-    if role is Role.R_R:
+    if spec.real:
+        if abs(op.value) > REAL_MAX:
+            raise _bad(text, role, f"outside the REAL range, ±{REAL_MAX:.7G}")
         return Const(float(op.value), op.text, is_real=True)
     if not lo <= op.value <= hi:
         raise _bad(text, role, f"constant out of range {lo}..{hi}")

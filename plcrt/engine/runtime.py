@@ -369,7 +369,10 @@ class Plc(AddressAccess):
             where = ".".join(str(step) for _, step in missing[0])
             raise PlcRuntimeError(f"internal error: the compiled program refers to "
                                   f"plc.{where}, which this PLC does not have")
-        self._bindings = {name: rebind(obj, memo) for name, obj in entry.unit.bindings.items()}
+        # constants (tables, string constants) are shared, state is this PLC's
+        constants = entry.unit.constants
+        self._bindings = {name: obj if name in constants else rebind(obj, memo)
+                          for name, obj in entry.unit.bindings.items()}
         rebind_per_cpu(template, self, memo)
         self._entry = entry
         self.unit, self.line_locs = entry.unit, entry.line_locs
@@ -1017,9 +1020,10 @@ class Plc(AddressAccess):
                                         *zip(self.ports, dst.ports),
                                         (self.ethernet, dst.ethernet)]
         pairs += list(zip(self.devices, dst.devices))
+        constants = self.unit.constants   # shared, read-only: nothing to copy
         for name, obj, other in (_binding_pairs(self, dst) if across else
                                  ((n, o, dst._bindings.get(n))
-                                  for n, o in self._bindings.items())):
+                                  for n, o in self._bindings.items() if n not in constants)):
             if other is None or type(other) is not type(obj):
                 raise PlcConfigError("internal error: the twin was compiled differently")
             if isinstance(obj, bytearray):
@@ -1095,7 +1099,8 @@ def _binding_pairs(src: Plc, dst: Plc) -> list[tuple[str, Any, Any]]:
         kinds: dict[str, list[tuple[int, str, Any]]] = {}
         for name, obj in plc._bindings.items():
             if isinstance(obj, (types.FunctionType, types.MethodType,
-                                types.BuiltinFunctionType)) or any(obj is b for b in own):
+                                types.BuiltinFunctionType)) or any(obj is b for b in own) \
+                    or name in plc.unit.constants:
                 continue
             kind = name.rstrip("0123456789")
             kinds.setdefault(kind, []).append((int(name[len(kind):] or 0), name, obj))

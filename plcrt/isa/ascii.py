@@ -171,7 +171,7 @@ def _make_number(mn: str) -> None:
         with g.box():
             g.eno(f"{fn}({g.rd(value, kind)}, {where}, {g.rd(fmt, 'B')}, {g.insn_id})")
 
-    insn(mn, role, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary,
+    insn(mn, role, Role.B_MW, Role.B_R, family=F, may_fail=True, summary=summary,
          spans=(Span(1, 8, OUT_CHARS[mn]),))(emit)
 
 
@@ -184,7 +184,7 @@ def _make_hex(mn: str, summary: str) -> None:
             g.eno(f"{fn}({a}, {b}, {g.rd(n, 'B')}, {g.insn_id})")
 
     unit_in, unit_out = HEX_UNITS[mn]
-    insn(mn, Role.B_R, Role.B_W, Role.B_R, family=F, may_fail=True, summary=summary,
+    insn(mn, Role.B_M, Role.B_MW, Role.B_R, family=F, may_fail=True, summary=summary,
          spans=(Span(0, unit_in, 255, by=2), Span(1, unit_out, 255, by=2)))(emit)
 
 

@@ -57,7 +57,8 @@ def _make(mn: str) -> None:
                 fn = g.bind(getattr(plc.clock, method), mn.lower())
                 g.line(f"{fn}(*{where})")
 
-    insn(mn, Role.B_W, family=F, summary=summary, may_fail=sets,
+    # TODW reads its buffer, TODR writes it
+    insn(mn, Role.B_M if sets else Role.B_MW, family=F, summary=summary, may_fail=sets,
          spans=(Span(0, 8, nbytes),))(emit)
 
 

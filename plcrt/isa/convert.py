@@ -155,7 +155,7 @@ def _bcd_error(g: Gen, ok: str, write: Callable[[], None]) -> None:
 @insn("BCDI", Role.W_W, family=F, may_fail=True,
       summary="OUT := INT of the BCD word OUT")
 def _bcdi(g: Gen, out) -> None:
-    table = g.bind(BCD_TO_INT, "bcd2i")
+    table = g.const(BCD_TO_INT, "bcd2i")
     with g.box():
         r = g.tmp("r")
         g.line(f"{r} = {table}.get({g.rd(out, 'WU')})")
@@ -165,7 +165,7 @@ def _bcdi(g: Gen, out) -> None:
 @insn("IBCD", Role.W_W, family=F, may_fail=True,
       summary="OUT := BCD word of the INT OUT (0..9999)")
 def _ibcd(g: Gen, out) -> None:
-    table = g.bind(INT_TO_BCD, "i2bcd")
+    table = g.const(INT_TO_BCD, "i2bcd")
     with g.box():
         v = g.tmp("v")
         g.line(f"{v} = {g.rd(out, 'W')}")
@@ -187,7 +187,7 @@ SEGMENTS: bytes = bytes((0x3F, 0x06, 0x5B, 0x4F, 0x66, 0x6D, 0x7D, 0x07,
 @insn("ENCO", Role.W_R, Role.B_W, family=F,
       summary="OUT := number of the lowest set bit of IN")
 def _enco(g: Gen, a, out) -> None:
-    table = g.bind(LOWEST_BIT, "enco")
+    table = g.const(LOWEST_BIT, "enco")
     with g.box():
         # The manual puts the bit number "into the least significant nibble"
         # of OUT; plcrt stores it as the whole byte (high nibble 0), the
@@ -205,6 +205,6 @@ def _deco(g: Gen, a, out) -> None:
 @insn("SEG", Role.B_R, Role.B_W, family=F,
       summary="OUT := 7-segment pattern of the low nibble of IN")
 def _seg(g: Gen, a, out) -> None:
-    table = g.bind(SEGMENTS, "seg")
+    table = g.const(SEGMENTS, "seg")
     with g.box():
         g.wr(out, "B", f"{table}[{g.rd(a, 'B')} & 15]")

@@ -109,19 +109,19 @@ def _fill_words(value: int, dst, count: int, insn: int, locs) -> None:
     db[do:do + 2 * count] = bytes((value >> 8 & 255, value & 255)) * count
 
 
-@insn("BMB", Role.B_R, Role.B_W, Role.B_R, family=F, summary="move N bytes",
+@insn("BMB", Role.B_M, Role.B_MW, Role.B_R, family=F, summary="move N bytes",
       spans=(Span(0, 8, 255, by=2), Span(1, 8, 255, by=2)))
 def _bmb(g: Gen, src, dst, n) -> None:
     _block(g, src, dst, n, "B", 1)
 
 
-@insn("BMW", Role.W_R, Role.W_W, Role.B_R, family=F, summary="move N words",
+@insn("BMW", Role.W_M, Role.W_MW, Role.B_R, family=F, summary="move N words",
       spans=(Span(0, 16, 255, by=2), Span(1, 16, 255, by=2)))
 def _bmw(g: Gen, src, dst, n) -> None:
     _block(g, src, dst, n, "WU", 2)
 
 
-@insn("BMD", Role.D_R, Role.D_W, Role.B_R, family=F, summary="move N double words",
+@insn("BMD", Role.D_M, Role.D_MW, Role.B_R, family=F, summary="move N double words",
       spans=(Span(0, 32, 255, by=2), Span(1, 32, 255, by=2)))
 def _bmd(g: Gen, src, dst, n) -> None:
     _block(g, src, dst, n, "DU", 4)
@@ -135,7 +135,7 @@ def _swap(g: Gen, op) -> None:
         g.wr(op, "W", f"({v} >> 8) | (({v} & 255) << 8)")
 
 
-@insn("FILL", Role.W_R, Role.W_W, Role.B_R, family=F, summary="write IN to N words from OUT",
+@insn("FILL", Role.W_R, Role.W_MW, Role.B_R, family=F, summary="write IN to N words from OUT",
       spans=(Span(1, 16, 255, by=2),))
 def _fill(g: Gen, src, dst, n) -> None:
     with g.box():

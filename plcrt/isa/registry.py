@@ -38,6 +38,15 @@ class Role(enum.Enum):
     D_W = "writable double word"
     R_W = "writable real"
     D_PTR = "double word or &address"  #: MOVD IN
+    #: the start of a run of values in memory (block moves, tables, ASCII
+    #: fields, the clock buffer): an address or a pointer, never a
+    #: constant or an accumulator
+    B_M = "byte in memory (an address or *pointer)"
+    W_M = "word in memory (an address or *pointer)"
+    D_M = "double word in memory (an address or *pointer)"
+    B_MW = "writable byte in memory (an address or *pointer)"
+    W_MW = "writable word in memory (an address or *pointer)"
+    D_MW = "writable double word in memory (an address or *pointer)"
     B_IB = "input byte (IB)"           #: BIR IN
     B_QB = "output byte (QB)"          #: BIW OUT
     N = "constant count"             #: 1..255 (S/R ranges, BMx, FILL, shifts)

@@ -274,7 +274,7 @@ def _ref(g: Gen, op: Any) -> str:
     """Source of the (buffer, offset) of a resolved string operand."""
     if isinstance(op, Const):
         # the validated bytes (length byte + characters), bound as an object
-        return g.bind((bytes(op.value), 0), "str")
+        return g.const((bytes(op.value), 0), "str")
     if isinstance(op, Indirect):
         pbuf, poff = g._place(op.ptr, 4)
         return f"{g.use('_ptr')}({pbuf}, {poff}, 1, {g.insn_id})"
@@ -436,7 +436,7 @@ def _constant_compare(g: Gen, mem: Any, const: Any) -> tuple[str, str] | None:
     v = g.use("V")
     with g.block(f"if {v}[{mem.offset}] > {MAX_STRING}:"):
         g.line(f"{g.bind(string_too_long, 'strlong')}({g.insn_id}, {g.use('_LOCS')})")
-    data = g.bind(bytes(const.value), "str")
+    data = g.const(bytes(const.value), "str")
     return f"{v}[{mem.offset}:{mem.offset + len(const.value)}]", data
 
 

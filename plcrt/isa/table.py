@@ -144,7 +144,7 @@ def _helper(g: Gen, mn: str) -> str:
                   .replace("<", "lt").replace(">", "gt"))
 
 
-@insn("ATT", Role.W_R, Role.W_W, family=F, may_fail=True,
+@insn("ATT", Role.W_R, Role.W_MW, family=F, may_fail=True,
       summary="append DATA to the table TBL (SM1.4 when full)", spans=(Span(1, 8, TABLE_BYTES),))
 def _att(g: Gen, data, tbl) -> None:
     fn = _helper(g, "ATT")
@@ -167,7 +167,7 @@ def _make_take(mn: str) -> None:
                 g.line("eno = 0")
 
     which = "first (oldest)" if mn == "FIFO" else "last (newest)"
-    insn(mn, Role.W_W, Role.W_W, family=F, may_fail=True,
+    insn(mn, Role.W_MW, Role.W_W, family=F, may_fail=True,
          summary=f"DATA := the {which} entry of TBL, removed (SM1.5 when empty)",
          spans=(Span(0, 8, TABLE_BYTES),))(emit)
 
@@ -186,7 +186,7 @@ def _make_find(mn: str) -> None:
             with g.block("else:"):
                 g.line("eno = 0")
 
-    insn(mn, Role.W_R, Role.W_R, Role.W_W, family=F, may_fail=True,
+    insn(mn, Role.W_M, Role.W_R, Role.W_W, family=F, may_fail=True,
          summary=f"INDX := first entry from INDX with entry {mn[3:]} PATRN, else EC",
          spans=(Span(0, 8, TABLE_BYTES),))(emit)
 

@@ -137,7 +137,7 @@ def test_table_past_area_end_is_error_0091():
 
 def test_table_in_accumulator_is_refused():
     """A table is memory: an accumulator cannot hold one (compile error)."""
-    with pytest.raises(PlcCompileError, match="memory address or a pointer"):
+    with pytest.raises(PlcCompileError, match="in memory .an address or .pointer.*not memory"):
         load_ob1("LD SM0.0\nATT +1, AC0")
 
 

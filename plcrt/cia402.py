@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from .devices.cia402.od import Entry, ObjectDictionary
 from .errors import PlcConfigError
+from .safetext import printable
 
 if TYPE_CHECKING:  # pragma: no cover
     import canopen.objectdictionary
@@ -56,6 +57,10 @@ def object_dictionary(model: str = "hcfa-am0520b", node_id: int | None = None
     from canopen.objectdictionary import ObjectDictionary as CoOD
     from canopen.objectdictionary import ODRecord
 
+    if node_id is not None and (isinstance(node_id, bool) or not isinstance(node_id, int)
+                                or not 1 <= node_id <= 127):
+        raise PlcConfigError("object_dictionary: node_id is a CANopen node id (1..127, "
+                             "CiA 301 §7.5.2.4) or None")
     data = ObjectDictionary.load(model)
     od = CoOD()
     info = od.device_information
@@ -104,8 +109,9 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
     """
     from .devices.cia402.canopen_node import CanopenDrive
 
-    if model not in models():
-        raise PlcConfigError(f"cia402.attach: unknown drive model {model!r}; models: "
+    if not isinstance(model, str) or model not in models():
+        raise PlcConfigError(f"cia402.attach: unknown drive model "
+                             f"{printable(model)[:40] if isinstance(model, str) else type(model).__name__!r}; models: "
                              + ", ".join(models()))
     return CanopenDrive(network, node_id, model, plant, clock=clock)
 

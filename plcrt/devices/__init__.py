@@ -27,8 +27,11 @@ class _StateMapping(Mapping[str, Any]):
         return asdict(self)  # type: ignore[call-overload]
 
     def __getitem__(self, key: str) -> Any:
-        if key not in self.KEYS:
-            raise KeyError(key)
+        if not isinstance(key, str) or key not in self.KEYS:
+            from ..engine.values import shown_value
+            from ..errors import PlcKeyError
+            raise PlcKeyError(f"{type(self).__name__} has no field {shown_value(key)}; "
+                              f"the fields are {', '.join(self.KEYS)}")
         return getattr(self, key)
 
     def __iter__(self) -> Iterator[str]:

@@ -29,7 +29,7 @@ from typing import Any, Optional
 
 from ..errors import PlcConfigError
 from .serial import MIN_CHAR_US
-from .values import Duration, duration_us, step_count
+from .values import Duration, duration_us, shown_value, step_count
 
 __all__ = ["Network", "link"]
 
@@ -106,7 +106,7 @@ class Network:
                 or not 0 <= number < len(plc.ports):
             raise PlcConfigError(f"the {plc.model.name} has port(s) "
                                  f"{', '.join(str(p.number) for p in plc.ports)}, got "
-                                 f"{number!r:.20}")
+                                 f"{shown_value(number)}")
         return plc.ports[number]
 
     def ethernet_of(self, ip: bytes) -> Optional[Any]:

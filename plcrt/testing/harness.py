@@ -88,10 +88,10 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
         return (lambda: bool(cond())), name        # type: ignore[call-arg]
     if not isinstance(cond, str):
         raise PlcConfigError(f"a condition is a string such as 'Q0.0' or 'VW100 >= 25', or a "
-                             f"function; got {type(cond).__name__} {cond!r}")
+                             f"function; got {type(cond).__name__} {shown_value(cond)}")
     m = _COND_RE.match(cond)
     if m is None:
-        raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
+        raise PlcConfigError(f"cannot read the condition {shown_value(cond)}: write 'ADDR', 'not ADDR' "
                              f"or 'ADDR <op> value' with op one of == != < <= > >=")
     neg, addr, op, value = m.groups()
     rd = reader(h.plc, addr)
@@ -100,7 +100,8 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
     try:
         v = parse_number(value)
     except PlcConfigError:
-        raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
+        raise PlcConfigError(f"condition {shown_value(cond)}: {shown_value(value)} is not a "
+                             f"number") from None
     fn = _OPS[op]
     if neg:
         return (lambda: not fn(rd(), v)), str(cond).strip()
@@ -272,6 +273,7 @@ class Harness:
         that took.  Fails with :class:`PlcTimeout` when ``timeout`` (simulated)
         passes first, or the CPU goes to STOP."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        _check_message(message)
         pred, what = condition(self, cond)
         t0 = self.plc.now_us
         limit = self._scans_for(timeout, "timeout")
@@ -296,6 +298,7 @@ class Harness:
     def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
         """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        _check_message(message)
         pred, what = condition(self, cond)
         plc = self.plc
         for _ in range(self._scans_for(duration, "duration")):
@@ -501,6 +504,7 @@ class Harness:
                          timeout: Duration = 1.0) -> float:
         """Run until the axis moves; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        self.axis(slot, axis)   # a bad axis is reported before any message is made
         return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not start")
 
@@ -508,6 +512,7 @@ class Harness:
                           timeout: Duration = 60.0) -> float:
         """Run until the axis stands still; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        self.axis(slot, axis)   # a bad axis is reported before any message is made
         return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not stop")
 
@@ -659,6 +664,12 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
                                codepage=string_codepage(encoding or ""))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                instrument=instrument, clock=clock, backend=backend)
+
+
+def _check_message(message: Any) -> None:
+    if not isinstance(message, str):
+        raise PlcConfigError(f"message= is the text a failure starts with, a str; got "
+                             f"{type(message).__name__}")
 
 
 def _mapping(values: Any, method: str) -> Mapping[str, Any]:

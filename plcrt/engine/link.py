@@ -136,7 +136,7 @@ class Network:
         # (a character: at least 79 µs; Ethernet: the latency), so that what
         # a CPU sends at the window's start arrives after its end
         window = min([MIN_CHAR_US] + [p.ethernet.latency_us - 1 for p in self.plcs])
-        step_count(span, window, seconds, "seconds", "window")
+        step_count(span, window, seconds, "seconds", "synchronisation window")
         end = self.time_us + span
         t = self.time_us
         while t < end:

@@ -306,7 +306,8 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
     history = kwargs.get("history")
     if history is not None and (isinstance(history, bool) or not isinstance(history, int)
                                 or history < 1):
-        raise PlcUsageError(f"history= must be a whole number of scans >= 1, got {_shown(history)}")
+        raise PlcUsageError(f"history= must be a whole number of scans >= 1, got "
+                            f"{_shown(history)}")
     spec.history = history
     max_time = kwargs.get("max_time")
     if max_time is not None:

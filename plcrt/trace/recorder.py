@@ -80,7 +80,7 @@ def parse_signal(plc: Any, text: str) -> Signal:
         PlcAddressError: an address, symbol or axis that does not exist.
     """
     if not isinstance(text, str) or not text.strip():
-        raise PlcConfigError(f"trace signal {text!r}: give an address, a symbol or "
+        raise PlcConfigError(f"trace signal {shown_value(text)}: give an address, a symbol or "
                              f"axis<slot>.<axis>.<quantity>")
     name = text.strip()
     if _AXIS_PREFIX_RE.match(name):

@@ -504,7 +504,8 @@ class Harness:
                          timeout: Duration = 1.0) -> float:
         """Run until the axis moves; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        self.axis(slot, axis)   # a bad axis is reported before any message is made
+        seconds(timeout)        # a bad timeout, then a bad axis, before any message
+        self.axis(slot, axis)
         return self.run_until(lambda: self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not start")
 
@@ -512,7 +513,8 @@ class Harness:
                           timeout: Duration = 60.0) -> float:
         """Run until the axis stands still; seconds it took."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
-        self.axis(slot, axis)   # a bad axis is reported before any message is made
+        seconds(timeout)        # a bad timeout, then a bad axis, before any message
+        self.axis(slot, axis)
         return self.run_until(lambda: not self.axis(slot, axis).moving, timeout=timeout,
                               message=f"axis {slot}.{axis} did not stop")
 

@@ -110,8 +110,8 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
     from .devices.cia402.canopen_node import CanopenDrive
 
     if not isinstance(model, str) or model not in models():
-        raise PlcConfigError(f"cia402.attach: unknown drive model "
-                             f"{printable(model)[:40] if isinstance(model, str) else type(model).__name__!r}; models: "
+        shown = printable(model)[:40] if isinstance(model, str) else type(model).__name__
+        raise PlcConfigError(f"cia402.attach: unknown drive model {shown!r}; models: "
                              + ", ".join(models()))
     return CanopenDrive(network, node_id, model, plant, clock=clock)
 

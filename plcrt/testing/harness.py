@@ -91,8 +91,8 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
                              f"function; got {type(cond).__name__} {shown_value(cond)}")
     m = _COND_RE.match(cond)
     if m is None:
-        raise PlcConfigError(f"cannot read the condition {shown_value(cond)}: write 'ADDR', 'not ADDR' "
-                             f"or 'ADDR <op> value' with op one of == != < <= > >=")
+        raise PlcConfigError(f"cannot read the condition {shown_value(cond)}: write 'ADDR', "
+                             f"'not ADDR' or 'ADDR <op> value' with op one of == != < <= > >=")
     neg, addr, op, value = m.groups()
     rd = reader(h.plc, addr)
     if op is None:

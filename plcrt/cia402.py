@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from .devices.cia402 import canopen_od
 from .devices.cia402.canopen_od import eds_text, models
 from .errors import PlcConfigError
+from .safetext import printable
 
 if TYPE_CHECKING:  # pragma: no cover
     import canopen.objectdictionary
@@ -45,6 +46,10 @@ def object_dictionary(model: str = "hcfa-am0520b", node_id: int | None = None
     Raises:
         PlcConfigError: unknown model or malformed data file.
     """
+    if node_id is not None and (isinstance(node_id, bool) or not isinstance(node_id, int)
+                                or not 1 <= node_id <= 127):
+        raise PlcConfigError("object_dictionary: node_id is a CANopen node id (1..127, "
+                             "CiA 301 §7.5.2.4) or None")
     od = canopen_od.object_dictionary(model)
     if node_id is not None:
         # perf: canopen_node imports canopen (about 0.2 s) when first needed
@@ -74,7 +79,8 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
     """
     from .devices.cia402.canopen_node import CanopenDrive   # perf: as in object_dictionary
 
-    if model not in models():
-        raise PlcConfigError(f"cia402.attach: unknown drive model {model!r}; models: "
+    if not isinstance(model, str) or model not in models():
+        shown = printable(model)[:40] if isinstance(model, str) else type(model).__name__
+        raise PlcConfigError(f"cia402.attach: unknown drive model {shown!r}; models: "
                              + ", ".join(models()))
     return CanopenDrive(network, node_id, model, plant, clock=clock)

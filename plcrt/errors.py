@@ -159,6 +159,15 @@ class PlcConfigError(PlcError, ValueError):
     """A bad option or configuration value."""
 
 
+class PlcKeyError(PlcAddressError, KeyError):
+    """A name that is not a key of one of plcrt's mappings (a trace's
+    signals, the fields of an axis or drive state); also a ``KeyError``, as
+    the mapping protocol asks."""
+
+    def __str__(self) -> str:
+        return PlcError.__str__(self)   # not KeyError's repr() of the message
+
+
 @dataclass
 class DiagnosticSink:
     """Collects diagnostics of one stage; ``raise_if_errors`` ends the stage."""

@@ -15,6 +15,8 @@ from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass, fields
 from typing import Any, ClassVar, Protocol
 
+from ..engine.values import shown_value
+from ..errors import PlcKeyError
 from .cia402.status import describe_statusword
 
 __all__ = ["AxisState", "Device", "DriveState"]
@@ -32,8 +34,9 @@ class _StateMapping(Mapping[str, Any]):
         return asdict(self)  # type: ignore[call-overload]
 
     def __getitem__(self, key: str) -> Any:
-        if key not in self.KEYS:
-            raise KeyError(key)
+        if not isinstance(key, str) or key not in self.KEYS:
+            raise PlcKeyError(f"{type(self).__name__} has no field {shown_value(key)}; "
+                              f"the fields are {', '.join(self.KEYS)}")
         return getattr(self, key)
 
     def __iter__(self) -> Iterator[str]:

@@ -29,7 +29,7 @@ from typing import Any, Optional
 
 from ..errors import PlcConfigError
 from .serial import MIN_CHAR_US
-from .values import Duration, duration_us, step_count
+from .values import Duration, duration_us, shown_value, step_count
 
 __all__ = ["Network", "link"]
 
@@ -106,7 +106,7 @@ class Network:
                 or not 0 <= number < len(plc.ports):
             raise PlcConfigError(f"the {plc.model.name} has port(s) "
                                  f"{', '.join(str(p.number) for p in plc.ports)}, got "
-                                 f"{number!r:.20}")
+                                 f"{shown_value(number)}")
         return plc.ports[number]
 
     def ethernet_of(self, ip: bytes) -> Optional[Any]:
@@ -136,7 +136,7 @@ class Network:
         # (a character: at least 79 µs; Ethernet: the latency), so that what
         # a CPU sends at the window's start arrives after its end
         window = min([MIN_CHAR_US] + [p.ethernet.latency_us - 1 for p in self.plcs])
-        step_count(span, window, seconds, "seconds", "window")
+        step_count(span, window, seconds, "seconds", "synchronisation window")
         end = self.time_us + span
         t = self.time_us
         while t < end:

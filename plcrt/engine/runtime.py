@@ -49,7 +49,8 @@ from .pulse import make_outputs
 from .ports import attach_devices, make_ports
 from .netjobs import make_ethernet, netr_netw
 from .values import (MAX_STEPS, Duration, check_backend, check_load_options,
-                     check_parsed_inputs, scan_number, scan_time_us, scan_total, source_items)
+                     check_parsed_inputs, scan_number, scan_time_us, scan_total, shown_value,
+                     source_items)
 
 if TYPE_CHECKING:
     from ..devices import AxisState, DriveState
@@ -76,12 +77,18 @@ class Plc(AddressAccess):
                  entry: str | None = None,
                  _entry: Any = None, _template: bool = False) -> None:
         scan_us = scan_time_us(scan_ms)
-        if pace not in ("simulated", "realtime"):
-            raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
+        for name, flag in (("instrument", instrument), ("library", library),
+                           ("auto_symbols", auto_symbols)):
+            if not isinstance(flag, bool):
+                raise PlcConfigError(f"{name} must be True or False, got "
+                                     f"{type(flag).__name__}")
+        if not isinstance(pace, str) or pace not in ("simulated", "realtime"):
+            raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got "
+                                 f"{shown_value(pace)}")
         if isinstance(watchdog_ms, bool) or not (isinstance(watchdog_ms, (int, float))
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
-                                 f"got {watchdog_ms!r:.40}")
+                                 f"got {shown_value(watchdog_ms)}")
         backend = check_backend(backend)
         if backend == "native":
             from ..compiler.native.jit import available
@@ -854,7 +861,16 @@ class Plc(AddressAccess):
         return self._t_us
 
     def warn(self, message: str, loc: SourceLoc | None, key: str) -> None:
-        """A run-time diagnostic (reported once per ``key``)."""
+        """A run-time diagnostic (reported once per ``key``).
+
+        Raises:
+            PlcConfigError: ``message`` or ``key`` not a str, ``loc`` not a
+                :class:`~plcrt.errors.SourceLoc` or None.
+        """
+        if not (isinstance(message, str) and isinstance(key, str)
+                and (loc is None or isinstance(loc, SourceLoc))):
+            raise PlcConfigError("warn(message, loc, key) takes a str, a SourceLoc or None, "
+                                 "and a str")
         if key in self._warned:
             return
         self._warned.add(key)
@@ -863,6 +879,9 @@ class Plc(AddressAccess):
 
     def module(self, slot: int) -> Any:
         """The simulated module in expansion slot ``slot`` (EmNo), or None."""
+        if isinstance(slot, bool) or not isinstance(slot, int):
+            raise PlcConfigError(f"a module is named by its slot, an int, got "
+                                 f"{type(slot).__name__}")
         return self.modules.get(slot)
 
     def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
@@ -873,14 +892,15 @@ class Plc(AddressAccess):
         if isinstance(slot, bool) or not isinstance(slot, int) \
                 or isinstance(axis, bool) or not isinstance(axis, int):
             raise PlcAddressError(f"an axis is named by two ints, slot and axis, got "
-                                  f"{slot!r:.40}, {axis!r:.40}")
+                                  f"{shown_value(slot)}, {shown_value(axis)}")
         mod = self.modules.get(slot)
         if mod is None:
-            raise PlcAddressError(f"no module in slot {slot}")
+            raise PlcAddressError(f"no module in slot {shown_value(slot)}")
         for entry in mod.snapshot(self._t_us):
             if entry["axis"] == axis:
                 return entry
-        raise PlcAddressError(f"axis {axis} of slot {slot} is not configured in the plant")
+        raise PlcAddressError(f"axis {shown_value(axis)} of slot {slot} is not configured in "
+                              f"the plant")
 
     def axes(self) -> list[AxisState]:
         """State of every configured axis (see :meth:`axis`)."""
@@ -900,11 +920,12 @@ class Plc(AddressAccess):
         if isinstance(node, bool) or not isinstance(node, int) or \
                 (slot is not None and (isinstance(slot, bool) or not isinstance(slot, int))):
             raise PlcAddressError(f"a drive is named by its node address (int) and optionally "
-                                  f"its module's slot, got {node!r:.40}, {slot!r:.40}")
+                                  f"its module's slot, got {shown_value(node)}, "
+                                  f"{shown_value(slot)}")
         found = [d for d in self.drives() if d.node == node and slot in (None, d.slot)]
         if not found:
-            where = f" on the module in slot {slot}" if slot is not None else ""
-            raise PlcAddressError(f"no drive at node {node}{where} in the plant")
+            where = f" on the module in slot {shown_value(slot)}" if slot is not None else ""
+            raise PlcAddressError(f"no drive at node {shown_value(node)}{where} in the plant")
         if len(found) > 1:
             raise PlcAddressError(f"node {node} is on several fieldbus modules (slots "
                                   f"{', '.join(str(d.slot) for d in found)}): name the slot")
@@ -983,7 +1004,10 @@ class Plc(AddressAccess):
         """
         cfg = dict(self._config)
         if instrument is not None:
-            cfg["instrument"] = bool(instrument)
+            if not isinstance(instrument, bool):
+                raise PlcConfigError(f"instrument must be True, False or None, got "
+                                     f"{type(instrument).__name__}")
+            cfg["instrument"] = instrument
         if backend is not None:
             cfg["backend"] = check_backend(backend)
         if cfg == self._config:

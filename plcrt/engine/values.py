@@ -90,7 +90,10 @@ def as_number(address: str, value: Any) -> Number:
     if isinstance(value, numbers.Integral):
         return int(value)
     if isinstance(value, numbers.Real):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:   # a Fraction beyond any float: beyond every range
+            return math.inf if value > 0 else -math.inf
     if hasattr(value, "item") and getattr(value, "shape", None) == ():
         item = value.item()   # numpy.bool_ and other 0-d numpy values
         if isinstance(item, (int, float)):
@@ -498,7 +501,7 @@ def check_backend(backend: Any) -> str:
         if backend not in BACKENDS:
             raise PlcConfigError(f"PLCRT_BACKEND must be one of "
                                  f"{', '.join(BACKENDS)}, got {shown_value(backend)}")
-    if backend not in BACKENDS:
+    if not isinstance(backend, str) or backend not in BACKENDS:
         raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
                              f"got {shown_value(backend)}")
     return backend

@@ -84,7 +84,7 @@ def resolve_encoding(name: str | None) -> str | None:
         return None
     if not isinstance(name, str):
         raise PlcConfigError(f"encoding must be a name such as 'cp1252', 'gbk' or 'utf-8', "
-                             f"got {type(name).__name__} {printable(repr(name))[:40]}")
+                             f"got {type(name).__name__}")
     key = name.strip()
     if key.lower() in ("", "auto"):
         return None

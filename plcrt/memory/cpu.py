@@ -56,12 +56,13 @@ DEFAULT_CPU = "CPU226"
 
 def cpu_model(name: str | None) -> CpuModel:
     """Look up a model by name (case and blanks ignored)."""
+    from ..engine.values import shown_value
     from ..errors import PlcConfigError
 
     if name is not None and not isinstance(name, str):
         raise PlcConfigError(f"the CPU model is a name such as 'CPU226' (known: "
                              f"{', '.join(CPU_MODELS)}), got {type(name).__name__} "
-                             f"{name!r:.40}")
+                             f"{shown_value(name)}")
     key = (name or DEFAULT_CPU).upper().replace(" ", "").replace("-", "")
     if not key.startswith("CPU"):
         key = "CPU" + key

@@ -15,7 +15,7 @@ import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Union
 
-from ..engine.values import parse_number
+from ..engine.values import parse_number, shown_value
 from ..errors import PlcConfigError
 from ..trace.recorder import is_device_signal, parse_signal
 
@@ -68,10 +68,11 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
         return (lambda: bool(cond())), name        # type: ignore[call-arg]
     if not isinstance(cond, str):
         raise PlcConfigError(f"a condition is a string such as 'Q0.0' or 'VW100 >= 25', or a "
-                             f"function; got {type(cond).__name__} {cond!r}")
+                             f"function; got {type(cond).__name__} {shown_value(cond)}")
     m = _COND_RE.match(cond)
     if m is None:
-        raise PlcConfigError(f"cannot read the condition {cond!r}: write 'ADDR', 'not ADDR' "
+        raise PlcConfigError(f"cannot read the condition {shown_value(cond)}: write 'ADDR', "
+                             f"'not ADDR' "
                              f"or 'ADDR <op> value' with op one of == != < <= > >=")
     neg, addr, op, value = m.groups()
     rd = reader(h.plc, addr)
@@ -80,7 +81,8 @@ def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
     try:
         v = parse_number(value)
     except PlcConfigError:
-        raise PlcConfigError(f"condition {cond!r}: {value!r} is not a number") from None
+        raise PlcConfigError(f"condition {shown_value(cond)}: {shown_value(value)} is not a "
+                             f"number") from None
     fn = _OPS[op]
     if neg:
         return (lambda: not fn(rd(), v)), str(cond).strip()

@@ -212,6 +212,7 @@ class Harness:
         that took.  Fails with :class:`PlcTimeout` when ``timeout`` (simulated)
         passes first, or the CPU goes to STOP."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        _check_message(message)
         pred, what = condition(self, cond)
         t0 = self.plc.now_us
         limit = self._scans_for(timeout, "timeout")
@@ -248,6 +249,7 @@ class Harness:
     def stays(self, cond: Condition, duration: Duration, *, message: str = "") -> Harness:
         """Run for ``duration`` and fail at the first scan where ``cond`` is false."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
+        _check_message(message)
         pred, what = condition(self, cond)
         plc = self.plc
         t0 = plc.time
@@ -666,6 +668,12 @@ def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_
                                codepage=string_codepage(encoding or ""))
     return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                instrument=instrument, clock=clock, backend=backend)
+
+
+def _check_message(message: Any) -> None:
+    if not isinstance(message, str):
+        raise PlcConfigError(f"message= is the text a failure starts with, a str; got "
+                             f"{type(message).__name__}")
 
 
 def _mapping(values: Any, method: str) -> Mapping[str, Any]:

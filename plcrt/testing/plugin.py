@@ -207,6 +207,11 @@ def _is_pathlike(x: Any) -> bool:
     return isinstance(x, (str, os.PathLike))
 
 
+def _shown(value: Any) -> str:
+    from ..engine.values import shown_value
+    return shown_value(value)
+
+
 def _scan_us(scan_ms: Any, what: str, error: type[Exception]) -> None:
     """The scan time checked as :func:`plcrt.load` checks it, the message
     naming the option (the engine is imported only when one is given)."""
@@ -240,7 +245,7 @@ def _file_or_text(value: Any, what: str, bases: list[Path]) -> Any:
         return value
     if not _is_pathlike(value):
         raise PlcUsageError(f"{what}= must be a file path, got {type(value).__name__} "
-                            f"{value!r}")
+                            f"{_shown(value)}")
     return _resolve(value, what, bases)
 
 
@@ -275,7 +280,7 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
         items = list(program) if isinstance(program, (list, tuple)) else [program]
         if not items or not all(_is_pathlike(x) for x in items):
             raise PlcUsageError(f"the program must be a .awl path or a non-empty list of "
-                                f"paths, got {program!r}")
+                                f"paths, got {_shown(program)}")
         prog = tuple(_resolve(x, "program", bases) for x in items)
         label = " + ".join(os.fspath(x) for x in items)
         key = " + ".join(_display(p, root) for p in prog)
@@ -290,18 +295,19 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
         spec.scan_ms = float(scan_ms)
     cpu = kwargs.get("cpu")
     if cpu is not None and not isinstance(cpu, str):
-        raise PlcUsageError(f"cpu= must be a CPU name such as 'CPU224', got {cpu!r}")
+        raise PlcUsageError(f"cpu= must be a CPU name such as 'CPU224', got {_shown(cpu)}")
     spec.cpu = cpu
     watch = kwargs.get("watch", ())
     if isinstance(watch, str) or not isinstance(watch, (list, tuple)) or \
             not all(isinstance(a, str) for a in watch):
         raise PlcUsageError(f"watch= must be a list of addresses such as ['Q0.0', 'VW100'], "
-                            f"got {watch!r}")
+                            f"got {_shown(watch)}")
     spec.watch = tuple(watch)
     history = kwargs.get("history")
     if history is not None and (isinstance(history, bool) or not isinstance(history, int)
                                 or history < 1):
-        raise PlcUsageError(f"history= must be a whole number of scans >= 1, got {history!r}")
+        raise PlcUsageError(f"history= must be a whole number of scans >= 1, got "
+                            f"{_shown(history)}")
     spec.history = history
     max_time = kwargs.get("max_time")
     if max_time is not None:
@@ -311,7 +317,7 @@ def _make_spec(args: tuple[Any, ...], kwargs: dict[str, Any], bases: list[Path],
             spec.max_time = seconds(max_time)
         except PlcConfigError:
             raise PlcUsageError(f"max_time= must be a duration such as 60, '90s' or '5min', "
-                                f"got {max_time!r}") from None
+                                f"got {_shown(max_time)}") from None
     encoding = kwargs.get("encoding")
     if encoding is not None:
         from ..errors import PlcConfigError

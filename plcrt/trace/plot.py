@@ -22,6 +22,8 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from ..errors import PlcConfigError
+from ..paths import check_path
+from ..safetext import printable
 
 _FORMATS = {".png": "png", ".svg": "svg"}
 
@@ -44,7 +46,7 @@ def plot_format(path: str | Path) -> str:
     Raises:
         PlcConfigError: for any other extension.
     """
-    fmt = _FORMATS.get(Path(path).suffix.lower())
+    fmt = _FORMATS.get(check_path(path, "plot(): the file name").suffix.lower())
     if fmt is None:
         raise PlcConfigError(f"cannot plot to '{path}': the file name must end in "
                              f".png or .svg")
@@ -81,7 +83,16 @@ def plot(trace: Any, path: str | Path, *, signals: Sequence[str] | None = None,
         PlcConfigError: a bad extension, an unknown signal, an empty trace,
             or matplotlib missing.
     """
+    from .recorder import Trace
+    if not isinstance(trace, Trace):
+        raise PlcConfigError(f"plot() draws a plcrt.trace.Trace, got {type(trace).__name__}")
     fmt = plot_format(path)
+    if signals is not None and (not isinstance(signals, (list, tuple))
+                                or not all(isinstance(s, str) for s in signals)):
+        raise PlcConfigError(f"signals= is a list of signal names, got "
+                             f"{type(signals).__name__}")
+    if title is not None and not isinstance(title, str):
+        raise PlcConfigError(f"title= is a str, got {type(title).__name__}")
     names = list(trace.names if signals is None else signals)
     if not names:
         raise PlcConfigError("nothing to plot: no signal selected")
@@ -120,7 +131,11 @@ def plot(trace: Any, path: str | Path, *, signals: Sequence[str] | None = None,
             fig.suptitle(title, parse_math=False)
         metadata: dict[str, Any] = {"Software": None} if fmt == "png" else \
             {"Date": None, "Creator": "plcrt"}
-        fig.savefig(path, format=fmt, metadata=metadata)
+        try:
+            fig.savefig(path, format=fmt, metadata=metadata)
+        except OSError as e:
+            raise PlcConfigError(f"cannot write the plot to '{printable(str(path))[:80]}': "
+                                 f"{e.strerror or type(e).__name__}") from None
     return Path(path)
 
 

@@ -22,6 +22,7 @@ import time
 from typing import Any, Callable, TextIO
 
 from ..engine.values import scan_total
+from ..engine.values import shown_value as _shown
 from ..errors import PlcConfigError, PlcError
 
 #: runs of at most this many scans never show a bar (they end too soon)
@@ -86,9 +87,9 @@ def check_max_wall(max_wall: float | None) -> None:
     """
     if max_wall is not None and (isinstance(max_wall, bool)
                                  or not isinstance(max_wall, (int, float))
-                                 or not (math.isfinite(max_wall) and max_wall > 0)):
+                                 or not 0 < max_wall < math.inf):
         raise PlcConfigError(f"--max-wall must be a positive number of seconds, "
-                             f"got {max_wall!r}")
+                             f"got {type(max_wall).__name__} {_shown(max_wall)}")
 
 
 def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | None = None,
@@ -113,9 +114,18 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
         PlcRuntimeError: a fault of the program (as ``plc.run`` raises it).
         WallTimeExceeded: ``max_wall`` seconds passed before the run ended.
     """
+    from ..engine.runtime import Plc
+    if not isinstance(plc, Plc):
+        raise PlcConfigError(f"run_with_progress() runs a plcrt.Plc, got {type(plc).__name__}")
+    if stream is not None and not callable(getattr(stream, "write", None)):
+        raise PlcConfigError(f"stream= is a text stream (sys.stderr, a file), got "
+                             f"{type(stream).__name__}")
+    if not callable(clock):
+        raise PlcConfigError(f"clock= is a function returning seconds, got "
+                             f"{type(clock).__name__}")
     # a wall-time limit ends a run of any simulated length
-    total = scan_count(plc, seconds, scans, bounded=max_wall is None)
     check_max_wall(max_wall)
+    total = scan_count(plc, seconds, scans, bounded=max_wall is None)
     out = sys.stderr if stream is None else stream
     terminal = _is_terminal(out)
     if terminal and (progress or not quiet and total > MIN_SCANS_FOR_BAR):

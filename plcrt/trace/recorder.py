@@ -28,7 +28,10 @@ from typing import IO, Any, Callable, Sequence
 
 import numpy as np
 
-from ..errors import PlcAddressError, PlcConfigError, PlcError
+from ..engine.values import MAX_STEPS, shown_value
+from ..errors import PlcAddressError, PlcConfigError, PlcError, PlcKeyError
+from ..paths import check_path
+from ..safetext import printable
 
 #: axis quantities a trace can record, and whether they are floats
 AXIS_QUANTITIES = {"position": False, "mechanical": False, "speed": True}
@@ -77,7 +80,7 @@ def parse_signal(plc: Any, text: str) -> Signal:
         PlcAddressError: an address, symbol or axis that does not exist.
     """
     if not isinstance(text, str) or not text.strip():
-        raise PlcConfigError(f"trace signal {text!r}: give an address, a symbol or "
+        raise PlcConfigError(f"trace signal {shown_value(text)}: give an address, a symbol or "
                              f"axis<slot>.<axis>.<quantity>")
     name = text.strip()
     if _AXIS_PREFIX_RE.match(name):
@@ -153,15 +156,23 @@ class Trace:
 
     def __init__(self, plc: Any, signals: Sequence[str], *, every: int = 1,
                  limit: int | None = None) -> None:
+        from ..engine.runtime import Plc
+        if not isinstance(plc, Plc):
+            raise PlcConfigError(f"a trace records a plcrt.Plc, got {type(plc).__name__}")
         if isinstance(signals, str):
             signals = [signals]
+        if not isinstance(signals, (list, tuple)):
+            raise PlcConfigError(f"the signals of a trace are a list of names such as "
+                                 f"['Q0.0', 'VW10'], got {type(signals).__name__}")
         if not signals:
             raise PlcConfigError("a trace needs at least one signal")
         if not isinstance(every, int) or isinstance(every, bool) or every < 1:
-            raise PlcConfigError(f"every must be a whole number of scans >= 1, got {every!r}")
+            raise PlcConfigError(f"every must be a whole number of scans >= 1, got "
+                                 f"{shown_value(every)}")
         if limit is not None and (not isinstance(limit, int) or isinstance(limit, bool)
-                                  or limit < 1):
-            raise PlcConfigError(f"limit must be a number of samples >= 1, got {limit!r}")
+                                  or not 1 <= limit <= MAX_STEPS):
+            raise PlcConfigError(f"limit must be a number of samples >= 1, got "
+                                 f"{shown_value(limit)}")
         parsed = [parse_signal(plc, s) for s in signals]
         seen: set[str] = set()
         for sig in parsed:
@@ -241,14 +252,14 @@ class Trace:
         return len(self._t_us)
 
     def __contains__(self, name: object) -> bool:
-        return name in self._index
+        return isinstance(name, str) and name in self._index
 
     def _lookup(self, name: str) -> int:
         try:
             return self._index[name.strip() if isinstance(name, str) else name]
-        except KeyError:
-            raise KeyError(f"no signal {name!r} in this trace "
-                           f"(signals: {', '.join(self.names)})") from None
+        except (KeyError, TypeError):   # TypeError: an unhashable name
+            raise PlcKeyError(f"no signal {shown_value(name)} in this trace "
+                              f"(signals: {', '.join(self.names)})") from None
 
     def _cached(self, key: Any, build: Callable[[], np.ndarray]) -> np.ndarray:
         hit = self._cache.get(key)
@@ -274,6 +285,9 @@ class Trace:
 
     def last(self, n: int = 1) -> list[tuple[int | float, ...]]:
         """The last ``n`` samples as rows ``(time_s, value, ...)``."""
+        if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+            raise PlcConfigError(f"the number of samples is a whole number >= 0, got "
+                                 f"{shown_value(n)}")
         return self._rows(max(0, len(self) - n), len(self))
 
     def _rows(self, start: int, stop: int) -> list[tuple[int | float, ...]]:
@@ -301,11 +315,16 @@ class Trace:
         Bits are 0/1, integers in decimal, floats (REAL, speed, time) with
         ``repr`` precision, so reading the file back gives the same numbers.
         """
-        if isinstance(path_or_file, (str, Path)):
-            with open(path_or_file, "w", encoding="utf-8", newline="") as f:
-                self._write_csv(f)
-        else:
+        if callable(getattr(path_or_file, "write", None)):
             self._write_csv(path_or_file)
+            return
+        path = check_path(path_or_file, "to_csv(): the file name")
+        try:
+            with open(path, "w", encoding="utf-8", newline="") as f:
+                self._write_csv(f)
+        except OSError as e:
+            raise PlcConfigError(f"cannot write the trace to '{printable(str(path))[:80]}': "
+                                 f"{e.strerror or type(e).__name__}") from None
 
     def _write_csv(self, f: IO[str]) -> None:
         w = csv.writer(f, lineterminator="\n")

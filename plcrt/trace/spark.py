@@ -12,7 +12,18 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..errors import PlcConfigError
 from .recorder import format_value
+
+#: the widest sparkline drawn, in characters (a terminal line is far less)
+MAX_WIDTH = 10_000
+
+
+def _check_width(width: Any) -> None:
+    if isinstance(width, bool) or not isinstance(width, int) or not 1 <= width <= MAX_WIDTH:
+        raise PlcConfigError(f"width must be a whole number of characters from 1 to "
+                             f"{MAX_WIDTH}, got {type(width).__name__}")
+
 
 #: the eight levels, lowest first
 BLOCKS = "▁▂▃▄▅▆▇█"
@@ -30,9 +41,14 @@ def sparkline(values: Sequence[float] | np.ndarray, width: int = 60, *,
     sequence of only 0 and 1) are ``▁`` for 0 and ``█`` for 1.  Values that
     are not finite (a NaN REAL) are a space.
     """
-    if width < 1:
-        raise ValueError(f"width must be at least 1, got {width}")
-    v = np.asarray(values, dtype=np.float64).ravel()
+    _check_width(width)
+    if bits is not None and not isinstance(bits, bool):
+        raise PlcConfigError(f"bits must be True, False or None, got {type(bits).__name__}")
+    try:
+        v = np.asarray(values, dtype=np.float64).ravel()
+    except (TypeError, ValueError, OverflowError):
+        raise PlcConfigError(f"sparkline() takes a sequence of numbers, got "
+                             f"{type(values).__name__}") from None
     n = len(v)
     if n == 0:
         return ""
@@ -79,6 +95,10 @@ def trend(trace: Any, width: int = 60) -> str:
     A first line gives the number of samples and the time they span.  The
     columns are aligned; the result ends without a newline.
     """
+    from .recorder import Trace
+    if not isinstance(trace, Trace):
+        raise PlcConfigError(f"trend() takes a plcrt.trace.Trace, got {type(trace).__name__}")
+    _check_width(width)
     n = len(trace)
     if n == 0:
         return "0 samples"

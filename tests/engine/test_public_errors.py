@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 
 import plcrt
 from plcrt import PlcAddressError, PlcConfigError, PlcError, PlcSyntaxError
+from plcrt.engine.values import MAX_STEPS
 from plcrt.testing import Harness
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -411,3 +412,90 @@ def test_a_huge_address_is_not_echoed_in_full(call: str, length: int) -> None:
     with pytest.raises(plcrt.PlcAddressError) as err:
         actions[call]()
     assert len(str(err.value)) < 200 and "V" * 41 not in str(err.value)
+
+
+# ---------------------------------------------------------------------------
+# Huge ints, file names, encodings, scan counts and scan times
+# ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("call", [
+    lambda p, h: p.run(10**400), lambda p, h: p.run(seconds=10**400),
+    lambda p, h: h.limit_time(10**400), lambda p, h: h.stimulus([(10**400, "I0.0", 1)]),
+    lambda p, h: h.run_until("Q0.0", timeout=10**400),
+    lambda p, h: h.stays("not Q0.0", 10**5000)],
+    ids=["run", "run seconds", "limit_time", "stimulus", "run_until", "stays"])
+def test_a_huge_int_duration_is_a_config_error(call: Callable[..., Any]) -> None:
+    """An int too large for a float is a duration too long to count, said
+    with its order of magnitude, before anything runs."""
+    plc = _plc()
+    h = Harness(_plc())
+    with pytest.raises(PlcConfigError, match=r"about 1e\d+ s is too long to count in "
+                                             r"microseconds"):
+        call(plc, h)
+    assert plc.scans == h.scans == 0
+
+
+@pytest.mark.parametrize("kwargs", [{"source": "a\x00b"}, {"source": Path("a\x00b")},
+                                    {"symbols": "sym\x00.txt"}, {"data": Path("d\x00.db")},
+                                    {"plant": "p\x00.toml"}, {"source": "a\ud800.awl"}],
+                         ids=["program", "program Path", "symbols", "data", "plant",
+                              "surrogate"])
+def test_a_file_name_no_file_can_have_is_a_config_error(kwargs: dict[str, Any]) -> None:
+    """A NUL character (or an unencodable one) in any path argument names
+    the argument and the character."""
+    args = {"source": TIMERS, **kwargs}
+    with pytest.raises(PlcConfigError) as info:
+        plcrt.load(args.pop("source"), **args)
+    what = next(iter(kwargs)).replace("source", "the program")
+    assert info.value.message.startswith(f"{what}: the file name")
+    assert "NUL character" in info.value.message or "U+D800" in info.value.message
+
+
+def test_trace_and_plot_paths_are_checked(tmp_path: Path) -> None:
+    from plcrt.trace import Trace, plot
+    plc = _plc()
+    tr = Trace(plc, ["Q0.0"])
+    plc.scan(2)
+    for write in (lambda p: tr.to_csv(p), lambda p: plot(tr, p)):
+        with pytest.raises(PlcConfigError, match="NUL character"):
+            write(str(tmp_path / "t\x00.svg"))
+        with pytest.raises(PlcConfigError, match="cannot write the (trace|plot) to"):
+            write(tmp_path / "no" / "such" / "t.svg")
+
+
+@pytest.mark.parametrize("encoding", ["punycode", "undefined", "idna", "hex", "a\x00b"])
+def test_an_encoding_stl_cannot_be_in_is_a_config_error(encoding: str) -> None:
+    """Codecs that are not text encodings, always fail or mangle text are
+    refused by name, for load and the harness alike."""
+    for load in (plcrt.load, Harness.load):
+        with pytest.raises(PlcConfigError, match="encoding"):
+            load(TIMERS, encoding=encoding)
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda p: p.run(scans=2**70), "scans must be at most 1_000_000_000"),
+    (lambda p: p.scan(MAX_STEPS + 1), "the number of scans must be at most 1_000_000_000"),
+    (lambda p: p.run(1e300), "1e+300 s at 10 ms a scan is more than 1_000_000_000 scans"),
+    (lambda p: p.run("99999999s"), "more than 1_000_000_000 scans"),
+    (lambda p: Harness(p).run_until("Q0.0", timeout=1e12), "timeout: 1000000000000.0 s at 10 ms"),
+    (lambda p: Harness(p).stimulus([(0, "I0.0", 1)], until=1e12), "until: 1000000000000.0 s"),
+    (lambda p: Harness(p).pulse("I0.0", scans=2**70), "scans must be at most"),
+    (lambda p: plcrt.link(p, 0, _plc(), 0).run(1e12), "synchronisation"),
+], ids=["scans", "scan", "seconds", "text", "run_until", "until", "pulse", "link"])
+def test_a_run_that_cannot_end_is_refused_before_it_starts(call: Callable[..., Any],
+                                                           words: str) -> None:
+    plc = _plc()
+    with pytest.raises(PlcConfigError) as info:
+        call(plc)
+    assert words in info.value.message and "split a longer run" in info.value.message
+    assert plc.scans == 0 and plc["I0.0"] == 0
+
+
+def test_the_longest_run_is_allowed() -> None:
+    """The bound is exactly MAX_STEPS scans (checked, not run: a Harness
+    wait computes its count the same way)."""
+    from plcrt.engine.values import scan_total
+    assert scan_total(10_000, seconds=MAX_STEPS * 0.01) == MAX_STEPS
+    assert scan_total(10_000, scans=MAX_STEPS) == MAX_STEPS
+    with pytest.raises(PlcConfigError):
+        scan_total(10_000, seconds=MAX_STEPS * 0.01 + 0.001)

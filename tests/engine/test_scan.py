@@ -8,6 +8,8 @@ SM0.5 a 1 s clock, SM0.6 a scan clock.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 import plcrt
@@ -171,3 +173,35 @@ def test_memory_persists_between_scans_and_outputs_hold() -> None:
     p["I0.0"] = 0
     p.scan(9)
     assert (p["M0.0"], p["Q0.2"], p["VW0"], p.scans) == (1, 1, 10, 10)
+
+
+@pytest.mark.parametrize("scan_ms, us", [(0.001, 1), (1.1, 1100), (7, 7000), (0.25, 250),
+                                         (60000, 60_000_000)])
+def test_a_scan_time_of_whole_microseconds_is_taken_exactly(scan_ms, us) -> None:
+    """Whole microseconds are taken as they are (1.1 ms is 1100 µs, whatever
+    the float's last bit says)."""
+    p = plcrt.load(SM_PROGRAM, scan_ms=scan_ms)
+    p.scan(3)
+    assert p.scan_us == us and p.now_us == 3 * us
+
+
+@pytest.mark.parametrize("scan_ms, shown, give", [(0.0015, "1.5 µs", "give 0.001 or 0.002"),
+                                                  (10.0001, "10000.1 µs",
+                                                   "give 10 or 10.001")])
+def test_a_scan_time_of_a_fraction_of_a_microsecond_is_refused(scan_ms, shown, give) -> None:
+    """The simulated clock counts whole µs: a scan time between two is
+    refused, naming both neighbours, never rounded."""
+    with pytest.raises(PlcConfigError) as info:
+        plcrt.load(SM_PROGRAM, scan_ms=scan_ms)
+    assert f"is {shown}; {give}" in info.value.message
+    assert "whole number of microseconds" in info.value.message
+
+
+def test_the_marker_and_the_harness_check_the_scan_time_the_same_way() -> None:
+    from plcrt.testing import Harness
+    from plcrt.testing.plugin import PlcUsageError, _make_spec
+    with pytest.raises(PlcConfigError, match="whole number of microseconds"):
+        Harness.load(SM_PROGRAM, scan_ms=0.0015)
+    with pytest.raises(PlcUsageError, match="scan_ms= must be a whole number of microseconds"):
+        root = Path(__file__).resolve().parents[2]
+        _make_spec((root / "programs" / "timers.awl",), {"scan_ms": 0.0015}, [root], root)

@@ -104,11 +104,12 @@ class CanopenDrive:
     def __init__(self, network: Any, node_id: int, model: str = "hcfa-am0520b",
                  plant: Optional[DrivePlant] = None, *, clock: Clock = "wall",
                  od: Any = None) -> None:
-        if clock not in CLOCKS:
-            raise PlcConfigError(f"cia402.attach: clock={clock!r}; expected one of "
+        if not isinstance(clock, str) or clock not in CLOCKS:
+            raise PlcConfigError(f"cia402.attach: clock={shown_value(clock)}; expected one of "
                                  + ", ".join(CLOCKS))
         if not isinstance(node_id, int) or isinstance(node_id, bool) or not 1 <= node_id <= 127:
-            raise PlcConfigError(f"cia402.attach: node id {node_id!r} is not a CANopen node id "
+            raise PlcConfigError(f"cia402.attach: node id {shown_value(node_id)} is not a "
+                                 f"CANopen node id "
                                  "(1..127, CiA 301 §7.5.2.4)")
         if not isinstance(network, canopen.Network):
             raise PlcConfigError(f"cia402.attach: {type(network).__name__} is not a "
@@ -116,6 +117,12 @@ class CanopenDrive:
         if network.bus is None:
             raise PlcConfigError("cia402.attach: the canopen.Network is not connected "
                                  "(call network.connect(interface='virtual', channel=...) first)")
+        if plant is not None and not isinstance(plant, DrivePlant):
+            raise PlcConfigError(f"cia402.attach: plant= is a DrivePlant or None, got "
+                                 f"{type(plant).__name__}")
+        if od is not None and not isinstance(od, canopen.ObjectDictionary):
+            raise PlcConfigError(f"cia402.attach: od= is a canopen.ObjectDictionary or None, "
+                                 f"got {type(od).__name__}")
         if node_id in network:
             raise PlcConfigError(f"cia402.attach: node {node_id} is already on the network")
         self.clock: Clock = clock

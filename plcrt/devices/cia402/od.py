@@ -27,6 +27,7 @@ from typing import Any, Callable, Iterator
 
 from ...blocks.interface import library_dirs as block_dirs
 from ...errors import PlcConfigError, PlcError, SourceLoc
+from ...safetext import printable
 
 #: dtype -> (bits, minimum, maximum); the CoE basic data types (ETG.1000.6).
 DTYPES: dict[str, tuple[int, int, int]] = {
@@ -208,7 +209,9 @@ class ObjectDictionary:
             PlcConfigError: unknown model (naming the known ones), or a
                 malformed file (naming the file, line and entry).
         """
-        for d in library_dirs() if _MODEL_NAME.fullmatch(model) else ():
+        # (a name longer than any file name is no model either)
+        named = isinstance(model, str) and len(model) <= 64 and _MODEL_NAME.fullmatch(model)
+        for d in library_dirs() if named else ():
             path = d / f"{model}.toml"
             if path.is_file():
                 stat = path.stat()
@@ -217,7 +220,8 @@ class ObjectDictionary:
                     _LOADED[key] = cls.from_file(path)
                 return _LOADED[key]
         known = ", ".join(cls.models()) or "none"
-        raise PlcConfigError(f"unknown CiA 402 drive model {model!r}; known models: {known}")
+        shown = printable(model)[:40] if isinstance(model, str) else type(model).__name__
+        raise PlcConfigError(f"unknown CiA 402 drive model {shown!r}; known models: {known}")
 
     @classmethod
     def from_file(cls, path: str | Path) -> ObjectDictionary:

@@ -98,7 +98,11 @@ def test_pv_velocity_reached(pair):
 
 @pytest.mark.parametrize("seconds, words", [
     (-0.1, "cannot go back in time"), (float("nan"), "non-negative, finite"),
-    (1.8e302, "too long to count in microseconds"), ("soon", "not a duration")])
+    (1.8e302, "too long to count in microseconds"), ("soon", "not a duration"),
+    (10**400, "about 1e400 s is too long to count in microseconds"),
+    (-(10**400), "cannot go back in time"),
+    (1e300, r"1e\+300 s at 1 ms a bus cycle is more than 1_000_000_000 bus cycles"),
+    ("3000h", "more than 1_000_000_000 bus cycles")])
 def test_advance_takes_a_duration_it_can_count(pair, seconds, words):
     """advance() refuses what is not a countable duration with a PlcError,
     and the drive's time stays where it was."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any, Protocol, Union
 
 from ..engine.values import parse_number, shown_value
 from ..errors import PlcConfigError
@@ -21,10 +21,16 @@ from ..trace.recorder import is_device_signal, parse_signal
 
 if TYPE_CHECKING:
     from ..engine.runtime import Plc
-    from .harness import Harness
 
 Value = Union[int, float, bool]
-Condition = Union[str, Callable[[], Any], Callable[["Harness"], Any]]
+#: a condition function takes no argument, or the harness it is checked on
+Condition = Union[str, Callable[[], Any], Callable[[Any], Any]]
+
+
+class HasPlc(Protocol):
+    """What a condition is checked on: a harness (or anything with its PLC)."""
+
+    plc: Plc
 
 
 # ---------------------------------------------------------------------------
@@ -50,7 +56,7 @@ _OPS: dict[str, Callable[[Any, Any], bool]] = {
 }
 
 
-def condition(h: Harness, cond: Condition) -> tuple[Callable[[], bool], str]:
+def condition(h: HasPlc, cond: Condition) -> tuple[Callable[[], bool], str]:
     """A no-argument predicate and its description from a condition:
     ``"Q0.0"``, ``"not M0.1"``, ``"VW100 >= 25"``, ``"VD8:REAL > 1.5"``, a
     callable taking no argument, or a callable taking the harness."""
@@ -140,5 +146,5 @@ def addresses_of(cond: Condition | None) -> list[str]:
     return [m.group(2)] if m is not None and m.group(3) else []
 
 
-__all__ = ["Condition", "UNNAMED", "addresses_of", "condition", "describe_function", "quoted",
+__all__ = ["Condition", "HasPlc", "UNNAMED", "addresses_of", "condition", "describe_function", "quoted",
            "reader"]

@@ -12,25 +12,28 @@ every public method and property of :class:`~plcrt.engine.Plc` with the same
 parameters (a test written against ``plcrt.load(...)`` runs unchanged on the
 ``plc`` fixture); methods that return nothing on the PLC return the harness
 here, so calls chain.
+
+This module holds the class with its loading, watching, time control and
+waiting (with the failure messages of a wait), state and forking; the
+class takes its stimuli from :mod:`plcrt.testing.stimuli` and its axes and
+drives from :mod:`plcrt.testing.motion`.
 """
 
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
-from ..devices import AxisState, DriveState
+from ..devices import AxisState
 from ..engine.runtime import Plc, load
-from ..engine.values import (Duration, check_address, duration_us, scan_number,
-                             shown_value, step_count)
+from ..engine.values import Duration, duration_us, scan_number, shown_value, step_count
 from ..engine.values import duration as parse_duration
-from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
-from .conditions import Condition, addresses_of, condition, quoted, reader
-
-Value = Union[int, float, bool]
+from ..errors import PlcConfigError, PlcError, SourceLoc
+from .conditions import Condition, Value, addresses_of, condition, quoted, reader
+from .motion import Motion
+from .stimuli import Stimuli
 
 
 class PlcTimeout(AssertionError):
@@ -47,7 +50,7 @@ def seconds(d: Duration) -> float:
     return parse_duration(d)
 
 
-class Harness:
+class Harness(Stimuli, Motion):
     """Drive one PLC from a test: run, stimulate, force, read, fork.
 
     Create it with :meth:`Harness.load` (or wrap an existing
@@ -301,123 +304,6 @@ class Harness:
             except PlcError:
                 continue
         return ", ".join(shown)
-
-    # -- stimuli ----------------------------------------------------------
-    def __getitem__(self, address: str) -> Value:
-        return self.read(address)
-
-    def __setitem__(self, address: str, value: Value) -> None:
-        self.write(address, value)
-
-    def read(self, address: str, kind: str | None = None) -> Value:
-        """Read an address or symbol (``kind`` "REAL" or "BIT"; or ``VD4:REAL``)."""
-        return self.plc.read(address, kind)
-
-    def write(self, address: str, value: Value) -> None:
-        """Write an address or symbol; an input keeps its value (a switch left on)."""
-        self.plc.write(address, value)
-
-    def set(self, values: Mapping[str, Value]) -> Harness:
-        """Write several addresses at once (they hold until changed)."""
-        for a, v in _mapping(values, "set").items():
-            self.write(a, v)
-        return self
-
-    def values(self, *addresses: str) -> dict[str, Value]:
-        """Several addresses at once, as a dict."""
-        return {a: self.read(a) for a in addresses}
-
-    def patch(self, values: Mapping[str, Value], scans: int = 1) -> Harness:
-        """Hold values for ``scans`` scans (default one), then put the old
-        values back: a push button pressed for exactly one scan."""
-        values = _mapping(values, "patch")
-        scan_number(scans, "scans")
-        for a, v in values.items():
-            self.plc._writable(a, v)   # all checked before any is written
-        old = {a: self.read(a) for a in values}
-        for a, v in values.items():
-            self.write(a, v)
-        self.scan(scans)
-        for a, v in old.items():
-            self.write(a, v)
-        return self
-
-    def pulse(self, address: str, scans: int = 1, value: Value = 1) -> Harness:
-        """Set ``address`` to ``value`` for ``scans`` scans, then back."""
-        return self.patch({check_address(address): value}, scans)
-
-    def force(self, address: str, value: Value) -> _Forced:
-        """Force an address until :meth:`unforce` (or the end of a ``with``).
-
-        Returns an object that is also a context manager:
-        ``with h.force("I0.1", 0): ...`` releases the force at the end."""
-        self.plc.force(address, value)
-        return _Forced(self, [address])
-
-    @contextmanager
-    def forced(self, values: Mapping[str, Value]) -> Iterator[Harness]:
-        """``with h.forced({"I0.1": 0, "VW10": 5}):`` forces inside the block only."""
-        values = _mapping(values, "forced")
-        for a, v in values.items():
-            self.plc._writable(a, v)   # all checked before any is forced
-        for a, v in values.items():
-            self.plc.force(a, v)
-        try:
-            yield self
-        finally:
-            _release(self.plc, values)
-
-    def unforce(self, address: str | None = None) -> Harness:
-        """Release one force (by the symbol or the address: a force belongs
-        to the memory location), or all of them."""
-        self.plc.unforce(address)
-        return self
-
-    def stimulus(self, table: Iterable[tuple[Duration, str, Value]], *,
-                 until: Duration | None = None) -> Harness:
-        """Play a time-ordered table of ``(time, address, value)`` rows.
-
-        Times count from now.  A row takes effect before the first scan that
-        starts at or after its time (scans are the only moments a PLC reads
-        its inputs).  After the last row the PLC runs on to ``until`` if it
-        is given.
-        """
-        if not isinstance(table, Iterable) or isinstance(table, (str, bytes, Mapping)):
-            raise PlcConfigError(f"a stimulus is a list of (time, address, value) rows, got "
-                                 f"{type(table).__name__}")
-        rows = []
-        for i, row in enumerate(table):
-            try:
-                t, addr, value = row
-            except (TypeError, ValueError):
-                raise PlcConfigError(f"stimulus row {i + 1}: expected (time, address, value), "
-                                     f"got {shown_value(row)}") from None
-            try:
-                t_us = duration_us(t)
-                self._scans_for(t)   # a time no run can reach is refused up front
-            except PlcConfigError as e:
-                raise PlcConfigError(f"stimulus row {i + 1} {shown_value(row)}: "
-                                     f"{e.message}") from None
-            try:   # every row is checked before the first scan runs
-                self.plc._writable(addr, value)
-            except PlcError as e:
-                raise type(e)(f"stimulus row {i + 1} {shown_value(row)}: {e.message}") from None
-            rows.append((t_us, i, addr, value))
-        if until is not None:
-            self._scans_for(until, "until")
-        rows.sort()
-        plc = self.plc
-        t0 = plc.now_us
-        for t_us, _, addr, value in rows:
-            while plc.now_us < t0 + t_us and plc.mode == "RUN":
-                plc.scan(1)
-            self.write(addr, value)
-        if until is not None:
-            end = t0 + duration_us(until, "until")
-            while plc.now_us < end and plc.mode == "RUN":
-                plc.scan(1)
-        return self
-
     # -- state ------------------------------------------------------------
     def snapshot(self) -> Plc:
         """The whole PLC state now (memory, timers, devices, time)."""
@@ -447,91 +333,6 @@ class Harness:
         h.history.extend(self.history)
         self.forks.append(h)
         return h
-
-    # -- motion -----------------------------------------------------------
-    def axis(self, slot: int = 0, axis: int = 0) -> AxisState:
-        """State of one EM253 axis (needs a plant): ``a.position`` or
-        ``a["position"]``, as :meth:`Plc.axis`."""
-        return self.plc.axis(slot, axis)
-
-    def axes(self) -> list[AxisState]:
-        """State of every configured axis."""
-        return self.plc.axes()
-
-    def module(self, slot: int) -> Any:
-        """The simulated module in expansion slot ``slot``, or None."""
-        return self.plc.module(slot)
-
-    def drive(self, node: int, slot: int | None = None) -> DriveState:
-        """State of the bus drive at *node* (needs a plant with a FIELDBUS
-        module): ``d.position``, ``d.statusword``, ``d.state``, ``d.flags``,
-        as :meth:`Plc.drive`."""
-        return self.plc.drive(node, slot)
-
-    def drives(self) -> list[DriveState]:
-        """State of every bus drive."""
-        return self.plc.drives()
-
-    def wait_axis_moving(self, slot: int = 0, axis: int = 0, *,
-                         timeout: Duration = 1.0) -> float:
-        """Run until the axis moves; seconds it took."""
-        __tracebackhide__ = True  # pytest: report the test's line, not ours
-
-        def moving() -> bool:
-            return self.axis(slot, axis).moving
-
-        moving.__name__ = f"axis {slot}.{axis} is moving"   # as messages name it
-        return self.run_until(moving, timeout=timeout, message=f"axis {slot}.{axis} did not start")
-
-    def wait_axis_stopped(self, slot: int = 0, axis: int = 0, *,
-                          timeout: Duration = 60.0) -> float:
-        """Run until the axis stands still; seconds it took."""
-        __tracebackhide__ = True  # pytest: report the test's line, not ours
-
-        def stopped() -> bool:
-            return not self.axis(slot, axis).moving
-
-        stopped.__name__ = f"axis {slot}.{axis} stands still"   # as messages name it
-        return self.run_until(stopped, timeout=timeout, message=f"axis {slot}.{axis} did not stop")
-
-    def axis_done_within(self, limit: Duration, slot: int = 0, axis: int = 0) -> float:
-        """Assert a move that is running (or about to start within a few
-        scans) ends within ``limit`` simulated seconds; returns the seconds
-        until the axis stood still.  One more scan follows, so the outputs of
-        the block that commanded the move (its Done, C_Status, C_Pos) are
-        current when this returns."""
-        __tracebackhide__ = True  # pytest: report the test's line, not ours
-        total = seconds(limit)   # a bad limit is reported before anything runs
-        plc = self.plc
-        t0 = plc.now_us
-        who = f"axis {slot}.{axis}"
-        expected = f"expected the move of {who} to be done within {total:g} s"
-        signals = [f"axis{slot}.{axis}.position", f"axis{slot}.{axis}.speed"]
-        if not self.axis(slot, axis).moving:
-            start = min(total, 1.0)
-            for _ in range(self._scans_for(start)):
-                plc.scan(1)
-                self._axis_running(expected, signals)
-                if self.axis(slot, axis).moving:
-                    break
-            else:
-                self._timeout(f"{expected}; the axis did not start moving within {start:g} s",
-                              "", shown=signals)
-        for _ in range(self._scans_for(total - (plc.now_us - t0) / 1e6)):
-            plc.scan(1)
-            self._axis_running(expected, signals)
-            if not self.axis(slot, axis).moving:
-                took = (plc.now_us - t0) / 1e6
-                plc.scan(1)     # the block sees the axis stopped and reports it
-                return took
-        self._timeout(f"{expected}; it was still moving {(plc.now_us - t0) / 1e6:g} s later",
-                      "", shown=signals)
-        raise AssertionError  # pragma: no cover - _timeout raises
-
-    def _axis_running(self, expected: str, signals: list[str]) -> None:
-        __tracebackhide__ = True  # pytest: report the test's line, not ours
-        if self.plc.mode != "RUN":
-            self._timeout(f"{expected}; the CPU went to STOP", "", shown=signals)
 
     # -- results ----------------------------------------------------------
     @property
@@ -622,30 +423,6 @@ class Harness:
         return Trace(self.plc, list(signals), every=every, limit=limit)
 
 
-class _Forced:
-    """The result of :meth:`Harness.force`: persistent, or a context manager."""
-
-    def __init__(self, h: Harness, addresses: list[str]) -> None:
-        self._h = h
-        self._addresses = addresses
-
-    def __enter__(self) -> Harness:
-        return self._h
-
-    def __exit__(self, *exc: Any) -> None:
-        _release(self._h.plc, self._addresses)
-
-
-def _release(plc: Plc, addresses: Iterable[str]) -> None:
-    """Release the forces of ``addresses`` that are still forced (by the
-    same location: a force re-made under another name counts too)."""
-    for a in addresses:
-        try:
-            plc.unforce(a)
-        except PlcAddressError:
-            pass   # released inside the block already
-
-
 def _plc_from_parsed(program: Any, *, symbols: Any, data: Any, plant: Any, scan_ms: float,
                      cpu: str | None, instrument: bool, encoding: str | None = None,
                      clock: Any = None, backend: str | None = None) -> Plc:
@@ -675,12 +452,6 @@ def _check_message(message: Any) -> None:
         raise PlcConfigError(f"message= is the text a failure starts with, a str; got "
                              f"{type(message).__name__}")
 
-
-def _mapping(values: Any, method: str) -> Mapping[str, Any]:
-    if not isinstance(values, Mapping):
-        raise PlcConfigError(f"{method}() takes a dict of address -> value, got "
-                             f"{type(values).__name__}")
-    return values
 
 
 def _fmt(v: Value) -> str:

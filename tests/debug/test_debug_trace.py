@@ -104,10 +104,11 @@ def test_trace_trend_csv_plot_on_the_timers(tmp_path: Path,
     assert out["trace T37 VD4:FOO"].startswith("error: trace signal 'VD4:FOO': ")
     assert out["plot out.pdf"] == ("error: cannot plot to 'out.pdf': the file name must end "
                                    "in .png or .svg\n")
-    assert out["csv nodir/out.csv"] == ("error: cannot write 'nodir/out.csv': "
+    assert out["csv nodir/out.csv"] == ("error: cannot write the trace to 'nodir/out.csv': "
                                         "No such file or directory\n")
-    assert out["plot nodir/out.svg"].startswith("error: cannot write 'nodir/out.svg': ")
-    assert out["csv ."].startswith("error: cannot write '.': ")
+    assert out["plot nodir/out.svg"].startswith("error: cannot write the plot to "
+                                                "'nodir/out.svg': ")
+    assert out["csv ."].startswith("error: cannot write the trace to '.': ")
     assert not (tmp_path / "out.pdf").exists()
     # the bad signals left the trace as it was; stop keeps its samples
     assert out["trace stop"] == ("stopped the trace of T37, Q0.0 (300 samples kept for "

@@ -142,7 +142,7 @@ def _names(symbols: Any) -> Any:
     without a table."""
     if symbols is None or not getattr(symbols, "entries", None):
         return None
-    from ..web.present import symbol_names
+    from .names import symbol_names
     names = symbol_names(symbols)
     return lambda text: names(text)[0]
 

@@ -40,13 +40,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..cli import SetItem, apply_sets, parse_sets
 from ..engine.access import force_covers
 from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError, PlcRuntimeError
 from ..lang import ir
 from ..safetext import printable
+from ..term.options import SetItem, apply_sets, parse_sets
 from ..testing.harness import Harness, condition, reader
 from ..view.ladder import Ladder, to_ladder
 from ..view.status import PlcStatus

@@ -166,7 +166,9 @@ class Session(SessionState):
         finally:
             signal.signal(signal.SIGINT, old)
 
-
+    # ------------------------------------------------------------------
+    # The paused mode
+    # ------------------------------------------------------------------
     def _on_break(self, net: NetworkRef) -> None:
         """Called by the PLC's code before a network with its probe set.
 

@@ -57,7 +57,6 @@ class SessionState:
     """The state of a debugging session over one instrumented :class:`~plcrt.Plc`,
     and the operations its commands use.
 
-
     Args:
         plc: a PLC loaded with ``instrument=True`` (breakpoints need the
             probes).
@@ -118,9 +117,8 @@ class SessionState:
         self._trace: Trace | None = None
         self._apply_breaks()
 
-
     # ------------------------------------------------------------------
-    # Driving the session
+    # What the session reports
     # ------------------------------------------------------------------
     @property
     def exit_status(self) -> int:
@@ -135,7 +133,6 @@ class SessionState:
     def paused(self) -> NetworkRef | None:
         """The network the current scan waits before, or None."""
         return self._paused
-
 
     # -- the same operations for the CLI's --break / --watch options --------
     def add_breakpoint(self, text: str) -> NetworkRef:
@@ -170,7 +167,6 @@ class SessionState:
             self._print(str(d))
         self._print("the CPU went to STOP: further scans do nothing (the session goes on "
                     "for inspection)")
-
 
     def _new_diagnostics(self) -> None:
         """Warnings raised while running (library blocks check parameters
@@ -238,7 +234,6 @@ class SessionState:
             bp[:] = bytes(len(bp))
             for k in self._breaks:
                 bp[k] = 1
-
 
     # ------------------------------------------------------------------
     # Running scans

@@ -192,6 +192,9 @@ class Session(SessionState):
         elif net.index not in self._breaks:
             return
         self._paused = net
+        # the stop display (the network drawn with its values) is part of
+        # the pause, not of the run --max-wall limits
+        paused_at = time.monotonic()
         what = "stopped before" if stepped else "break at"
         # scan N is the one in progress: plc.scans counts the finished ones
         irq = getattr(self.plc, "interrupts", None)
@@ -208,7 +211,6 @@ class Session(SessionState):
             for row in self._watch_table():
                 self._print(row)
         self._resume = None
-        paused_at = time.monotonic()
         while self._resume is None:
             line = self._read(self._prompt())
             if line is None:

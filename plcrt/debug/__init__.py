@@ -1,10 +1,12 @@
 """``plcrt debug``: an interactive, scriptable debugger for a loaded PLC.
 
 :mod:`plcrt.debug.session` is the command interpreter (the input loop,
-breakpoints on networks and the paused mode inside a scan);
-:mod:`plcrt.debug.commands` holds its commands (scan, run, break, watch,
-set, force, show, axes, ...) and :mod:`plcrt.debug.panels` the tables and
-the ladder view with live values they print; :mod:`plcrt.debug.complete`
+breakpoints on networks and the paused mode inside a scan) over
+:mod:`plcrt.debug.state`, the state a session keeps and the operations the
+commands use; :mod:`plcrt.debug.commands` holds the commands (scan, run,
+break, watch, set, force, show, axes, ...) in a table of
+:class:`plcrt.debug.base.Command` entries, and :mod:`plcrt.debug.panels`
+the tables and the ladder view with live values they print; :mod:`plcrt.debug.complete`
 is Tab completion at the prompt; :mod:`plcrt.debug.cli` is the
 ``plcrt debug`` subcommand that wires a session to a terminal, a script file
 or a pipe.

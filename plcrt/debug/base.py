@@ -1,26 +1,20 @@
-"""What every module of debugger commands shares: :class:`Command`, one
-entry of the command table, and :class:`CommandError`.
+"""The entry type of the debugger's command table: :class:`Command`.
 
 The table itself is :data:`plcrt.debug.commands.COMMANDS`; the commands are
 written in :mod:`plcrt.debug.commands` and, for traces,
-:mod:`plcrt.debug.trace_commands`.  Both import these two names from here,
-so neither module needs the other at import time.  This module holds no
-command and no session state.
+:mod:`plcrt.debug.trace_commands`.  A handler receives the
+:class:`~plcrt.debug.state.SessionState` it acts on, never the interpreter
+(:class:`plcrt.debug.session.Session`), so the command modules and the
+interpreter import this module and :mod:`plcrt.debug.state`, not each other.
+This module holds no command and no session state.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    from .session import Session
-
-
-class CommandError(Exception):
-    """A command that cannot be carried out as written: printed as
-    ``error: <message>`` and the session goes on."""
+from .state import CommandError, SessionState
 
 
 @dataclass(frozen=True)
@@ -28,7 +22,7 @@ class Command:
     """One entry of the command table."""
 
     name: str
-    handler: Callable[[Session, list[str]], None]
+    handler: Callable[[SessionState, list[str]], None]
     usage: str
     summary: str
     details: str = ""

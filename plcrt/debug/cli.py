@@ -25,10 +25,11 @@ import os
 import sys
 from typing import Any
 
-from ..cli import (EXIT_ERROR, PROG, add_program_args, add_scan_ms_arg, load_for_run,
-                   print_diagnostics)
 from ..errors import PlcError
 from ..safetext import printable
+from ..term.options import add_program_args, add_scan_ms_arg, load_for_run
+from ..term.progress import check_max_wall
+from ..term.report import EXIT_ERROR, PROG, print_diagnostics
 
 #: readline history of interactive sessions (kept between sessions)
 HISTORY_FILE = "~/.plcrt_debug_history"
@@ -63,8 +64,6 @@ def register(sub: Any) -> None:
 def cmd_debug(args: argparse.Namespace) -> int:
     """Load, set up, run the session; returns the exit status."""
     from .session import CommandError, Session
-
-    from ..trace.progress import check_max_wall
 
     try:
         check_max_wall(args.max_wall)

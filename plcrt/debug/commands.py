@@ -2,15 +2,16 @@
 command.
 
 Each :class:`Command` names its handler, a function taking the
-:class:`~plcrt.debug.session.Session` and the words after the command
+:class:`~plcrt.debug.state.SessionState` and the words after the command
 name.  A handler raises :class:`CommandError` for a command that cannot be
 carried out as written; the session prints it as ``error: ...`` and goes
 on.  Commands that run scans do so inside the session's ``_scanning()``, so
 a fault, Ctrl-C and ``finish`` end them the same way.
 
 This module is not the session: reading input, the paused mode and the
-breakpoint probes live in :mod:`plcrt.debug.session`, whose internals the
-handlers use (they are one package).  The tables and the drawing are
+breakpoint probes live in :mod:`plcrt.debug.session`; the handlers use the
+state and operations of :mod:`plcrt.debug.state` (one package, so they reach
+its underscored members) and never import the interpreter.  The tables and the drawing are
 :mod:`plcrt.debug.panels`; the trace commands (``trace``, ``trend``,
 ``csv``, ``plot``) are :mod:`plcrt.debug.trace_commands`, entered into the
 same table.  Nothing here holds PLC semantics: values are
@@ -21,16 +22,14 @@ conditions are the test harness's.
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING
 
+from ..engine.values import parse_number
 from ..errors import PlcConfigError, PlcError
 from ..testing.harness import PlcTimeout, condition, reader, seconds
-from .base import Command, CommandError
+from .base import Command
 from .panels import axes_table, block_heading, drives_table, fmt, key_values, mode, ms, sim_time
+from .state import CommandError, SessionState
 from .trace_commands import TRACE_COMMANDS, trace_summary
-
-if TYPE_CHECKING:
-    from .session import Session
 
 #: ``run until`` gives up after this much simulated time unless told otherwise
 DEFAULT_UNTIL_TIMEOUT = "10s"
@@ -45,13 +44,13 @@ MAX_COMMAND_SCANS = 10_000_000
 # The handlers
 # ---------------------------------------------------------------------------
 
-def _cmd_scan(s: Session, args: list[str]) -> None:
+def _cmd_scan(s: SessionState, args: list[str]) -> None:
     n = _count(args, "scan", default=1)
     with s._scanning():
         s._scan(n)
 
 
-def _cmd_run(s: Session, args: list[str]) -> None:
+def _cmd_run(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("run needs a duration (run 1.5s, run 200ms, run 2) or "
                            "'until COND [timeout DURATION]'")
@@ -66,7 +65,7 @@ def _cmd_run(s: Session, args: list[str]) -> None:
         s._scan(n)
 
 
-def _run_until(s: Session, args: list[str]) -> None:
+def _run_until(s: SessionState, args: list[str]) -> None:
     timeout = DEFAULT_UNTIL_TIMEOUT
     low = [a.lower() for a in args]
     if "timeout" in low:
@@ -100,7 +99,7 @@ def _run_until(s: Session, args: list[str]) -> None:
                 s._print(f"{what!r} is true after {took:g} s")
 
 
-def _cmd_pulse(s: Session, args: list[str]) -> None:
+def _cmd_pulse(s: SessionState, args: list[str]) -> None:
     if not 1 <= len(args) <= 2:
         raise CommandError("write 'pulse ADDR [SCANS]'")
     addr = args[0]
@@ -119,7 +118,7 @@ def _cmd_pulse(s: Session, args: list[str]) -> None:
         s.plc.write(addr, old)
 
 
-def _cmd_break(s: Session, args: list[str]) -> None:
+def _cmd_break(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("write 'break NET' (OB1/3, SBR0/1 or 3); 'breaks' lists them")
     for text in args:
@@ -130,7 +129,7 @@ def _cmd_break(s: Session, args: list[str]) -> None:
                                                           else ""))
 
 
-def _cmd_delete(s: Session, args: list[str]) -> None:
+def _cmd_delete(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("write 'delete NET' or 'delete all'")
     if [a.lower() for a in args] == ["all"]:
@@ -148,7 +147,7 @@ def _cmd_delete(s: Session, args: list[str]) -> None:
         s._print(f"deleted the breakpoint before {net.name}")
 
 
-def _cmd_clear(s: Session, args: list[str]) -> None:
+def _cmd_clear(s: SessionState, args: list[str]) -> None:
     if args:
         # gdb's `clear LOCATION`: the breakpoints at these networks go
         _cmd_delete(s, args)
@@ -161,7 +160,7 @@ def _cmd_clear(s: Session, args: list[str]) -> None:
         s.out.flush()
 
 
-def _cmd_breaks(s: Session, args: list[str]) -> None:
+def _cmd_breaks(s: SessionState, args: list[str]) -> None:
     _no_args(args, "breaks")
     if not s._breaks:
         s._print("no breakpoints")
@@ -170,7 +169,7 @@ def _cmd_breaks(s: Session, args: list[str]) -> None:
         s._print(f"breakpoint before {s._label(s.coverage.networks[k])}")
 
 
-def _cmd_watch(s: Session, args: list[str]) -> None:
+def _cmd_watch(s: SessionState, args: list[str]) -> None:
     for spec in args:
         s.add_watch(spec)
     if not s._watches:
@@ -180,7 +179,7 @@ def _cmd_watch(s: Session, args: list[str]) -> None:
         s._print(line)
 
 
-def _cmd_unwatch(s: Session, args: list[str]) -> None:
+def _cmd_unwatch(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("write 'unwatch ADDR...' or 'unwatch all'")
     if [a.lower() for a in args] == ["all"]:
@@ -195,7 +194,7 @@ def _cmd_unwatch(s: Session, args: list[str]) -> None:
     s._print("watching " + (", ".join(w.spec for w in s._watches) or "nothing"))
 
 
-def _cmd_print(s: Session, args: list[str]) -> None:
+def _cmd_print(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("write 'print ADDR...' (VW100, Q0.0, VD4:REAL, T37)")
     for spec in args:
@@ -203,7 +202,7 @@ def _cmd_print(s: Session, args: list[str]) -> None:
         s._print(f"{spec} = {value}" + ("  (forced)" if forced else ""))
 
 
-def _cmd_set(s: Session, args: list[str]) -> None:
+def _cmd_set(s: SessionState, args: list[str]) -> None:
     pairs = _pairs(" ".join(args))
     if not pairs:
         raise CommandError("write 'set ADDR=VALUE...' (VALUE: 12, -3, 16#FF, 2#1010, 1.5)")
@@ -213,7 +212,7 @@ def _cmd_set(s: Session, args: list[str]) -> None:
         s._print(f"{spec} = {_written(s, addr, value)}")
 
 
-def _cmd_force(s: Session, args: list[str]) -> None:
+def _cmd_force(s: SessionState, args: list[str]) -> None:
     usage = "write 'force ADDR VALUE' (VALUE: 12, -3, 16#FF, 2#1010, 1.5)"
     if len(args) == 2 and "=" not in args[0]:
         pairs = [(args[0], args[1])]
@@ -230,7 +229,7 @@ def _cmd_force(s: Session, args: list[str]) -> None:
     s._print(f"forced {spec} = {_written(s, addr, value)}")
 
 
-def _cmd_unforce(s: Session, args: list[str]) -> None:
+def _cmd_unforce(s: SessionState, args: list[str]) -> None:
     if not args:
         raise CommandError("write 'unforce ADDR' or 'unforce all'")
     if [a.lower() for a in args] == ["all"]:
@@ -251,7 +250,7 @@ def _cmd_unforce(s: Session, args: list[str]) -> None:
             s._print(f"released {key} (it keeps {value} until the program changes it)")
 
 
-def _cmd_forces(s: Session, args: list[str]) -> None:
+def _cmd_forces(s: SessionState, args: list[str]) -> None:
     _no_args(args, "forces")
     if not s.plc.forces:
         s._print("no forces")
@@ -260,7 +259,7 @@ def _cmd_forces(s: Session, args: list[str]) -> None:
         s._print(f"{key} = {fmt(value)}")
 
 
-def _cmd_show(s: Session, args: list[str]) -> None:
+def _cmd_show(s: SessionState, args: list[str]) -> None:
     if args:
         wanted = [s._nets[(n.block, n.number)] for n in map(s._network, args)]
     else:
@@ -276,7 +275,7 @@ def _cmd_show(s: Session, args: list[str]) -> None:
         s._show_network(pou, network)
 
 
-def _cmd_axes(s: Session, args: list[str]) -> None:
+def _cmd_axes(s: SessionState, args: list[str]) -> None:
     _no_args(args, "axes")
     axes = s.plc.axes()
     if not axes:
@@ -286,7 +285,7 @@ def _cmd_axes(s: Session, args: list[str]) -> None:
         s._print(line)
 
 
-def _cmd_drives(s: Session, args: list[str]) -> None:
+def _cmd_drives(s: SessionState, args: list[str]) -> None:
     _no_args(args, "drives")
     drives = s.plc.drives()
     if not drives:
@@ -296,7 +295,7 @@ def _cmd_drives(s: Session, args: list[str]) -> None:
         s._print(line)
 
 
-def _cmd_status(s: Session, args: list[str]) -> None:
+def _cmd_status(s: SessionState, args: list[str]) -> None:
     _no_args(args, "status")
     plc = s.plc
     rows = [("time", f"{sim_time(plc)} s"),
@@ -320,22 +319,22 @@ def _cmd_status(s: Session, args: list[str]) -> None:
         s._print(line)
 
 
-def _cmd_continue(s: Session, args: list[str]) -> None:
+def _cmd_continue(s: SessionState, args: list[str]) -> None:
     _no_args(args, "continue")
     s._resume = "continue"
 
 
-def _cmd_next(s: Session, args: list[str]) -> None:
+def _cmd_next(s: SessionState, args: list[str]) -> None:
     _no_args(args, "next")
     s._resume = "next"
 
 
-def _cmd_finish(s: Session, args: list[str]) -> None:
+def _cmd_finish(s: SessionState, args: list[str]) -> None:
     _no_args(args, "finish")
     s._resume = "finish"
 
 
-def _cmd_help(s: Session, args: list[str]) -> None:
+def _cmd_help(s: SessionState, args: list[str]) -> None:
     if args:
         cmd = lookup(args[0])
         if cmd is None:
@@ -354,7 +353,7 @@ def _cmd_help(s: Session, args: list[str]) -> None:
              "symbols.  'help CMD' says more.")
 
 
-def _cmd_quit(s: Session, args: list[str]) -> None:
+def _cmd_quit(s: SessionState, args: list[str]) -> None:
     _no_args(args, "quit")
     if s._paused is not None:
         # The scan in progress cannot be abandoned half-way (the memory
@@ -364,22 +363,21 @@ def _cmd_quit(s: Session, args: list[str]) -> None:
         s._quit = True
 
 
-def _written(s: Session, addr: str, value: int | float) -> str:
+def _written(s: SessionState, addr: str, value: int | float) -> str:
     """The value now at ``addr``, read back the way it was written (a
     real as a real), so the answer shows any truncation."""
     return fmt(s.plc.read(addr, "REAL" if isinstance(value, float) and
                           s._location(addr)[2] == 4 else None))
 
 
-def _target(s: Session, spec: str, value_text: str) -> tuple[str, int | float]:
+def _target(s: SessionState, spec: str, value_text: str) -> tuple[str, int | float]:
     """Address and value of ``set``/``force``; ``VD4:REAL=2`` stores a REAL."""
-    from ..cli import parse_value
     addr, _, kind = spec.partition(":")
     kind = kind.strip().upper()
     if kind not in ("", "REAL"):
         raise CommandError(f"{spec}: only ':REAL' can follow an address here")
     try:
-        value = parse_value(value_text)
+        value = parse_number(value_text)
     except PlcConfigError as e:
         raise CommandError(f"{spec}: {e.message}") from None
     if kind == "REAL":
@@ -392,7 +390,7 @@ def _target(s: Session, spec: str, value_text: str) -> tuple[str, int | float]:
     return addr, value
 
 
-def _value(s: Session, spec: str) -> tuple[str, bool]:
+def _value(s: SessionState, spec: str) -> tuple[str, bool]:
     """(formatted value, forced?) of an address spec."""
     return fmt(reader(s.plc, spec)()), s._is_forced(spec)
 
@@ -427,7 +425,7 @@ def _count(args: list[str], cmd: str, default: int) -> int:
     return _bounded(int(args[0]), cmd)
 
 
-def _bounded(n: int, what: str, s: Session | None = None) -> int:
+def _bounded(n: int, what: str, s: SessionState | None = None) -> int:
     """``n`` scans, refused above :data:`MAX_COMMAND_SCANS`."""
     if n > MAX_COMMAND_SCANS:
         span = f" ({n:.3g} scans of {ms(s.plc.scan_us)} ms)" if s is not None else ""

@@ -77,7 +77,7 @@ def key_values(rows: Sequence[tuple[str, str]]) -> list[str]:
 def axes_table(axes: Sequence[dict[str, Any]]) -> list[str]:
     """The EM253 axes (entries of :meth:`plcrt.Plc.axes`, at least one):
     numbers right-aligned, the status left-aligned with its notes."""
-    from ..cli_tables import axis_rows, table_lines
+    from ..term.tables import axis_rows, table_lines
     head = ("slot", "axis", "position", "mechanical", "speed Hz", "status")
     return table_lines(head, axis_rows(axes), {len(head) - 1})
 
@@ -86,7 +86,7 @@ def drives_table(drives: Sequence[Any]) -> list[str]:
     """The bus drives (entries of :meth:`plcrt.Plc.drives`, at least one):
     numbers right-aligned, model and state left-aligned, the statusword in
     hex and decoded."""
-    from ..cli_tables import DRIVE_COLUMNS, drive_rows, table_lines
+    from ..term.tables import DRIVE_COLUMNS, drive_rows, table_lines
     return table_lines(DRIVE_COLUMNS, drive_rows(drives), {2, 3, len(DRIVE_COLUMNS) - 1})
 
 

@@ -6,7 +6,7 @@ the recorder of ``plcrt trace``: one sample at the end of every scan,
 stamped with the simulated time then.  ``trend`` prints its sparklines
 (:func:`plcrt.trace.trend`), ``csv`` and ``plot`` write its samples
 (:meth:`plcrt.trace.Trace.to_csv`, :func:`plcrt.trace.plot`).  A session
-has at most one trace, kept in ``Session._trace``; a new ``trace SIG...``
+has at most one trace, kept in ``SessionState._trace``; a new ``trace SIG...``
 replaces it.
 
 None of these commands runs a scan, so all of them work while paused at a
@@ -22,16 +22,13 @@ lists.
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING
 
 from ..trace.plot import plot
 from ..trace.recorder import Trace
 from ..trace.spark import trend
-from .base import Command, CommandError
+from .base import Command
 from .panels import key_values
-
-if TYPE_CHECKING:
-    from .session import Session
+from .state import CommandError, SessionState
 
 #: columns of ``trend`` without a width, as ``plcrt trace`` prints
 DEFAULT_TREND_WIDTH = 60
@@ -45,7 +42,7 @@ _NO_TRACE = "no trace yet: start one with 'trace SIG...' and run some scans"
 # The handlers
 # ---------------------------------------------------------------------------
 
-def _cmd_trace(s: Session, args: list[str]) -> None:
+def _cmd_trace(s: SessionState, args: list[str]) -> None:
     if not args:
         _list(s)
         return
@@ -60,7 +57,7 @@ def _cmd_trace(s: Session, args: list[str]) -> None:
     _start(s, args)
 
 
-def _start(s: Session, signals: list[str]) -> None:
+def _start(s: SessionState, signals: list[str]) -> None:
     old = s._trace
     # a bad signal raises here, before anything is attached: the old trace
     # (if any) goes on recording
@@ -74,7 +71,7 @@ def _start(s: Session, signals: list[str]) -> None:
     _stop_mode_note(s)
 
 
-def _stop(s: Session) -> None:
+def _stop(s: SessionState) -> None:
     trace = s._trace
     if trace is None:
         raise CommandError("no trace to stop")
@@ -87,7 +84,7 @@ def _stop(s: Session) -> None:
              f"trend, csv and plot)")
 
 
-def _clear(s: Session) -> None:
+def _clear(s: SessionState) -> None:
     old = s._trace
     if old is None:
         raise CommandError("no trace to clear: start one with 'trace SIG...'")
@@ -99,7 +96,7 @@ def _clear(s: Session) -> None:
     _stop_mode_note(s)
 
 
-def _list(s: Session) -> None:
+def _list(s: SessionState) -> None:
     trace = s._trace
     if trace is None:
         s._print("no trace (start one with 'trace SIG...')")
@@ -115,7 +112,7 @@ def _list(s: Session) -> None:
         s._print(line)
 
 
-def _cmd_trend(s: Session, args: list[str]) -> None:
+def _cmd_trend(s: SessionState, args: list[str]) -> None:
     width = DEFAULT_TREND_WIDTH
     if args:
         if len(args) > 1 or not re.fullmatch(r"\d+", args[0]) or \
@@ -129,7 +126,7 @@ def _cmd_trend(s: Session, args: list[str]) -> None:
         s._print("(a sample is taken at the end of each scan: run some scans)")
 
 
-def _cmd_csv(s: Session, args: list[str]) -> None:
+def _cmd_csv(s: SessionState, args: list[str]) -> None:
     path = _file(args, "csv FILE")
     trace = _need_trace(s)
     try:
@@ -139,7 +136,7 @@ def _cmd_csv(s: Session, args: list[str]) -> None:
     s._print(f"wrote {_samples(len(trace))} of {_names(trace)} to {path}")
 
 
-def _cmd_plot(s: Session, args: list[str]) -> None:
+def _cmd_plot(s: SessionState, args: list[str]) -> None:
     path = _file(args, "plot FILE.png|FILE.svg")
     trace = _need_trace(s)
     files = sorted({p.loc.file for p in s.plc.program.pous}) or [s.plc.program.file]
@@ -170,7 +167,7 @@ def _samples(n: int) -> str:
     return f"{n} sample{'' if n == 1 else 's'}"
 
 
-def _need_trace(s: Session) -> Trace:
+def _need_trace(s: SessionState) -> Trace:
     if s._trace is None:
         raise CommandError(_NO_TRACE)
     return s._trace
@@ -182,12 +179,12 @@ def _file(args: list[str], usage: str) -> str:
     return args[0]
 
 
-def _stop_mode_note(s: Session) -> None:
+def _stop_mode_note(s: SessionState) -> None:
     if s.plc.mode != "RUN":
         s._print("note: the CPU is in STOP mode: no scan runs, so nothing is recorded")
 
 
-def _symbol_note(s: Session, word: str) -> None:
+def _symbol_note(s: SessionState, word: str) -> None:
     """``trace Stop`` stops the trace even when the program has a symbol
     ``Stop``: say how to record that symbol instead."""
     lookup = getattr(s.plc.symbols, "lookup", None)

@@ -15,7 +15,8 @@
 * :mod:`.recorder`: :class:`Trace`, the per-scan recorder (numpy arrays, CSV);
 * :mod:`.spark`: :func:`sparkline` and :func:`trend`, plain-text quick looks;
 * :mod:`.plot`: :func:`plot` to PNG/SVG with matplotlib (optional);
-* :mod:`.progress`: :func:`run_with_progress`, ``plc.run`` with a progress bar;
+* :func:`run_with_progress`, ``plc.run`` with a progress bar, is
+  :mod:`plcrt.term.progress`'s (the ``plcrt`` commands share it), re-exported;
 * :mod:`.cli`: the ``plcrt trace`` command.
 
 See docs/traces.md.  matplotlib and rich are imported only when used.
@@ -30,15 +31,15 @@ from typing import TYPE_CHECKING, Any
 from .plot import plot
 
 if TYPE_CHECKING:
-    from .progress import run_with_progress
+    from ..term.progress import run_with_progress
     from .recorder import Trace
     from .spark import sparkline, trend
 
 __all__ = ["Trace", "plot", "run_with_progress", "sparkline", "trend"]
 
 #: public name -> the module that defines it (imported on first use)
-_LAZY = {"Trace": "recorder", "run_with_progress": "progress",
-         "sparkline": "spark", "trend": "spark"}
+_LAZY = {"Trace": ".recorder", "run_with_progress": "plcrt.term.progress",
+         "sparkline": ".spark", "trend": ".spark"}
 
 
 def __getattr__(name: str) -> Any:
@@ -46,5 +47,5 @@ def __getattr__(name: str) -> Any:
     # recorder (numpy) and the engine load only when a trace is made
     if name in _LAZY:
         import importlib
-        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -16,7 +16,8 @@ and the exit status is 2.
 
 Presentation only: recording, formatting and plotting live in the other
 modules of :mod:`plcrt.trace`; options shared with ``plcrt run`` are parsed
-by the helpers of :mod:`plcrt.cli`.
+by the helpers of :mod:`plcrt.term.options`, the run is paced by
+:mod:`plcrt.term.progress`.
 """
 
 from __future__ import annotations
@@ -35,8 +36,8 @@ EXIT_INTERRUPTED = 130
 
 def register(sub: Any) -> None:
     """Add the ``trace`` subcommand to the ``plcrt`` parser."""
-    from ..cli import (add_long_run_args, add_program_args, add_run_length_args,
-                       add_scan_ms_arg, add_set_args)
+    from ..term.options import (add_long_run_args, add_program_args, add_run_length_args,
+                                add_scan_ms_arg, add_set_args)
 
     p = sub.add_parser(
         "trace", help="run a program and record signals scan by scan (CSV, plot, sparklines)",
@@ -66,10 +67,10 @@ def register(sub: Any) -> None:
 
 def cmd_trace(args: argparse.Namespace) -> int:
     """``plcrt trace``: exit 0, 1 for bad input or options, 2 after a fault."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
-                       load_for_run, parse_sets, print_diagnostics)
+    from ..term.options import check_run_length, load_for_run, parse_sets
+    from ..term.progress import WallTimeExceeded, run_with_progress
+    from ..term.report import EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, print_diagnostics
     from .plot import plot, plot_format, require_matplotlib
-    from .progress import WallTimeExceeded, run_with_progress
     from .recorder import Trace
     from .spark import trend
 

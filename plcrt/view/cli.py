@@ -20,8 +20,8 @@ _NET_RE = re.compile(r"(?:([^/\s]+)\s*/\s*)?(\d+)")
 
 def register(sub: Any) -> None:
     """Add ``show`` to the subparsers of the ``plcrt`` command."""
-    from ..cli import (add_long_run_args, add_program_args, add_run_length_args,
-                       add_scan_ms_arg, add_set_args)
+    from ..term.options import (add_long_run_args, add_program_args, add_run_length_args,
+                                add_scan_ms_arg, add_set_args)
 
     p = sub.add_parser(
         "show", help="draw networks as ladder (LAD), optionally with live status",
@@ -47,8 +47,8 @@ def register(sub: Any) -> None:
 def cmd_show(args: argparse.Namespace) -> int:
     """``plcrt show``: 0 ok, 1 an input or option error, 2 a PLC fault while
     running for --status (the drawing then shows the state at the fault)."""
-    from ..cli import (EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, check_run_length,
-                       load_for_run, parse_sets, print_diagnostics)
+    from ..term.options import check_run_length, load_for_run, parse_sets
+    from ..term.report import EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_WALL, print_diagnostics
     from ..errors import PlcConfigError, PlcError, PlcRuntimeError, PlcSyntaxError
 
     fault: PlcError | None = None
@@ -81,7 +81,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     status = None
     stopped: PlcError | None = None
     if args.status:
-        from ..trace.progress import WallTimeExceeded, run_with_progress
+        from ..term.progress import WallTimeExceeded, run_with_progress
         from .status import PlcStatus
         loaded = len(plc.diagnostics)
         watch = dict(max_wall=args.max_wall, progress=args.progress)
@@ -142,7 +142,7 @@ def _names(symbols: Any) -> Any:
     without a table."""
     if symbols is None or not getattr(symbols, "entries", None):
         return None
-    from ..web.present import symbol_names
+    from .names import symbol_names
     names = symbol_names(symbols)
     return lambda text: names(text)[0]
 

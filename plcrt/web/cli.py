@@ -20,7 +20,7 @@ DEFAULT_PORT = 8253
 
 def register(sub: Any) -> None:
     """Add ``serve`` to the subparsers of the ``plcrt`` command."""
-    from ..cli import add_program_args, add_scan_ms_arg
+    from ..term.options import add_program_args, add_scan_ms_arg
 
     p = sub.add_parser(
         "serve", help="open a program in the browser panel (ladder, I/O, axes, trends)",
@@ -51,7 +51,8 @@ def build_panel(args: argparse.Namespace) -> Any:
     Raises:
         PlcError: the program does not load, or a bad option.
     """
-    from ..cli import load_from_args, print_diagnostics
+    from ..term.options import load_from_args
+    from ..term.report import print_diagnostics
     from . import course
     from .server import Panel
     from .session import PanelSession
@@ -110,7 +111,7 @@ def _loopback(host: str) -> bool:
 
 def cmd_serve(args: argparse.Namespace) -> int:
     """``plcrt serve``: 0 after Ctrl-C, 1 a program, option or port error."""
-    from ..cli import EXIT_ERROR, EXIT_OK, print_diagnostics
+    from ..term.report import EXIT_ERROR, EXIT_OK, print_diagnostics
     from ..errors import PlcConfigError, PlcError
     try:
         if not 0 <= args.port <= 65535:

@@ -1,18 +1,19 @@
 """What the panel shows of a PLC beside the ladder: watch values in their
-formats, symbol names with their comments, the input and output bits that
-become switches and lamps (and which kind of switch each input is), and
-the marks of axes and drives from the plant file.  Pure functions of a
-loaded PLC: no state, no threads, no web code (the runner,
-:mod:`plcrt.web.session`, calls them)."""
+formats, symbol names with their comments (:mod:`plcrt.view.names`,
+re-exported), the input and output bits that become switches and lamps
+(and which kind of switch each input is), and the marks of axes and
+drives from the plant file.  Pure functions of a loaded PLC: no state, no
+threads, no web code (the runner, :mod:`plcrt.web.session`, calls them)."""
 
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 from ..engine.runtime import Plc
 from ..errors import PlcError
+from ..view.names import symbol_names
 from .protocol import finite
 
 #: the most inputs and outputs shown as switches and lamps
@@ -31,28 +32,6 @@ def format_value(v: Any, fmt: str, width: int) -> str:
         digits = max(2, 2 * (width or 1))
         return f"16#{int(v) & ((1 << (4 * digits)) - 1):0{digits}X}"
     return str(v)
-
-
-def symbol_names(table: Any) -> Callable[[str], tuple[str, str]]:
-    """operand text -> (text shown, tooltip): ``name:address`` and the
-    symbol's comment when a symbol is involved."""
-    by_name: dict[str, Any] = dict(getattr(table, "entries", {}) or {})
-    by_addr: dict[str, Any] = {}
-    for s in by_name.values():
-        by_addr.setdefault(s.address.replace(" ", "").upper(), s)
-
-    def names(text: str) -> tuple[str, str]:
-        s = by_name.get(text)
-        if s is not None:
-            return f"{s.name}:{s.address}", f"{s.name} = {s.address}" + \
-                (f": {s.comment}" if s.comment else "")
-        s = by_addr.get(text.replace(" ", "").upper())
-        if s is not None:
-            return f"{s.name}:{text}", f"{s.name} = {s.address}" + \
-                (f": {s.comment}" if s.comment else "")
-        return text, ""
-
-    return names
 
 
 def io_bits(plc: Plc) -> tuple[list[str], list[str]]:

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from ..cli import SetItem, apply_sets, parse_sets
+from ..term.options import SetItem, apply_sets, parse_sets
 from ..engine.access import force_covers
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError

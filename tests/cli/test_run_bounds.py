@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from plcrt.cli import main
-from plcrt.trace.progress import MAX_RUN_US
+from plcrt.term.progress import MAX_RUN_US
 
 SEAL_IN = str(Path(__file__).resolve().parents[2] / "programs" / "seal_in.awl")
 

@@ -88,6 +88,24 @@ def test_time_paused_at_a_breakpoint_does_not_count() -> None:
     assert status == 0
 
 
+def test_drawing_the_network_at_a_stop_is_paused_time() -> None:
+    """The stop display (the network drawn with its values, the first
+    drawing imports the ladder view) is part of the pause: it used to count
+    as run time, so a slow first drawing ended the command by --max-wall."""
+    s, out = session(SEAL_IN)
+    s.max_wall = 0.5
+    show = s._show
+
+    def slow_show(net) -> None:
+        time.sleep(0.6)         # longer than the whole limit
+        show(net)
+
+    s._show = slow_show
+    status = s.run(["break 1", "scan 2", "continue", "continue"])
+    assert "stopped by --max-wall" not in out.getvalue()
+    assert status == 0
+
+
 def test_cli_max_wall_option(tmp_path) -> None:
     script = tmp_path / "s.txt"
     script.write_text(f"scan {MAX_COMMAND_SCANS}\nprint Q0.0\n", encoding="utf-8")

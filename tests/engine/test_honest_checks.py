@@ -14,7 +14,7 @@ import pytest
 import plcrt
 from plcrt import PlcCompileError, PlcConfigError, PlcRuntimeError, PlcSyntaxError
 from plcrt.cli import main
-from plcrt.trace.progress import WallTimeExceeded, run_with_progress
+from plcrt.term.progress import WallTimeExceeded, run_with_progress
 
 from stl_helpers import ob1_text
 

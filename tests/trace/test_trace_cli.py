@@ -191,7 +191,7 @@ def test_trace_ctrl_c_keeps_the_samples(tmp_path: Path, monkeypatch: pytest.Monk
     """Ctrl-C during a long run used to end plcrt with "interrupted" and no
     CSV: every sample was lost.  Now the samples so far are written, and a
     sample cut in half by the interruption is dropped."""
-    import plcrt.trace.progress as progress
+    import plcrt.term.progress as progress
 
     def interrupted(plc, **kw) -> None:
         plc.scan(5)

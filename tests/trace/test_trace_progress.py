@@ -11,7 +11,7 @@ import pytest
 import plcrt
 from plcrt.errors import PlcConfigError, PlcRuntimeError
 from plcrt.trace import Trace, run_with_progress
-from plcrt.trace.progress import MIN_SCANS_FOR_BAR, scan_count
+from plcrt.term.progress import MIN_SCANS_FOR_BAR, scan_count
 from stl_helpers import ob1_text
 
 PROGRAM = ob1_text("LD SM0.0\nINCW VW0", "LD I0.0\nTON T37, +20", "LD T37\n= Q0.0",

@@ -11,7 +11,8 @@ which says how far the simulated time got.  Scans are deterministic and
 independent of how they are grouped, so the results are the same either
 way.  rich is imported only when the bar is shown.
 
-This module does not record anything (see :mod:`plcrt.trace.recorder`).
+This module does not record anything (see :mod:`plcrt.trace.recorder`) and
+parses no option (see :mod:`plcrt.term.options`).
 """
 
 from __future__ import annotations

@@ -89,8 +89,16 @@ def _parser() -> Lark:
                                  "NAME": _retype_keyword})
 
 
+# perf: the bound lookup once; the callback runs for every mnemonic and name
+# token, and a method called on an imported name is not compiled as a
+# method call (CPython 3.11 builds a bound method each time)
+_keyword_type = KEYWORD_TYPES.get
+
+
 def _retype_keyword(token: Token) -> Token:
-    kind = KEYWORD_TYPES.get(token.value.upper())
+    """A MNEMONIC or NAME token spelled like a structural keyword becomes
+    that keyword's token (``stltext.KEYWORD_TYPES`` says why)."""
+    kind = _keyword_type(token.value.upper())
     if kind is None:
         return token
     return Token.new_borrow_pos(kind, token.value, token)

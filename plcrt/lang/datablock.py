@@ -47,7 +47,7 @@ from ..errors import Diagnostic, DiagnosticSink, SourceLoc
 from ..safetext import excerpt
 from .codepage import DEFAULT_CODEPAGE, MAX_STRING, string_bytes
 from .limits import too_many_digits
-from .stl import raise_collected
+from .stlerrors import raise_collected
 
 __all__ = ["DataBlock", "DataEntry", "parse_datablock"]
 

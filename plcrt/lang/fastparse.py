@@ -34,7 +34,7 @@ import re
 from ..errors import SourceLoc
 from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl
 from .limits import too_many_digits
-from .stl import _BLOCK_ID, _KEYWORD_TYPES, _SECTION_OF, _prepare
+from .stltext import BLOCK_ID, KEYWORD_TYPES, SECTION_OF, prepare
 
 __all__ = ["fast_parse"]
 
@@ -135,7 +135,7 @@ def _folded_lines(text: str) -> set[int]:
 
 
 def _parse(text: str, file: str) -> Program | None:
-    prepared = _prepare(text)
+    prepared = prepare(text)
     # perf: one scan in C; almost every text has no folded letter at all
     folded = _folded_lines(prepared) if _FOLDED.search(prepared) else set()
     lines = prepared.split("\n")
@@ -193,10 +193,10 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
     kind = _KINDS[kind_group - 1]
     first, second = header.group(4), header.group(5)
     for word in (first, second):
-        if word is not None and word.upper() in _KEYWORD_TYPES:
+        if word is not None and word.upper() in KEYWORD_TYPES:
             return None             # lark re-types it and rejects the header
     id_text = second if second is not None else first
-    match = _BLOCK_ID.fullmatch(id_text)
+    match = BLOCK_ID.fullmatch(id_text)
     if (match is None or too_many_digits(match.group(2))
             or match.group(1).upper() != kind):
         return None                 # lark's builder reports these
@@ -224,7 +224,7 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
             else:
                 comments.append(m.group(1).strip())
         elif m := _VAR_LINE.match(line):
-            section = _SECTION_OF.get(m.group(1).upper())
+            section = SECTION_OF.get(m.group(1).upper())
             if section is None:
                 return None         # "VAR_İNPUT": matched by /i, no such section
             while True:
@@ -240,8 +240,8 @@ def _block(lines: list[str], index: int, header: re.Match[str], file: str,
                 if d is None:
                     return None
                 var_name, var_type = d.group(1), d.group(2)
-                if (var_name.upper() in _KEYWORD_TYPES
-                        or var_type.upper() in _KEYWORD_TYPES):
+                if (var_name.upper() in KEYWORD_TYPES
+                        or var_type.upper() in KEYWORD_TYPES):
                     return None
                 comment = d.group(3)
                 variables.append(VarDecl(

@@ -5,7 +5,10 @@ Micro/WIN SMART, in any of the dialects seen in real files) into an
 :class:`~plcrt.lang.ir.Program`, and decodes such files from disk.  The
 grammar lives in ``grammar/stl.lark``; lark builds the parse tree and this
 module walks it into immutable IR nodes that all carry a
-:class:`~plcrt.errors.SourceLoc`.
+:class:`~plcrt.errors.SourceLoc`.  The words of the text that the fast path
+reads too (keywords, block ids, VAR sections, line ends) are in
+:mod:`plcrt.lang.stltext`; how a syntax error is worded is in
+:mod:`plcrt.lang.stlerrors`.
 
 It is *not* a checker: mnemonics and operands are kept as written, and
 whether ``LDX`` exists or ``MOVW`` got a word operand is the compiler's
@@ -24,7 +27,6 @@ source of syntax errors.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -33,12 +35,16 @@ from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from ..errors import DiagnosticSink, PlcSyntaxError, SourceLoc
-from ..safetext import EXCERPT_CHARS, excerpt
+from ..safetext import excerpt
 from .encoding import read_decoded
-from .limits import MAX_DIGITS, too_many_digits
-from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl, VarSection
+from .fastparse import fast_parse
+from .ir import Insn, Network, Operand, Pou, PouKind, Program, VarDecl
+from .limits import too_many_digits
+from .stlerrors import describe, raise_collected
+from .stltext import BLOCK_ID, KEYWORD_TYPES, SECTION_OF, prepare
 
-__all__ = ["parse_program", "read_source"]
+# raise_collected is re-exported: its home is plcrt.lang.stlerrors
+__all__ = ["parse_program", "parse_program_lark", "raise_collected", "read_source"]
 
 # Stop collecting after this many syntax errors: past that point the user is
 # better served by fixing the first ones than by reading a long list.
@@ -83,25 +89,16 @@ def _parser() -> Lark:
                                  "NAME": _retype_keyword})
 
 
-# Structural keywords that the generic MNEMONIC / NAME regexes also match.
-# The contextual lexer only tries terminals the parser can accept, so inside
-# a network "SUBROUTINE_BLOCK" would lex as a mnemonic and a missing
-# END_ORGANIZATION_BLOCK would surface only much later.  Re-typing such a
-# token makes the parser reject it on the spot with a precise message.
-_KEYWORD_TYPES = {
-    "ORGANIZATION_BLOCK": "OB_KW",
-    "SUBROUTINE_BLOCK": "SBR_KW",
-    "INTERRUPT_BLOCK": "INT_KW",
-    "END_ORGANIZATION_BLOCK": "END_OB",
-    "END_SUBROUTINE_BLOCK": "END_SBR",
-    "END_INTERRUPT_BLOCK": "END_INT",
-    "BEGIN": "BEGIN",
-    "END_VAR": "END_VAR",
-}
+# perf: the bound lookup once; the callback runs for every mnemonic and name
+# token, and a method called on an imported name is not compiled as a
+# method call (CPython 3.11 builds a bound method each time)
+_keyword_type = KEYWORD_TYPES.get
 
 
 def _retype_keyword(token: Token) -> Token:
-    kind = _KEYWORD_TYPES.get(token.value.upper())
+    """A MNEMONIC or NAME token spelled like a structural keyword becomes
+    that keyword's token (``stltext.KEYWORD_TYPES`` says why)."""
+    kind = _keyword_type(token.value.upper())
     if kind is None:
         return token
     return Token.new_borrow_pos(kind, token.value, token)
@@ -119,9 +116,6 @@ def parse_program(text: str, file: str = "<string>") -> Program:
     :mod:`plcrt.lang.fastparse`, which gives the same program; anything it
     is not sure of goes to lark (:func:`parse_program_lark`).
     """
-    # imported here: fastparse builds on this module's tables
-    from .fastparse import fast_parse
-
     program = fast_parse(text, file)
     if program is not None:
         return program
@@ -131,7 +125,7 @@ def parse_program(text: str, file: str = "<string>") -> Program:
 def parse_program_lark(text: str, file: str = "<string>") -> Program:
     """:func:`parse_program` through lark only: the reference the fast path
     is tested against, and the path that reports syntax errors."""
-    prepared = _prepare(text)
+    prepared = prepare(text)
     sink = DiagnosticSink()
     tree, broken = _parse_collecting(prepared, file, sink)
     pous: list[Pou] = []
@@ -145,40 +139,6 @@ def parse_program_lark(text: str, file: str = "<string>") -> Program:
             e.partial = Program(pous=good, file=file, source=text)
             raise
     return Program(pous=tuple(pous), file=file, source=text)
-
-
-def raise_collected(sink: DiagnosticSink) -> None:
-    """Raise one :class:`PlcSyntaxError` for all errors in ``sink``, if any.
-
-    Unlike ``DiagnosticSink.raise_if_errors`` the exception's ``message`` and
-    ``loc`` are those of the first error, so a caller that shows only one line
-    still shows something useful; ``str()`` lists every diagnostic.  Shared
-    by the symbol-table and data-block readers.
-    """
-    errors = sink.errors
-    if not errors:
-        return
-    first = errors[0]
-    message = first.message
-    if len(errors) > 1:
-        message += f" (and {len(errors) - 1} more error(s))"
-    raise PlcSyntaxError(message, first.loc, sink.items)
-
-
-def _prepare(text: str) -> str:
-    """Normalise line ends so that lark sees LF only, keeping line numbers.
-
-    A lone CR counts as a line end (old Mac files); CRLF becomes one LF, so
-    line numbers match what an editor shows.  A final newline is added because
-    every grammar line ends in one.  A leading byte-order mark is dropped.
-    """
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    if "\r" in text:
-        text = text.replace("\r\n", "\n").replace("\r", "\n")
-    if not text.endswith("\n"):
-        text += "\n"
-    return text
 
 
 _BLOCK_START = re.compile(
@@ -215,7 +175,7 @@ def _parse_collecting(text: str, file: str,
         try:
             return parser.parse("\n".join(work)), broken
         except UnexpectedInput as exc:
-            loc, message = _describe(exc, "\n".join(work), file, lines)
+            loc, message = describe(exc, "\n".join(work), file, lines)
             sink.error(message, loc, code="syntax")
             if len(sink.errors) >= _MAX_SYNTAX_ERRORS:
                 return None, broken
@@ -249,155 +209,6 @@ def _parse_collecting(text: str, file: str,
 
 
 # --------------------------------------------------------------------------
-# Error messages
-# --------------------------------------------------------------------------
-
-# How terminals are named in messages.
-_TERMINAL_WORDS = {
-    "OB_KW": "ORGANIZATION_BLOCK",
-    "SBR_KW": "SUBROUTINE_BLOCK",
-    "INT_KW": "INTERRUPT_BLOCK",
-    "END_OB": "END_ORGANIZATION_BLOCK",
-    "END_SBR": "END_SUBROUTINE_BLOCK",
-    "END_INT": "END_INTERRUPT_BLOCK",
-    "BEGIN": "BEGIN",
-    "VAR_KW": "VAR section",
-    "END_VAR": "END_VAR",
-    "NETWORK": "Network",
-    "TITLE": "TITLE=",
-    "COMMENT": "comment",
-    "MNEMONIC": "instruction",
-    "OPERAND": "operand",
-    "STRING": "operand",
-    "NAME": "name",
-    "NET_NUMBER": "network number",
-    "COLON": "':'",
-    "SEMICOLON": "';'",
-    "COMMA": "','",
-    "_NL": "end of line",
-    "$END": "end of file",
-}
-_END_OF = {"END_OB": "ORGANIZATION_BLOCK", "END_SBR": "SUBROUTINE_BLOCK",
-           "END_INT": "INTERRUPT_BLOCK"}
-
-
-def _describe(exc: UnexpectedInput, text: str, file: str,
-              lines: list[str]) -> tuple[SourceLoc, str]:
-    """Turn a lark exception into a location and a short message."""
-    expected: set[str]
-    if isinstance(exc, UnexpectedToken):
-        token = exc.token
-        expected = set(exc.expected)
-        if token.type == "$END":
-            # lark places $END on the last token; point after the last
-            # non-blank line instead, where the missing text belongs.
-            line, column = _end_position(lines)
-            found = "end of file"
-        else:
-            line, column = token.line or 1, token.column or 1
-            found = _describe_found(token)
-    elif isinstance(exc, UnexpectedCharacters):
-        line, column = exc.line, exc.column
-        expected = set(exc.allowed or ())
-        pos = exc.pos_in_stream or 0
-        char = text[pos] if pos < len(text) else ""
-        if char in ("'", '"'):
-            _, block, network = _open_block(lines, line)
-            loc = SourceLoc(file, line, column, block, network if block else None)
-            return loc, f"unterminated string literal (missing closing {char})"
-        found = repr(excerpt(_word_at(text, pos)))
-    else:  # UnexpectedEOF and future kinds
-        line, column = _end_position(lines)
-        expected = set(getattr(exc, "expected", ()) or ())
-        found = "end of file"
-    keyword, block, network = _open_block(lines, line)
-    loc = SourceLoc(file, max(line, 1), max(column, 1), block,
-                    network if block else None)
-    ends = sorted(t for t in expected if t in _END_OF)
-    if keyword is not None:
-        # LALR merges the states of the three block kinds, so all three END
-        # keywords may be "expected"; the open block says which one is meant.
-        ends = [t for t in ends if _END_OF[t] == keyword] or ends
-        expected = {t for t in expected
-                    if t not in _END_OF or _END_OF[t] == keyword}
-    if ends and isinstance(exc, UnexpectedToken) and exc.token.type in _END_OF:
-        words = " or ".join(_TERMINAL_WORDS[t] for t in ends)
-        return loc, f"{found} does not close this block; expected {words}"
-    if ends and (found == "end of file" or isinstance(exc, UnexpectedToken)
-                 and exc.token.type in ("OB_KW", "SBR_KW", "INT_KW")):
-        words = " or ".join(_TERMINAL_WORDS[t] for t in ends)
-        return loc, f"missing {words} before {found}"
-    if expected & {"OB_KW", "SBR_KW", "INT_KW"}:
-        # Between blocks a blank line is always fine; saying so is noise.
-        expected.discard("_NL")
-    return loc, f"unexpected {found}; expected {_expected_words(expected)}"
-
-
-def _describe_found(token: Token) -> str:
-    if token.type == "_NL":
-        return "end of line"
-    return repr(excerpt(str(token.value)))
-
-
-def _word_at(text: str, pos: int) -> str:
-    """The run of non-blank characters starting at ``pos`` (for messages)."""
-    end = pos
-    while end < len(text) and end - pos <= EXCERPT_CHARS and not text[end].isspace():
-        end += 1
-    return text[pos:end] if end > pos else text[pos:pos + 1]
-
-
-def _expected_words(expected: Iterable[str]) -> str:
-    words = sorted({_TERMINAL_WORDS.get(t, t) for t in expected})
-    # A long list helps nobody; the line is usually clear from context.
-    if not words:
-        return "something else"
-    if len(words) > 5:
-        return ", ".join(words[:5]) + ", ..."
-    if len(words) == 1:
-        return words[0]
-    return ", ".join(words[:-1]) + " or " + words[-1]
-
-
-def _end_position(lines: list[str]) -> tuple[int, int]:
-    for index in range(len(lines) - 1, -1, -1):
-        if lines[index].strip():
-            return index + 1, len(lines[index].rstrip()) + 1
-    return 1, 1
-
-
-_CTX_HEADER = re.compile(
-    r"[ \t]*(ORGANIZATION_BLOCK|SUBROUTINE_BLOCK|INTERRUPT_BLOCK)[ \t]+"
-    r"(?:[^:\s]*:)?[ \t]*(\w+)", re.I)
-_CTX_END = re.compile(r"[ \t]*END_(?:ORGANIZATION|SUBROUTINE|INTERRUPT)_BLOCK", re.I)
-_CTX_NETWORK = re.compile(r"[ \t]*NETWORK[ \t]*([0-9]{1,%d})(?![0-9])" % MAX_DIGITS, re.I)
-
-
-def _open_block(lines: list[str], line: int) -> tuple[str | None, str | None, int | None]:
-    """Return (header keyword, block id, network) open at ``line``.
-
-    Only computed on the error path, by a plain scan of the lines before the
-    error, because no parse tree exists for a broken text.  The error line
-    itself counts only when it is a Network line: an error *on* a block header
-    or END line belongs to the block that was open before it.
-    """
-    keyword: str | None = None
-    block: str | None = None
-    network: int | None = None
-    for text in lines[:line - 1]:
-        if m := _CTX_HEADER.match(text):
-            keyword, block, network = m.group(1).upper(), m.group(2).upper(), None
-        elif _CTX_END.match(text):
-            keyword, block, network = None, None, None
-        elif block is not None and (m := _CTX_NETWORK.match(text)):
-            network = int(m.group(1))
-    if block is not None and 0 < line <= len(lines):
-        if m := _CTX_NETWORK.match(lines[line - 1]):
-            network = int(m.group(1))
-    return keyword, block, network
-
-
-# --------------------------------------------------------------------------
 # Tree -> IR
 # --------------------------------------------------------------------------
 
@@ -405,10 +216,6 @@ _KIND_OF_RULE: dict[str, PouKind] = {
     "ob_block": "OB", "sbr_block": "SBR", "int_block": "INT"}
 _KEYWORD_OF_KIND = {"OB": "ORGANIZATION_BLOCK", "SBR": "SUBROUTINE_BLOCK",
                     "INT": "INTERRUPT_BLOCK"}
-_BLOCK_ID = re.compile(r"(OB|SBR|INT)([0-9]+)", re.I)
-_SECTION_OF: dict[str, VarSection] = {
-    "VAR_INPUT": "IN", "VAR_IN_OUT": "IN_OUT", "VAR_OUTPUT": "OUT",
-    "VAR": "TEMP", "VAR_TEMP": "TEMP"}
 
 
 def _comment_text(token: Token) -> str:
@@ -479,11 +286,11 @@ class _Builder:
         """Return (name, ident, number) of ``MAIN:OB1`` or ``OB1``."""
         tokens = [t for t in ref.children if isinstance(t, Token)]
         id_token = tokens[-1]
-        match = _BLOCK_ID.fullmatch(str(id_token))
+        match = BLOCK_ID.fullmatch(str(id_token))
         if match is not None and too_many_digits(match.group(2)):
             self.sink.error(f"block number of {excerpt(str(id_token))!r} is out of range",
                             self.loc(id_token), code="syntax")
-            match = _BLOCK_ID.fullmatch(f"{match.group(1)}0")
+            match = BLOCK_ID.fullmatch(f"{match.group(1)}0")
         if match is None:
             self.sink.error(
                 f"block id {excerpt(str(id_token))!r} is not of the form "
@@ -506,7 +313,7 @@ class _Builder:
     def var_section(self, tree: Tree, block: str) -> list[VarDecl]:
         head = tree.children[0]
         assert isinstance(head, Token)
-        section = _SECTION_OF.get(str(head).upper())
+        section = SECTION_OF.get(str(head).upper())
         if section is None:
             # VAR_KW is matched case-insensitively, and Python folds "İ" onto
             # "I" there: "VAR_İNPUT" is a VAR_KW token that names no section

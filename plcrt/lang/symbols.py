@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 from ..errors import Diagnostic, DiagnosticSink, PlcSyntaxError, SourceLoc
 from ..safetext import excerpt
-from .stl import raise_collected
+from .stlerrors import raise_collected
 
 __all__ = ["SYSTEM_SYMBOLS", "Symbol", "SymbolTable", "parse_symbols",
            "resolve_symbol"]

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from ..errors import Diagnostic, DiagnosticSink, PlcError, SourceLoc
+from ..isa.libraries import interfaces
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
@@ -25,16 +26,13 @@ from ..lang.codepage import program_codepage
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
 from .constpower import ConstantPower, contact_value
-from .emit import CodegenError, Gen
+from ..gen.emit import CodegenError, Gen
+from ..gen.limits import MAX_FOR_NESTING, MAX_NESTING, MAX_STACK
 from .locs import LineLocs, LocTable
-from .resolve import LocalVar, ResolveError, Resolver, layout_locals
-
-#: S7-200: subroutines nest at most eight levels (System Manual, CALL).
-MAX_NESTING = 8
-MAX_FOR_NESTING = 8
+from ..gen.resolve import LocalVar, ResolveError, Resolver, layout_locals
 
 #: depth of the S7-200 logic stack (System Manual, "Logic stack")
-MAX_STACK_LEVELS = 9
+MAX_STACK_LEVELS = MAX_STACK
 
 # Flow kinds that start a new piece at the instruction / after it.
 _CUT_BEFORE = {"label"}
@@ -889,7 +887,6 @@ def _empty_library_blocks(unit: Unit) -> None:
     its interface and an empty body: its calls run nothing here.  Blocks
     plcrt emulates by name (a library interface in ``library/``) are left
     to that emulation."""
-    from ..blocks.interface import interfaces
     emulated = interfaces()
     called = {callee for info in unit.pous.values() for callee in info.calls}
     for ident in called:

@@ -27,9 +27,9 @@ from __future__ import annotations
 import struct
 from typing import Any, Callable
 
-from ..emit import VALUE_WIDTH, const_expr
-from ..operands import Addr, Const, Pointer
-from ...engine.timers import MAX_CV, resolution_ms
+from ...gen.exprs import VALUE_WIDTH, const_expr
+from ...gen.operands import Addr, Const, Pointer
+from ...memory.hardware import MAX_CV, resolution_ms
 
 #: the buffers a segment can reach, in the order of the context table
 SLOTS = ("I", "Q", "M", "V", "SM", "S", "TV", "TB", "CV", "CB", "AC", "AI", "AQ",

@@ -29,7 +29,7 @@ from ..lang.codepage import program_codepage
 from . import cache
 from .callgraph import check_calls
 from .locs import LineLocs
-from .network import MAX_STACK_LEVELS, emit_piece, network_probe, plcrt_bug
+from .network import emit_piece, network_probe, plcrt_bug
 from .pieces import build_unit, split_pieces
 from .unit import Compiled, Piece, PouInfo, Unit
 
@@ -246,7 +246,8 @@ def _runner(unit: Unit, info: PouInfo, fnames: list[str],
     ]
 
 
-# the compiler's other modules' names, where they were before the split
-__all__ = ["GROUP_LINES", "GROUP_PIECES", "MAX_FOR_NESTING", "MAX_NESTING", "MAX_STACK_LEVELS",
-           "Compiled", "Piece", "PouInfo", "Unit", "build_unit", "check_calls", "emit_piece",
-           "generate", "plcrt_bug", "split_pieces"]
+# also the names of the modules split off this one (.unit, .pieces, .callgraph,
+# .network) and of the limits, importable from here as before
+__all__ = ["GROUP_LINES", "GROUP_PIECES", "MAX_FOR_NESTING", "MAX_NESTING", "Compiled",
+           "Piece", "PouInfo", "Unit", "build_unit", "check_calls", "emit_piece", "generate",
+           "plcrt_bug", "split_pieces"]

@@ -23,9 +23,6 @@ from ..safetext import excerpt
 from .constpower import ConstantPower, contact_value
 from .unit import Piece, Unit
 
-#: depth of the S7-200 logic stack (System Manual, "Logic stack")
-MAX_STACK_LEVELS = MAX_STACK
-
 
 def network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:
     """Mark the network as run; the first piece also checks for a breakpoint."""
@@ -76,7 +73,7 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     instruction is not a contact (nothing emitted).
     """
     shp = shape(insn.mnemonic)
-    if shp.kind != "contact" or gen.depth >= MAX_STACK_LEVELS:
+    if shp.kind != "contact" or gen.depth >= MAX_STACK:
         return False
     if contact_value(insn.mnemonic, ops) is not None:
         return False            # a constant bit (SM0.0) is no coverage goal
@@ -216,4 +213,4 @@ def plcrt_bug(what: str, exc: BaseException) -> str:
             f"program")
 
 
-__all__ = ["MAX_STACK_LEVELS", "emit_piece", "network_probe", "plcrt_bug"]
+__all__ = ["emit_piece", "network_probe", "plcrt_bug"]

@@ -25,7 +25,6 @@ from .unit import Piece, PouInfo, Unit, pou_fname
 
 # Flow kinds that start a new piece at the instruction / after it.
 _CUT_BEFORE = {"label"}
-
 _CUT_AFTER = {"for", "next", "scre"}
 
 

@@ -13,7 +13,10 @@ from ..errors import DiagnosticSink, PlcCompileError, PlcError
 from ..lang import ir
 from ..lang.limits import MAX_INSTRUCTIONS, MAX_NETWORKS
 from ..memory.cpu import CpuModel
-from .codegen import Compiled, Unit, build_unit, generate, plcrt_bug
+from .codegen import generate
+from .network import plcrt_bug
+from .pieces import build_unit
+from .unit import Compiled, Unit
 
 
 def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None,

@@ -43,13 +43,14 @@ from dataclasses import dataclass
 from typing import Any, Iterable
 
 from ..errors import Diagnostic, PlcConfigError, SourceLoc
+from ..gen.operands import Addr, Name, OperandError, parse_constant, parse_operand
+from ..gen.resolve import LocalVar, ResolveError, Resolver, layout_locals
+from ..isa.libraries import interfaces
 from ..isa.registry import Role, Span, lookup
 from ..lang import ir
 from ..lang.symbols import Symbol, SymbolTable
 from ..memory.cpu import CpuModel
 from ..safetext import excerpt
-from .operands import Addr, Name, OperandError, parse_constant, parse_operand
-from .resolve import LocalVar, ResolveError, Resolver, layout_locals
 
 __all__ = ["auto_symbols"]
 
@@ -281,7 +282,6 @@ def _subroutine_params(program: ir.Program, layouts: dict[str, dict[str, LocalVa
     its parameters in call order; the library blocks' too."""
     out: dict[str, list[str | int]] = {}
     try:
-        from ..blocks.interface import interfaces
         for name, itf in interfaces().items():
             out[name] = [_TYPE_KIND.get(p.type, 4) for p in itf.params]
     except PlcConfigError:      # a bad library file: the compiler reports it

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..gen.operands import Addr
 from ..isa.shape import shape
-from .operands import Addr
 
 #: (area, byte, bit) -> its value in every scan of RUN mode.  S7-200 System
 #: Manual, "Special memory bits" (SMB0): SM0.0 is always on.  SM0.1 (first

@@ -193,7 +193,7 @@ _CENTURY_S = int((_dt.datetime(LAST_YEAR + 1, 1, 1) - _EPOCH).total_seconds())
 
 #: GPA/SPA ports and station addresses (S7-200 System Manual, "Get Port
 #: Address and Set Port Address": PPI station addresses 0..126)
-PORTS = (0, 1)
+from ..memory.hardware import PORTS  # noqa: E402
 ADDRESS_RANGE = range(0, 127)
 DEFAULT_ADDRESS = 2   #: Micro/WIN's default CPU station address
 

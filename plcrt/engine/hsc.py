@@ -53,9 +53,7 @@ INPUTS: dict[int, tuple[Optional[int], ...]] = {
     0: (0, 1, 2, None), 1: (6, 7, 8, 9), 2: (10, 11, 12, 13),
     3: (1, None, None, None), 4: (3, 4, 5, None), 5: (4, None, None, None)}
 #: counter -> the modes it has
-MODES: dict[int, tuple[int, ...]] = {
-    0: (0, 1, 3, 4, 6, 7, 9, 10, 12), 1: tuple(range(12)), 2: tuple(range(12)),
-    3: (0, 12), 4: (0, 1, 3, 4, 6, 7, 9, 10), 5: (0,)}
+from ..memory.hardware import MODES  # noqa: E402
 #: counter -> interrupt events (CV=PV, direction changed, external reset)
 EVENTS: dict[int, tuple[Optional[int], ...]] = {
     0: (12, 27, 28), 1: (13, 14, 15), 2: (16, 17, 18), 3: (32, None, None),

@@ -46,7 +46,7 @@ from typing import Any, Callable
 
 __all__ = ["PidLoops", "TABLE_BYTES"]
 
-TABLE_BYTES = 36
+from ..memory.hardware import TABLE_BYTES  # noqa: E402
 _TABLE = struct.Struct(">9f")
 _OUT = struct.Struct(">f")
 

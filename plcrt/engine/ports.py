@@ -41,7 +41,7 @@ __all__ = ["Port", "make_ports", "attach_devices", "PORTS_OF", "STATUS"]
 #: receive-character event, transmit-complete event, message event, SMB4 idle bit)
 _LAYOUT = {0: (30, 86, 87, 8, 9, 23, 0x20), 1: (130, 186, 187, 25, 26, 24, 0x40)}
 #: CPU model -> its ports (CPU 221, 222 and 224 have one, 224XP and 226 two)
-PORTS_OF = {"CPU221": 1, "CPU222": 1, "CPU224": 1, "CPU224XP": 2, "CPU226": 2}
+from ..memory.hardware import PORTS_OF  # noqa: E402
 #: SMB86 status bits: why the receive ended
 STATUS = {"user": 0x80, "parameter": 0x40, "end": 0x20, "timer": 0x04, "count": 0x02,
           "parity": 0x01}

@@ -44,23 +44,7 @@ from struct import Struct
 _H = Struct(">h")
 _UH = Struct(">H")
 
-MAX_CV = 32767
-
-TONR_RES = {0: 1, 64: 1, **{n: 10 for n in (1, 2, 3, 4, 65, 66, 67, 68)}}
-TON_RES = {32: 1, 96: 1, **{n: 10 for n in (33, 34, 35, 36, 97, 98, 99, 100)}}
-
-
-def timer_kind_ok(kind: str, n: int) -> bool:
-    """Whether timer number ``n`` may be used by a ``kind`` box (TON/TOF/TONR)."""
-    tonr = n < 32 or 64 <= n < 96
-    return tonr if kind == "TONR" else not tonr
-
-
-def resolution_ms(n: int) -> int:
-    """Resolution of timer ``n`` in milliseconds (1, 10 or 100)."""
-    if n < 32 or 64 <= n < 96:
-        return TONR_RES.get(n, 100)
-    return TON_RES.get(n, 100)
+from ..memory.hardware import MAX_CV, resolution_ms, timer_kind_ok  # noqa: E402, F401
 
 
 class TimerBank:

@@ -8,9 +8,9 @@ ranges; each instruction checks its own values and says which it takes.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Const
-from ..compiler.resolve import ResolveError
+from ..gen.emit import Gen
+from ..gen.operands import Const
+from ..gen.resolve import ResolveError
 
 __all__ = ["operand_texts", "int_constant"]
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 from decimal import ROUND_HALF_UP, Decimal
 from typing import Callable
 
-from ..compiler.emit import Gen
+from ..gen.emit import Gen
 from .region import region, runtime_error
 from .registry import Role, Span, insn
 

@@ -9,8 +9,8 @@ top without changing the stack.  Immediate contacts read the physical input
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const
+from ..gen.emit import Gen
+from ..gen.operands import Addr, Const, area_size
 from ..safetext import excerpt
 from .registry import Role, Span, insn
 
@@ -173,7 +173,6 @@ def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
             return
         start = op.offset * 8 + op.bit
         end = start + count
-        from ..compiler.operands import area_size
         size = area_size(g.unit.model, op.area) if op.area != "PQ" else g.unit.model.q_bytes
         if (end + 7) // 8 > size:
             g.fail(f"{count} bits from {excerpt(op.text)} run past the end of the {op.area} area")

@@ -16,7 +16,7 @@ ENO is 0.  No SMB1 bit changes.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
+from ..gen.emit import Gen
 from .region import region, runtime_error
 from .registry import Role, Span, insn
 

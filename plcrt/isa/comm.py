@@ -14,13 +14,13 @@ selected, a busy port, a bad table).  The ports and jobs are
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import POINTER_AREAS, Addr, Indirect
-from ..compiler.resolve import ResolveError
-from ..engine.ports import PORTS_OF
-from ..isa.registry import insn
+from ..gen.emit import Gen
+from ..gen.operands import POINTER_AREAS, Addr, Indirect
+from ..gen.resolve import ResolveError
+from ..memory.hardware import PORTS_OF
 from ..safetext import excerpt
 from .args import int_constant, operand_texts
+from .registry import insn
 
 F = "communications"
 _TABLE_AREAS = ("I", "Q", "M", "S", "SM", "V")

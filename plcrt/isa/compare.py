@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Const
 from ..errors import PlcRuntimeError, SourceLoc
+from ..gen.emit import Gen
+from ..gen.operands import Const
 from .registry import Role, insn
 
 F = "compare"

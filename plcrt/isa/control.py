@@ -12,11 +12,12 @@ leaves the POU).  POUs without control flow pay nothing for it.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const, Pointer
-from ..compiler.resolve import ResolveError, check_role
-from ..isa.registry import Role, insn
+from ..gen.emit import Gen
+from ..gen.limits import MAX_NESTING
+from ..gen.operands import Addr, Const, Pointer
+from ..gen.resolve import ResolveError, Resolver, check_role
 from ..safetext import excerpt
+from .registry import Role, insn
 
 F = "control"
 
@@ -127,7 +128,6 @@ def _next(g: Gen) -> None:
     if fp is None:
         g.fail("NEXT without a matching FOR", reported=True)
     body, _exit, for_insn = info.loops[fp]
-    from ..compiler.resolve import Resolver
     res = Resolver(g.unit.model, g.unit.symbols, g.unit.system_symbols, info.local_vars)
     indx = res.resolve(for_insn.operands[0], Role.W_W)
     final = res.resolve(for_insn.operands[2], Role.W_R)
@@ -197,7 +197,6 @@ def _tofs_in_segment(g: Gen, info, start: int) -> list[int]:
     symbol (``TOF Fan_Delay, +50``, common in SMART exports) is found too.
     Operands that do not resolve are reported by the TOF itself.
     """
-    from ..compiler.resolve import Resolver
     res = Resolver(g.unit.model, g.unit.symbols, g.unit.system_symbols, info.local_vars)
     found: list[int] = []
     for idx in info.scr_pieces.get(start, [start]):
@@ -305,7 +304,6 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
         with g.box():
             _call_body(g, callee, g.bind(bytearray(l_bytes), "Lc"), copy_in, copy_out)
         return
-    from ..compiler.codegen import MAX_NESTING
     # Run-time nesting check (System Manual, CALL: eight levels from the
     # main program; error 0008, SM4.3, ENO 0 on a deeper call).  WD[3] is
     # the number of subroutines active in this scan.

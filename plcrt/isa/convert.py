@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..compiler.emit import Gen
+from ..gen.emit import Gen
 from .registry import Role, insn
 
 F = "convert"

@@ -9,8 +9,8 @@ same network (docs/decisions.md).
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr
+from ..gen.emit import Gen
+from ..gen.operands import Addr
 from .registry import Role, insn
 
 F = "counter"

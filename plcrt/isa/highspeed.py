@@ -10,11 +10,11 @@ counter has are checked when the program is loaded.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..isa.registry import insn
-from ..engine.hsc import MODES
+from ..gen.emit import Gen
+from ..memory.hardware import MODES
 from ..safetext import excerpt
 from .args import int_constant, operand_texts
+from .registry import insn
 
 F = "high-speed"
 

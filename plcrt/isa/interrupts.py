@@ -10,10 +10,10 @@ through the engine.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..isa.registry import insn
-from .args import int_constant, operand_texts
+from ..gen.emit import Gen
 from ..safetext import excerpt
+from .args import int_constant, operand_texts
+from .registry import insn
 
 F = "interrupt"
 

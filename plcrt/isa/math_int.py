@@ -12,7 +12,8 @@ dividend) in the high word.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
+from ..gen.emit import Gen
+from ..gen.operands import Addr
 from .registry import Role, insn
 
 F = "math"
@@ -71,7 +72,6 @@ def _divd(g: Gen, a, out) -> None:
 def _low_word(g: Gen, out) -> str:
     """Expression reading the low word (INT) of a double-word operand: the
     second input of MUL/DIV (big-endian, so bytes 2..3 of the double word)."""
-    from ..compiler.operands import Addr
     if isinstance(out, Addr):
         if out.area == "AC":
             return g.rd(Addr("AC", out.offset, 2, 0, out.text), "W")

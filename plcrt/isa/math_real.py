@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 
-from ..compiler.emit import Gen
-from ..compiler.rt import to_f32
+from ..gen.emit import Gen
+from ..gen.rt import to_f32
 from .registry import Role, insn
 
 F = "real"

@@ -8,8 +8,9 @@ open, plcrt copies element by element in ascending order (docs/decisions.md).
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const, Indirect
+from ..errors import PlcRuntimeError
+from ..gen.emit import Gen
+from ..gen.operands import Addr, Const, Indirect, area_size
 from ..safetext import excerpt
 from .registry import Role, Span, insn
 
@@ -68,7 +69,6 @@ def _block(g: Gen, src, dst, n, kind: str, width: int) -> None:
 
 
 def _check_span(g: Gen, a: Addr, nbytes: int) -> None:
-    from ..compiler.operands import area_size
     if a.offset + nbytes > area_size(g.unit.model, a.area):
         g.fail(f"the block at {excerpt(a.text)} runs past the end of the {a.area} area")
 
@@ -91,7 +91,6 @@ def _ref(g: Gen, op) -> str:
 
 
 def _block_elem(src, dst, i: int, width: int, insn: int, locs) -> None:
-    from ..errors import PlcRuntimeError
     sb, so = src
     db, do = dst
     a, b = so + i * width, do + i * width
@@ -102,7 +101,6 @@ def _block_elem(src, dst, i: int, width: int, insn: int, locs) -> None:
 
 def _fill_words(value: int, dst, count: int, insn: int, locs) -> None:
     """FILL at run time: ``count`` big-endian copies of ``value`` from ``dst``."""
-    from ..errors import PlcRuntimeError
     db, do = dst
     if do + 2 * count > len(db):
         raise PlcRuntimeError("FILL runs past the end of its memory area", locs[insn])

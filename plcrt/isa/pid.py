@@ -10,13 +10,13 @@ a math error (SM1.1).
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr
-from ..compiler.resolve import ResolveError
-from ..engine.pid import TABLE_BYTES
-from ..isa.registry import insn
+from ..gen.emit import Gen
+from ..gen.operands import Addr
+from ..gen.resolve import ResolveError
+from ..memory.hardware import TABLE_BYTES
 from ..safetext import excerpt
 from .args import int_constant, operand_texts
+from .registry import insn
 
 F = "pid"
 

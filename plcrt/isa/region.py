@@ -11,8 +11,8 @@ that reads or writes; each family reads its own layout.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Indirect, area_size
+from ..gen.emit import Gen
+from ..gen.operands import Addr, Indirect, area_size
 from ..safetext import excerpt
 
 

@@ -22,9 +22,9 @@ The settings live in :class:`plcrt.engine.clock.Station`.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Const
-from ..engine.clock import PORTS
+from ..gen.emit import Gen
+from ..gen.operands import Const
+from ..memory.hardware import PORTS
 from .region import runtime_error
 from .registry import Role, insn
 

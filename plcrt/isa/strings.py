@@ -8,7 +8,7 @@ instructions", compare string).
 An S7-200 string is a length byte (0..254) followed by that many characters;
 a string operand names its length byte: ``VB100``, ``LB4``, ``*VD20``,
 ``*LD8``, ``*AC1``, or for an input a double-quoted constant ``"ABC"``
-(:func:`plcrt.compiler.operands.string_constant` turns it into the same
+(:func:`plcrt.gen.operands.string_constant` turns it into the same
 bytes; generated code gets it as a bound ``bytes`` object, never as text).
 
 Errors and flags (docs/decisions.md, "Strings", has every choice):
@@ -42,10 +42,10 @@ from collections.abc import Callable, Sequence
 from decimal import ROUND_HALF_UP, Decimal
 from typing import Any
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr, Const, Indirect, area_size
-from ..compiler.rt import to_f32
 from ..errors import PlcRuntimeError, SourceLoc
+from ..gen.emit import Gen
+from ..gen.operands import Addr, Const, Indirect, area_size
+from ..gen.rt import to_f32
 from ..lang.codepage import MAX_STRING
 from .registry import Role, insn
 

@@ -29,8 +29,8 @@ from __future__ import annotations
 import operator
 from typing import Callable
 
-from ..compiler.emit import Gen
-from ..compiler.rt import s16
+from ..gen.emit import Gen
+from ..gen.rt import s16
 from .region import region, runtime_error
 from .registry import Role, Span, insn
 

@@ -9,9 +9,9 @@ cannot be used by two different timer boxes.
 
 from __future__ import annotations
 
-from ..compiler.emit import Gen
-from ..compiler.operands import Addr
-from ..engine.timers import resolution_ms, timer_kind_ok
+from ..gen.emit import Gen
+from ..gen.operands import Addr
+from ..memory.hardware import resolution_ms, timer_kind_ok
 from .registry import Role, insn
 
 F = "timer"

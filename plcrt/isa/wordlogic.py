@@ -23,8 +23,8 @@ FILL in :mod:`plcrt.isa.move`).
 
 from __future__ import annotations
 
-from ..compiler.emit import BUFFER_NAME, Gen
-from ..compiler.operands import Addr, Const, area_size
+from ..gen.emit import BUFFER_NAME, Gen
+from ..gen.operands import Addr, Const, area_size
 from ..safetext import excerpt
 from .registry import Role, Span, insn
 

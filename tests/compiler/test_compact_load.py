@@ -12,10 +12,11 @@ from typing import Any
 import pytest
 
 import plcrt
-from plcrt.compiler.emit import Gen, _is_atom
 from plcrt.compiler.locs import LineLocs, LocTable
 from plcrt.dump import render_dump
 from plcrt.errors import SourceLoc
+from plcrt.gen.emit import Gen
+from plcrt.gen.exprs import is_atom as _is_atom
 
 LOOP = """ORGANIZATION_BLOCK MAIN:OB1
 BEGIN

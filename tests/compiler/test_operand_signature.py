@@ -127,7 +127,7 @@ def test_a_plcrt_bug_in_an_emitter_is_a_located_compile_error(
 def test_a_plcrt_bug_in_operand_resolution_is_a_located_compile_error(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """The same for an exception while resolving an operand: at the operand."""
-    from plcrt.compiler import resolve
+    from plcrt.gen import resolve
 
     def broken(*args, **kwargs):  # noqa: ANN002, ANN003
         raise OverflowError("too big")

@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-from .lower import SLOTS
+from .fn import SLOTS
 
 _MAGIC = b"plcrt-native-1\n"
 

@@ -19,7 +19,9 @@ run only with power flow: their stores are written as ``select`` between the
 new and the old byte, which keeps each piece one basic block (cheap to
 compile, and the same bytes as a conditional store).
 
-This module is pure Python (no llvmlite): :mod:`.jit` compiles its output.
+This module is the table and its lowerings; the function under construction
+is :mod:`.fn`'s and the reading and writing of operands :mod:`.values`'.
+It is pure Python (no llvmlite): :mod:`.jit` compiles its output.
 """
 
 from __future__ import annotations
@@ -27,243 +29,11 @@ from __future__ import annotations
 import struct
 from typing import Any, Callable
 
-from ..emit import VALUE_WIDTH, const_expr
-from ..operands import Addr, Const, Pointer
-from ...engine.timers import MAX_CV, resolution_ms
-
-#: the buffers a segment can reach, in the order of the context table
-SLOTS = ("I", "Q", "M", "V", "SM", "S", "TV", "TB", "CV", "CB", "AC", "AI", "AQ",
-         "T_RUN", "T_PRE", "T_D100", "T_PREV", "EDGES")
-SLOT = {name: i for i, name in enumerate(SLOTS)}
-
-#: operand areas a native piece may read and write directly (L is per call,
-#: HC is brought up to date by the engine, the immediate forms reach terminals)
-AREAS = {"I", "Q", "M", "V", "SM", "S", "T", "C", "AC", "AI", "AQ"}
-
-MAX_STACK = 9
-
-#: IR lines per generated function: a segment longer than this is split
-#: into functions it calls in turn.  Code generation grows faster than
-#: linearly with the size of one function (measured: a 1000-statement mixed
-#: program's single function took 1.1 s, 2000 statements 10.5 s, 4000 47 s);
-#: in parts of this size it stays linear.
-PART_LINES = 2000
-
-
-class NotLowered(Exception):
-    """The piece cannot run natively (the reason is reported by ``plcrt dump``)."""
-
-
-class Fn:
-    """One LLVM function under construction: SSA names, the logic stack as a
-    list of ``i1`` values, and the buffer pointers it loads at its entry."""
-
-    def __init__(self) -> None:
-        self.body: list[str] = []
-        self.stack: list[str] = []
-        self.slots: set[str] = set()
-        self._n = 0
-        #: finished parts (body, slots): see :data:`PART_LINES`
-        self.parts: list[tuple[list[str], set[str]]] = []
-        self.site = -1    #: the instruction's EU/ED edge memory byte
-
-    # -- SSA -------------------------------------------------------------
-    def t(self) -> str:
-        self._n += 1
-        return f"%v{self._n}"
-
-    def op(self, text: str) -> str:
-        """Append ``%new = text`` and return the new name."""
-        name = self.t()
-        self.body.append(f"  {name} = {text}")
-        return name
-
-    def stmt(self, text: str) -> None:
-        self.body.append(f"  {text}")
-
-    # -- stack -------------------------------------------------------------
-    def push(self, v: str) -> None:
-        if len(self.stack) >= MAX_STACK:
-            raise NotLowered("the logic stack overflows (the bottom level is lost)")
-        self.stack.append(v)
-
-    def combine(self, how: str, v: str) -> None:
-        """A contact's or a compare's result: ``push`` it, or ``and``/``or``
-        it into the top of the stack."""
-        if how == "push":
-            self.push(v)
-        else:
-            self.stack[-1] = self.op(f"{how} i1 {self.top}, {v}")
-
-    @property
-    def top(self) -> str:
-        if not self.stack:
-            raise NotLowered("the logic stack is empty")
-        return self.stack[-1]
-
-    def level(self, n: int) -> str:
-        if len(self.stack) <= n:
-            raise NotLowered("the logic stack holds too few levels")
-        return self.stack[-1 - n]
-
-    # -- memory ------------------------------------------------------------
-    def base(self, slot: str) -> str:
-        self.slots.add(slot)
-        return f"%b{SLOT[slot]}"
-
-    def at(self, slot: str, off: int) -> str:
-        return self.op(f"getelementptr i8, ptr {self.base(slot)}, i64 {int(off)}")
-
-    def load8(self, slot: str, off: int) -> str:
-        return self.op(f"load i8, ptr {self.at(slot, off)}, align 1")
-
-    def store8(self, slot: str, off: int, v: str) -> None:
-        self.stmt(f"store i8 {v}, ptr {self.at(slot, off)}, align 1")
-
-    def split(self) -> None:
-        """Close the current part once it is long enough (between pieces)."""
-        if len(self.body) >= PART_LINES:
-            self.parts.append((self.body, self.slots))
-            self.body, self.slots = [], set()
-
-    def emit(self, name: str) -> str:
-        """The text of function ``name`` (and of its parts, if it has any)."""
-        parts = self.parts + [(self.body, self.slots)]
-        if len(parts) == 1:
-            return _function(name, "", *parts[0])
-        out = [_function(f"{name}_{i}", "internal ", body, slots)
-               for i, (body, slots) in enumerate(parts)]
-        calls = [f"  call void @{name}_{i}(ptr %ctx)" for i in range(len(parts))]
-        out.append("\n".join([f"define void @{name}(ptr %ctx) {{", "entry:", *calls,
-                              "  ret void", "}", ""]))
-        return "".join(out)
-
-
-def _function(name: str, linkage: str, body: list[str], slots: set[str]) -> str:
-    head = [f"define {linkage}void @{name}(ptr %ctx) noinline {{", "entry:"]
-    for slot in sorted(slots, key=SLOT.__getitem__):
-        k = SLOT[slot]
-        head.append(f"  %c{k} = getelementptr ptr, ptr %ctx, i64 {k}")
-        head.append(f"  %b{k} = load ptr, ptr %c{k}, align 8")
-    return "\n".join(head + body + ["  ret void", "}", ""])
-
-
-# -- operands ------------------------------------------------------------------
-
-def _area(op: Any) -> str:
-    if not isinstance(op, Addr) or op.area not in AREAS:
-        what = getattr(op, "area", type(op).__name__)
-        raise NotLowered(f"operand area {what} is not reached natively")
-    return op.area
-
-
-def get_bit(f: Fn, slot: str, byte: int, bit: int) -> str:
-    """``i1`` of bit ``bit`` of byte ``byte`` of a buffer."""
-    v = f.load8(slot, byte)
-    if bit:
-        v = f.op(f"lshr i8 {v}, {int(bit)}")
-    return f.op(f"trunc i8 {v} to i1")
-
-
-def put_bit(f: Fn, slot: str, byte: int, bit: int, v: str) -> None:
-    """Write ``i1`` ``v`` to bit ``bit`` of byte ``byte`` of a buffer."""
-    old = f.load8(slot, byte)
-    kept = f.op(f"and i8 {old}, {~(1 << bit) & 0xFF}")
-    b = f.op(f"zext i1 {v} to i8")
-    if bit:
-        b = f.op(f"shl i8 {b}, {int(bit)}")
-    f.store8(slot, byte, f.op(f"or i8 {kept}, {b}"))
-
-
-def rbit(f: Fn, op: Any) -> str:
-    """``i1`` value of a bit operand (T/C: the bit of the TB/CB bitmap)."""
-    area = _area(op)
-    if area in ("T", "C"):
-        return get_bit(f, "TB" if area == "T" else "CB", op.offset >> 3, op.offset & 7)
-    return get_bit(f, area, op.offset, op.bit)
-
-
-def wbit(f: Fn, op: Any, v: str) -> None:
-    """Write ``i1`` ``v`` to a bit operand (T/C bits are not written by ``=``)."""
-    area = _area(op)
-    if area in ("T", "C"):
-        raise NotLowered("timer and counter bits are written by their boxes")
-    put_bit(f, area, op.offset, op.bit, v)
-
-
-def place(op: Any, width: int) -> tuple[str, int]:
-    """Buffer slot and byte offset of a value operand (as Gen._place)."""
-    area = _area(op)
-    if area == "T":
-        return "TV", op.offset * 2
-    if area == "C":
-        return "CV", op.offset * 2
-    if area == "AC":
-        return "AC", op.offset * 4 + 4 - width
-    return area, op.offset
-
-
-#: the LLVM type a value of each kind is computed in (wide enough for the
-#: result of one math step before its range check)
-WIDE = {"B": "i32", "W": "i32", "WU": "i32", "D": "i64", "DU": "i64"}
-
-
-def rd(f: Fn, op: Any, kind: str) -> str:
-    """Value of an operand as ``WIDE[kind]`` (B, WU, DU unsigned; W, D signed)."""
-    ty = WIDE[kind]
-    if isinstance(op, Const):
-        # the value the Python code uses (a character constant's code, a
-        # REAL constant's bit pattern in a double word)
-        return str(int(const_expr(op, kind)))
-    if isinstance(op, Pointer):
-        return str(int(op.value))
-    width = VALUE_WIDTH[kind[0]]
-    slot, off = place(op, width)
-    acc = None
-    for i in range(width):
-        b = f.op(f"zext i8 {f.load8(slot, off + i)} to {ty}")
-        if acc is None:
-            acc = b
-        else:
-            acc = f.op(f"or {ty} {f.op(f'shl {ty} {acc}, 8')}, {b}")
-    assert acc is not None
-    if kind == "W":
-        acc = f.op(f"sext i16 {f.op(f'trunc i32 {acc} to i16')} to i32")
-    elif kind == "D":
-        acc = f.op(f"sext i32 {f.op(f'trunc i64 {acc} to i32')} to i64")
-    return acc
-
-
-def wr(f: Fn, op: Any, kind: str, v: str, cond: str | None) -> None:
-    """Store ``v`` (type ``WIDE[kind]``) big-endian; only where ``cond`` (i1)
-    holds when given (the old bytes are written back otherwise)."""
-    ty = WIDE[kind]
-    width = VALUE_WIDTH[kind[0]]
-    slot, off = place(op, width)
-    for i in range(width):
-        shift = 8 * (width - 1 - i)
-        x = f.op(f"lshr {ty} {v}, {shift}") if shift else v
-        byte = f.op(f"trunc {ty} {x} to i8")
-        if cond is not None:
-            old = f.load8(slot, off + i)
-            byte = f.op(f"select i1 {cond}, i8 {byte}, i8 {old}")
-        f.store8(slot, off + i, byte)
-
-
-def set_sm1(f: Fn, cond: str, keep: int, bits: str) -> None:
-    """``SM1 := SM1 & keep | bits`` where ``cond`` holds (``bits``: i8)."""
-    old = f.load8("SM", 1)
-    new = f.op(f"or i8 {f.op(f'and i8 {old}, {keep}')}, {bits}")
-    f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
-
-
-def zn_bits(f: Fn, ty: str, r: str, signed: bool = True) -> str:
-    """i8 of SM1.0 (zero) and, for signed kinds, SM1.2 (negative) of ``r``."""
-    z = f.op(f"zext i1 {f.op(f'icmp eq {ty} {r}, 0')} to i8")
-    if not signed:
-        return z
-    n = f.op(f"zext i1 {f.op(f'icmp slt {ty} {r}, 0')} to i8")
-    return f.op(f"or i8 {z}, {f.op(f'shl i8 {n}, 2')}")
+from ...gen.exprs import VALUE_WIDTH, const_expr
+from ...gen.operands import Addr, Const
+from ...memory.hardware import MAX_CV, resolution_ms
+from .fn import PART_LINES, SLOT, SLOTS, Fn, NotLowered
+from .values import WIDE, get_bit, native_area, put_bit, rbit, rd, set_sm1, wbit, wr, zn_bits
 
 
 # -- the table -------------------------------------------------------------------
@@ -349,7 +119,7 @@ def _range(value: int) -> Lowering:
     def lower(f: Fn, op: Any, n: Any) -> None:
         if not isinstance(n, Const) or not isinstance(n.value, int):
             raise NotLowered("the bit count is not a constant")
-        area = _area(op)
+        area = native_area(op)
         if area == "T" and not value:
             _reset_timers(f, op.offset, int(n.value))
             return
@@ -713,3 +483,7 @@ def lower_piece(f: Fn, insns: list[tuple[str, list[Any], int]]) -> None:
         f.site = site
         fn(f, *ops)
     f.stack.clear()
+
+
+__all__ = ["LOWER", "PART_LINES", "SLOT", "SLOTS", "Fn", "Lowering", "NotLowered", "lower_piece",
+           "lowers"]

@@ -1,0 +1,138 @@
+"""Operands in LLVM IR for the native backend: bits, values and SMB1 flags.
+
+Reading and writing a resolved operand (:func:`rbit`, :func:`wbit`,
+:func:`rd`, :func:`wr`), its place in the context table (:func:`place`)
+and the status bits of a result (:func:`set_sm1`, :func:`zn_bits`), each
+the same bytes as the Python generator's (:class:`plcrt.gen.emit.Gen`).
+Only integers computed from resolved operands reach the text.  The table
+of instructions is :mod:`.lower`'s.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...gen.exprs import VALUE_WIDTH, const_expr
+from ...gen.operands import Addr, Const, Pointer
+from .fn import AREAS, Fn, NotLowered
+
+
+def native_area(op: Any) -> str:
+    """The area of an operand a native piece reads and writes directly."""
+    if not isinstance(op, Addr) or op.area not in AREAS:
+        what = getattr(op, "area", type(op).__name__)
+        raise NotLowered(f"operand area {what} is not reached natively")
+    return op.area
+
+
+def get_bit(f: Fn, slot: str, byte: int, bit: int) -> str:
+    """``i1`` of bit ``bit`` of byte ``byte`` of a buffer."""
+    v = f.load8(slot, byte)
+    if bit:
+        v = f.op(f"lshr i8 {v}, {int(bit)}")
+    return f.op(f"trunc i8 {v} to i1")
+
+
+def put_bit(f: Fn, slot: str, byte: int, bit: int, v: str) -> None:
+    """Write ``i1`` ``v`` to bit ``bit`` of byte ``byte`` of a buffer."""
+    old = f.load8(slot, byte)
+    kept = f.op(f"and i8 {old}, {~(1 << bit) & 0xFF}")
+    b = f.op(f"zext i1 {v} to i8")
+    if bit:
+        b = f.op(f"shl i8 {b}, {int(bit)}")
+    f.store8(slot, byte, f.op(f"or i8 {kept}, {b}"))
+
+
+def rbit(f: Fn, op: Any) -> str:
+    """``i1`` value of a bit operand (T/C: the bit of the TB/CB bitmap)."""
+    area = native_area(op)
+    if area in ("T", "C"):
+        return get_bit(f, "TB" if area == "T" else "CB", op.offset >> 3, op.offset & 7)
+    return get_bit(f, area, op.offset, op.bit)
+
+
+def wbit(f: Fn, op: Any, v: str) -> None:
+    """Write ``i1`` ``v`` to a bit operand (T/C bits are not written by ``=``)."""
+    area = native_area(op)
+    if area in ("T", "C"):
+        raise NotLowered("timer and counter bits are written by their boxes")
+    put_bit(f, area, op.offset, op.bit, v)
+
+
+def place(op: Any, width: int) -> tuple[str, int]:
+    """Buffer slot and byte offset of a value operand (as Gen._place)."""
+    area = native_area(op)
+    if area == "T":
+        return "TV", op.offset * 2
+    if area == "C":
+        return "CV", op.offset * 2
+    if area == "AC":
+        return "AC", op.offset * 4 + 4 - width
+    return area, op.offset
+
+
+#: the LLVM type a value of each kind is computed in (wide enough for the
+#: result of one math step before its range check)
+WIDE = {"B": "i32", "W": "i32", "WU": "i32", "D": "i64", "DU": "i64"}
+
+
+def rd(f: Fn, op: Any, kind: str) -> str:
+    """Value of an operand as ``WIDE[kind]`` (B, WU, DU unsigned; W, D signed)."""
+    ty = WIDE[kind]
+    if isinstance(op, Const):
+        # the value the Python code uses (a character constant's code, a
+        # REAL constant's bit pattern in a double word)
+        return str(int(const_expr(op, kind)))
+    if isinstance(op, Pointer):
+        return str(int(op.value))
+    width = VALUE_WIDTH[kind[0]]
+    slot, off = place(op, width)
+    acc = None
+    for i in range(width):
+        b = f.op(f"zext i8 {f.load8(slot, off + i)} to {ty}")
+        if acc is None:
+            acc = b
+        else:
+            acc = f.op(f"or {ty} {f.op(f'shl {ty} {acc}, 8')}, {b}")
+    assert acc is not None
+    if kind == "W":
+        acc = f.op(f"sext i16 {f.op(f'trunc i32 {acc} to i16')} to i32")
+    elif kind == "D":
+        acc = f.op(f"sext i32 {f.op(f'trunc i64 {acc} to i32')} to i64")
+    return acc
+
+
+def wr(f: Fn, op: Any, kind: str, v: str, cond: str | None) -> None:
+    """Store ``v`` (type ``WIDE[kind]``) big-endian; only where ``cond`` (i1)
+    holds when given (the old bytes are written back otherwise)."""
+    ty = WIDE[kind]
+    width = VALUE_WIDTH[kind[0]]
+    slot, off = place(op, width)
+    for i in range(width):
+        shift = 8 * (width - 1 - i)
+        x = f.op(f"lshr {ty} {v}, {shift}") if shift else v
+        byte = f.op(f"trunc {ty} {x} to i8")
+        if cond is not None:
+            old = f.load8(slot, off + i)
+            byte = f.op(f"select i1 {cond}, i8 {byte}, i8 {old}")
+        f.store8(slot, off + i, byte)
+
+
+def set_sm1(f: Fn, cond: str, keep: int, bits: str) -> None:
+    """``SM1 := SM1 & keep | bits`` where ``cond`` holds (``bits``: i8)."""
+    old = f.load8("SM", 1)
+    new = f.op(f"or i8 {f.op(f'and i8 {old}, {keep}')}, {bits}")
+    f.store8("SM", 1, f.op(f"select i1 {cond}, i8 {new}, i8 {old}"))
+
+
+def zn_bits(f: Fn, ty: str, r: str, signed: bool = True) -> str:
+    """i8 of SM1.0 (zero) and, for signed kinds, SM1.2 (negative) of ``r``."""
+    z = f.op(f"zext i1 {f.op(f'icmp eq {ty} {r}, 0')} to i8")
+    if not signed:
+        return z
+    n = f.op(f"zext i1 {f.op(f'icmp slt {ty} {r}, 0')} to i8")
+    return f.op(f"or i8 {z}, {f.op(f'shl i8 {n}, 2')}")
+
+
+__all__ = ["WIDE", "get_bit", "native_area", "place", "put_bit", "rbit", "rd", "set_sm1", "wbit", "wr",
+           "zn_bits"]

@@ -23,6 +23,7 @@ from program text, never markup strings.  This module has no dependency.
 from __future__ import annotations
 
 import re
+from typing import Any
 
 #: bidirectional formatting characters (Unicode TR9): embeddings,
 #: overrides and isolates, which reorder how the text around them is shown
@@ -62,4 +63,17 @@ def excerpt(text: str, limit: int = EXCERPT_CHARS) -> str:
     return text[:limit] + "\u2026"
 
 
-__all__ = ["EXCERPT_CHARS", "excerpt", "printable"]
+def shown_value(value: Any) -> str:
+    """``repr(value)`` short enough for one line of a message."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 200:
+        # str() of a huge int is slow, and refused above 4300 digits
+        return f"{'-' if value < 0 else ''}a {value.bit_length()}-bit integer"
+    try:
+        text = printable(repr(value))
+    except ValueError:
+        # a huge int inside a list or tuple: its repr() is refused too
+        return f"a {type(value).__name__} holding a huge integer"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+__all__ = ["EXCERPT_CHARS", "excerpt", "printable", "shown_value"]

@@ -15,8 +15,8 @@ from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass, fields
 from typing import Any, ClassVar, Protocol
 
-from ..engine.values import shown_value
 from ..errors import PlcKeyError
+from ..safetext import shown_value
 from .cia402.status import describe_statusword
 
 __all__ = ["AxisState", "Device", "DriveState"]

@@ -38,7 +38,7 @@ from typing import Any, Union
 
 from ..errors import PlcAddressError, PlcConfigError
 from ..paths import check_path
-from ..safetext import excerpt, printable
+from ..safetext import excerpt, printable, shown_value
 
 Number = Union[int, float]
 Duration = Union[int, float, str]
@@ -61,19 +61,6 @@ _TYPE_NAMES = {1: "a byte (BYTE)", 2: "a word (INT or WORD)", 4: "a double word 
 
 _F32 = struct.Struct(">f")
 REAL_RANGE = "about -3.4e38 to 3.4e38"
-
-
-def shown_value(value: Any) -> str:
-    """``repr(value)`` short enough for one line of a message."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 200:
-        # str() of a huge int is slow, and refused above 4300 digits
-        return f"{'-' if value < 0 else ''}a {value.bit_length()}-bit integer"
-    try:
-        text = printable(repr(value))
-    except ValueError:
-        # a huge int inside a list or tuple: its repr() is refused too
-        return f"a {type(value).__name__} holding a huge integer"
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def as_number(address: str, value: Any) -> Number:

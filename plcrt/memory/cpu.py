@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..errors import PlcConfigError
+from ..safetext import shown_value
+
 
 @dataclass(frozen=True, slots=True)
 class CpuModel:
@@ -56,9 +59,6 @@ DEFAULT_CPU = "CPU226"
 
 def cpu_model(name: str | None) -> CpuModel:
     """Look up a model by name (case and blanks ignored)."""
-    from ..engine.values import shown_value
-    from ..errors import PlcConfigError
-
     if name is not None and not isinstance(name, str):
         raise PlcConfigError(f"the CPU model is a name such as 'CPU226' (known: "
                              f"{', '.join(CPU_MODELS)}), got {type(name).__name__} "

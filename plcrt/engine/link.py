@@ -29,7 +29,7 @@ from typing import Any, Optional
 
 from ..errors import PlcConfigError
 from .serial import MIN_CHAR_US
-from .values import Duration, scan_total
+from .values import Duration, duration_us, step_count
 
 __all__ = ["Network", "link"]
 
@@ -123,16 +123,22 @@ class Network:
         return min(self._pos.values()) if self._pos else 0
 
     def run(self, seconds: Duration) -> None:
-        """Run every CPU for *seconds* of simulated time (``0.5``, ``"200ms"``)."""
+        """Run every CPU for *seconds* of simulated time (``0.5``, ``"200ms"``).
+
+        Raises:
+            PlcConfigError: not a duration, or a span of more than
+                :data:`~plcrt.engine.values.MAX_STEPS` windows (below).
+        """
+        span = duration_us(seconds, "seconds")
         if not self.plcs:
             return
-        span = scan_total(1, seconds, None)          # µs, validated
-        end = self.time_us + span
-        t = self.time_us
         # a window shorter than the quickest way from one CPU to another
         # (a character: at least 79 µs; Ethernet: the latency), so that what
         # a CPU sends at the window's start arrives after its end
         window = min([MIN_CHAR_US] + [p.ethernet.latency_us - 1 for p in self.plcs])
+        step_count(span, window, seconds, "seconds", "window")
+        end = self.time_us + span
+        t = self.time_us
         while t < end:
             t = min(t + window, end)
             for plc in self.plcs:

@@ -48,8 +48,8 @@ from .pid import make_loops
 from .pulse import make_outputs
 from .ports import attach_devices, make_ports
 from .netjobs import make_ethernet, netr_netw
-from .values import (Duration, check_backend, check_load_options, check_parsed_inputs,
-                     scan_number, scan_total, source_items)
+from .values import (MAX_STEPS, Duration, check_backend, check_load_options,
+                     check_parsed_inputs, scan_number, scan_time_us, scan_total, source_items)
 
 if TYPE_CHECKING:
     from ..devices import AxisState, DriveState
@@ -75,9 +75,7 @@ class Plc(AddressAccess):
                  auto_symbols: bool = False, clock: Any = None, backend: str | None = None,
                  entry: str | None = None,
                  _entry: Any = None, _template: bool = False) -> None:
-        if isinstance(scan_ms, bool) or not (isinstance(scan_ms, (int, float))
-                                             and 0.001 <= scan_ms <= 60000):
-            raise PlcConfigError(f"scan time must be between 0.001 and 60000 ms, got {scan_ms!r}")
+        scan_us = scan_time_us(scan_ms)
         if pace not in ("simulated", "realtime"):
             raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
         if isinstance(watchdog_ms, bool) or not (isinstance(watchdog_ms, (int, float))
@@ -128,7 +126,7 @@ class Plc(AddressAccess):
         self.forces: dict[str, int | float] = {}
         self._force_slots: list[tuple[bytearray, int, int, int, int | float]] = []
         self.mem = MemoryImage(self.model)
-        self.scan_us = int(round(scan_ms * 1000))
+        self.scan_us = scan_us
         self.pace = pace
         self.mode = "RUN"
         self.fault: PlcError | None = None
@@ -438,7 +436,7 @@ class Plc(AddressAccess):
             PlcConfigError: ``n`` is not a non-negative whole number.
             PlcRuntimeError: on a fatal fault; the CPU is left in STOP.
         """
-        if type(n) is not int or n < 0:  # perf: one test for the usual scan(1)
+        if type(n) is not int or not 0 <= n <= MAX_STEPS:  # perf: one test for scan(1)
             n = scan_number(n)
         if self.network is not None:
             raise PlcConfigError("this PLC is linked to others: run them together with the "
@@ -1193,7 +1191,9 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
             newline), or a list of them whose blocks are merged.
         symbols: path or text of a symbol table, or a parsed table.
         data: path or text of a data block, or a parsed one.
-        scan_ms: simulated scan time in milliseconds.
+        scan_ms: simulated scan time in milliseconds, a whole number of
+            microseconds from 0.001 to 60000 (``0.0015`` is refused, not
+            rounded).
         cpu: CPU model name (default CPU 226).
         encoding: text encoding of the files (``"cp1252"``, ``"gbk"``,
             ``"utf-8"`` ...); by default it is detected, one for all files

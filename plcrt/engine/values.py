@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..errors import PlcAddressError, PlcConfigError
+from ..paths import check_path
 from ..safetext import excerpt, printable
 
 Number = Union[int, float]
@@ -62,12 +63,16 @@ _F32 = struct.Struct(">f")
 REAL_RANGE = "about -3.4e38 to 3.4e38"
 
 
-def _shown(value: Any) -> str:
+def shown_value(value: Any) -> str:
     """``repr(value)`` short enough for one line of a message."""
     if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 200:
         # str() of a huge int is slow, and refused above 4300 digits
         return f"{'-' if value < 0 else ''}a {value.bit_length()}-bit integer"
-    text = printable(repr(value))
+    try:
+        text = printable(repr(value))
+    except ValueError:
+        # a huge int inside a list or tuple: its repr() is refused too
+        return f"a {type(value).__name__} holding a huge integer"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
@@ -90,7 +95,7 @@ def as_number(address: str, value: Any) -> Number:
         item = value.item()   # numpy.bool_ and other 0-d numpy values
         if isinstance(item, (int, float)):
             return int(item) if isinstance(item, bool) else item
-    raise PlcAddressError(f"{address}: {_shown(value)} is not a number (expected an int, "
+    raise PlcAddressError(f"{address}: {shown_value(value)} is not a number (expected an int, "
                           f"a float or a bool, got {type(value).__name__})")
 
 
@@ -113,24 +118,24 @@ def check_value(address: str, width: int, value: Any) -> Number:
     v = as_number(address, value)
     if width == 0:
         if v not in (0, 1):
-            raise PlcAddressError(f"{address}: a bit takes 0 or 1, got {_shown(value)}")
+            raise PlcAddressError(f"{address}: a bit takes 0 or 1, got {shown_value(value)}")
         return 1 if v else 0
     if isinstance(v, float):
         if width == 4:
             try:
                 _F32.pack(v)
             except OverflowError:
-                raise PlcAddressError(f"{address}: {_shown(value)} is out of the range of "
+                raise PlcAddressError(f"{address}: {shown_value(value)} is out of the range of "
                                       f"a REAL ({REAL_RANGE})") from None
             return v
         if not v.is_integer():
             raise PlcAddressError(f"{address}: a real value needs a double word (VD, MD, ...), "
-                                  f"got {_shown(value)}")
+                                  f"got {shown_value(value)}")
         v = int(v)
     lo, hi = INT_RANGES[width]
     if not lo <= v <= hi:
         extra = "; an S7-200 byte is unsigned" if width == 1 and v < 0 else ""
-        raise PlcAddressError(f"{address}: {_shown(value)} does not fit in "
+        raise PlcAddressError(f"{address}: {shown_value(value)} does not fit in "
                               f"{_TYPE_NAMES[width]}, which takes {lo} to {hi}{extra}")
     return v
 
@@ -162,7 +167,7 @@ def check_format(fmt: Any, spec: str, *, suffix: bool = False) -> str:
         return ""
     if not isinstance(fmt, str):
         raise PlcAddressError(f"{spec}: a format is a string such as 'REAL', got "
-                              f"{type(fmt).__name__} {_shown(fmt)}")
+                              f"{type(fmt).__name__} {shown_value(fmt)}")
     name = fmt.strip().upper()
     name = FORMAT_ALIASES.get(name, name)
     if name and name not in FORMATS:
@@ -181,7 +186,7 @@ def check_address(address: Any) -> str:
     """
     if not isinstance(address, str):
         raise PlcAddressError(f"an address is a string such as 'VW100', 'Q0.0' or a symbol "
-                              f"name, got {type(address).__name__} {_shown(address)}")
+                              f"name, got {type(address).__name__} {shown_value(address)}")
     text = address.strip()
     if not text:
         raise PlcAddressError("an address is a string such as 'VW100', 'Q0.0' or a symbol "
@@ -215,7 +220,7 @@ def split_format(spec: Any, fmt: Any = None) -> tuple[str, str]:
         name = check_format(suffix, printable(text)[:60], suffix=True)
         if fmt is not None and check_format(fmt, addr) != name:
             raise PlcAddressError(f"{printable(text)[:60]}: the format is given twice "
-                                  f"(also as {_shown(fmt)}); give it once")
+                                  f"(also as {shown_value(fmt)}); give it once")
         return addr, name
     return text, check_format(fmt, printable(text)[:60])
 
@@ -299,6 +304,23 @@ def json_number(value: Number) -> Number | str:
 _UNITS = {"us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0}
 _DURATION_RE = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?|\.[0-9]+)\s*(us|µs|ms|s|sec|min|h)?\s*$")
 
+#: most scans one call runs (``scan``, ``run``, the harness's waits and
+#: stimuli), and most bus cycles one ``advance()`` of the CANopen simulator
+#: runs: about an hour of wall time at the fastest (a few µs a scan), 115
+#: days of simulated time at the default 10 ms scans.  A span or count
+#: beyond it cannot end in any useful time (``run(1e300)``,
+#: ``scans=2**70``) and is refused before anything runs
+#: (docs/decisions.md, "Values at the public boundary").
+MAX_STEPS = 10**9
+
+
+def _seconds_shown(d: Any) -> str:
+    if isinstance(d, numbers.Integral) and not isinstance(d, bool) and int(d).bit_length() > 200:
+        # the order of magnitude, without str() of a huge int (slow, refused
+        # above 4300 digits)
+        return f"{'-' if d < 0 else ''}about 1e{int(int(d).bit_length() * 0.30103)}"
+    return shown_value(d)
+
 
 def duration(d: Any, what: str = "") -> float:
     """A duration in seconds from ``1.5``, ``"1.5s"``, ``"200ms"``,
@@ -307,63 +329,151 @@ def duration(d: Any, what: str = "") -> float:
     ``what`` names the argument in messages.
 
     Raises:
-        PlcConfigError: not a finite, non-negative number of seconds.
+        PlcConfigError: not a finite, non-negative number of seconds whose
+            microseconds a float can count.
     """
     where = f"{what}: " if what else ""
     forms = "write e.g. 2, '1.5s', '200ms', '2min'"
     if isinstance(d, str):
         m = _DURATION_RE.match(d) if len(d) <= MAX_NUMBER_TEXT else None
         if m is None:
-            raise PlcConfigError(f"{where}not a duration: {_shown(d)} ({forms})")
+            raise PlcConfigError(f"{where}not a duration: {shown_value(d)} ({forms})")
         value = float(m.group(1)) * _UNITS[m.group(2) or "s"]
     elif isinstance(d, numbers.Real) and not isinstance(d, bool):
-        value = float(d)
+        try:
+            value = float(d)
+        except OverflowError:
+            # an int (or Fraction) beyond any float: too long if positive,
+            # refused as negative below otherwise
+            if d > 0:
+                raise PlcConfigError(f"{where}a duration of {_seconds_shown(d)} s is too long "
+                                     f"to count in microseconds") from None
+            value = -math.inf
     else:
-        raise PlcConfigError(f"{where}not a duration: {type(d).__name__} {_shown(d)} "
+        raise PlcConfigError(f"{where}not a duration: {type(d).__name__} {shown_value(d)} "
                              f"(a number of seconds or a string; {forms})")
     if not (math.isfinite(value) and value >= 0):
         raise PlcConfigError(f"{where}a duration must be a non-negative, finite time, "
-                             f"got {_shown(d)}")
+                             f"got {_seconds_shown(d)}")
     if not math.isfinite(value * 1e6):
         # simulated time is counted in whole microseconds: the count must
         # exist (about 1.8e302 s and more overflow a float)
-        raise PlcConfigError(f"{where}a duration of {_shown(d)} s is too long to count in "
-                             f"microseconds")
+        raise PlcConfigError(f"{where}a duration of {_seconds_shown(d)} s is too long to "
+                             f"count in microseconds")
     return value
 
 
-def scan_number(n: Any, what: str = "the number of scans") -> int:
-    """A number of scans: a non-negative whole number (numpy ints too).
+def duration_us(d: Any, what: str = "") -> int:
+    """:func:`duration` in whole microseconds (the engine's unit of time)."""
+    return int(round(duration(d, what) * 1e6))
+
+
+def scan_number(n: Any, what: str = "the number of scans", bounded: bool = True) -> int:
+    """A number of scans: a whole number from 0 to :data:`MAX_STEPS` (any
+    size if not ``bounded``; numpy ints too).
 
     Raises:
-        PlcConfigError: a negative, fractional or non-numeric count.
+        PlcConfigError: a negative, fractional, non-numeric or too large count.
     """
     if isinstance(n, bool) or not isinstance(n, numbers.Integral):
         if isinstance(n, float) and n.is_integer():
-            raise PlcConfigError(f"{what} must be an int, got the float {_shown(n)}; "
+            raise PlcConfigError(f"{what} must be an int, got the float {shown_value(n)}; "
                                  f"write {int(n)}")
         raise PlcConfigError(f"{what} must be a whole number (an int), got "
-                             f"{type(n).__name__} {_shown(n)}")
+                             f"{type(n).__name__} {shown_value(n)}")
     n = int(n)
     if n < 0:
-        raise PlcConfigError(f"{what} must not be negative, got {n}")
+        raise PlcConfigError(f"{what} must not be negative, got {shown_value(n)}")
+    if n > MAX_STEPS and bounded:
+        raise PlcConfigError(f"{what} must be at most {MAX_STEPS:_} (one call runs at most "
+                             f"that many scans: split a longer run into several calls), "
+                             f"got {shown_value(n)}")
     return n
 
 
-def scan_total(scan_us: int, seconds: Any = None, scans: Any = None) -> int:
-    """How many scans ``run(seconds=...)`` or ``run(scans=...)`` runs: a
-    duration is rounded up to whole scans (a partial last scan is a scan).
+def step_count(span_us: int, step_us: int, d: Any = None, what: str = "",
+               step: str = "scan") -> int:
+    """How many steps of ``step_us`` (scans, bus cycles) cover ``span_us``,
+    a partial last step counting as one; ``d`` is the duration as the user
+    gave it and ``what`` names it, for the message.
 
     Raises:
-        PlcConfigError: neither or both given, or a bad value.
+        PlcConfigError: more than :data:`MAX_STEPS` steps.
+    """
+    n = -(-span_us // step_us)
+    if n > MAX_STEPS:
+        where = f"{what}: " if what else ""
+        shown = _seconds_shown(d) if d is not None else f"{span_us / 1e6:g}"
+        raise PlcConfigError(
+            f"{where}{shown} s at {step_us / 1000:g} ms a {step} is more than "
+            f"{MAX_STEPS:_} {step}s, the most one call runs (at this {step} time, "
+            f"{MAX_STEPS * step_us / 86_400e6:.3g} days): split a longer run into "
+            f"several calls")
+    return n
+
+
+def scan_total(scan_us: int, seconds: Any = None, scans: Any = None,
+               what: str = "seconds", bounded: bool = True) -> int:
+    """How many scans ``run(seconds=...)`` or ``run(scans=...)`` runs: a
+    duration is rounded up to whole scans (a partial last scan is a scan).
+    ``bounded=False`` lifts :data:`MAX_STEPS` from a duration, for a run
+    that another limit ends (a wall-clock limit).
+
+    Raises:
+        PlcConfigError: neither or both given, a bad value, or more than
+            :data:`MAX_STEPS` scans.
     """
     if (seconds is None) == (scans is None):
         raise PlcConfigError("give exactly one of seconds (a duration such as 1.5 or '1.5s') "
                              "or scans=")
     if scans is not None:
-        return scan_number(scans, "scans")
-    us = int(round(duration(seconds, "seconds") * 1e6))
-    return -(-us // scan_us)
+        return scan_number(scans, "scans", bounded)
+    if not bounded:
+        return -(-duration_us(seconds, what) // scan_us)
+    return step_count(duration_us(seconds, what), scan_us, seconds, what)
+
+
+# ---------------------------------------------------------------------------
+# The scan time
+# ---------------------------------------------------------------------------
+
+#: the scan times accepted, in ms: 1 µs to one minute
+SCAN_MS_RANGE = (0.001, 60000)
+
+
+def scan_time_us(scan_ms: Any, what: str = "scan time") -> int:
+    """The scan time ``scan_ms`` (milliseconds: ``load(scan_ms=...)``,
+    ``--scan-ms``, the pytest marker and ``--plc-scan-ms``) in whole
+    microseconds, the unit the engine counts time in.
+
+    Raises:
+        PlcConfigError: not a number, outside :data:`SCAN_MS_RANGE`, or not
+            a whole number of microseconds (``0.0015`` ms would have to be
+            rounded to 1 or 2 µs, and every timer would drift from what
+            the test asked for; see docs/decisions.md).
+    """
+    lo, hi = SCAN_MS_RANGE
+    if isinstance(scan_ms, bool) or not isinstance(scan_ms, numbers.Real) \
+            or not _fits_float(scan_ms) or not lo <= float(scan_ms) <= hi:
+        raise PlcConfigError(f"{what} must be between {lo:g} and {hi:g} ms, got "
+                             f"{shown_value(scan_ms)}")
+    us = float(scan_ms) * 1000
+    whole = round(us)
+    # 1e-6 µs: far below any scan time one means, far above the float
+    # error of writing one in ms (1.1 ms is 1100.0000000000002 µs)
+    if abs(us - whole) > 1e-6:
+        raise PlcConfigError(f"{what} must be a whole number of microseconds (the simulated "
+                             f"clock counts µs): {shown_value(scan_ms)} ms is {us:.6g} µs; give "
+                             f"{max(1, math.floor(us)) / 1000:g} or "
+                             f"{math.ceil(us) / 1000:g}")
+    return whole
+
+
+def _fits_float(x: Any) -> bool:
+    try:
+        return math.isfinite(float(x))
+    except (OverflowError, ValueError, TypeError):
+        return False
 
 
 # ---------------------------------------------------------------------------
@@ -387,10 +497,10 @@ def check_backend(backend: Any) -> str:
         backend = os.environ.get("PLCRT_BACKEND") or "python"
         if backend not in BACKENDS:
             raise PlcConfigError(f"PLCRT_BACKEND must be one of "
-                                 f"{', '.join(BACKENDS)}, got {backend!r:.40}")
+                                 f"{', '.join(BACKENDS)}, got {shown_value(backend)}")
     if backend not in BACKENDS:
         raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
-                             f"got {backend!r:.40}")
+                             f"got {shown_value(backend)}")
     return backend
 
 _SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
@@ -423,6 +533,9 @@ def _check_text_or_path(x: Any, what: str, forms: str) -> None:
         raise PlcConfigError(f"{what} is an empty string; give {forms}")
     if not isinstance(x, (str, Path)):
         raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
+    from ..lang.sources import is_file_arg
+    if is_file_arg(x):
+        check_path(x, f"{what}: the file name")
 
 
 def check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str, Any]) -> None:
@@ -433,7 +546,7 @@ def check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str
                              f"the options are symbols, data, scan_ms, cpu, encoding, "
                              f"{', '.join(LOAD_OPTIONS)}")
     for what, x in (("symbols", symbols), ("data", data), ("plant", plant)):
-        if isinstance(x, (str, bytes, bytearray)):
+        if isinstance(x, (str, bytes, bytearray, Path)):
             _check_text_or_path(x, what, "a file path or the file's text")
 
 
@@ -452,11 +565,11 @@ def check_parsed_inputs(symbols: Any, data: Any, plant: Any) -> None:
 
 
 def _typed(x: Any) -> str:
-    return f"{type(x).__name__} {_shown(x)[:40]}"
+    return f"{type(x).__name__} {shown_value(x)[:40]}"
 
 
-__all__ = ["FORMATS", "FORMAT_ALIASES", "INT_RANGES", "LOAD_OPTIONS", "NONFINITE",
-           "NUMBER_FORMS", "as_number", "check_address", "check_format",
+__all__ = ["FORMATS", "FORMAT_ALIASES", "INT_RANGES", "LOAD_OPTIONS", "MAX_STEPS", "NONFINITE",
+           "NUMBER_FORMS", "SCAN_MS_RANGE", "as_number", "check_address", "check_format",
            "check_load_options", "check_parsed_inputs", "check_value", "duration",
-           "json_number", "parse_number", "scan_number", "scan_total", "source_items",
-           "split_format"]
+           "duration_us", "json_number", "parse_number", "scan_number", "scan_time_us",
+           "scan_total", "shown_value", "source_items", "split_format", "step_count"]

@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import NoReturn, Sequence
 
 from ..errors import Diagnostic, PlcConfigError, PlcSyntaxError, SourceLoc
+from ..safetext import printable
 from .limits import file_limit, read_capped
 
 __all__ = ["Decoded", "decode_bytes", "decode_files", "decode_many", "encoding_note",
@@ -63,31 +64,56 @@ class Decoded:
         return self.encoding.upper()
 
 
+#: what an encoding must write and read back to be one STL can be in: the
+#: printable ASCII characters, tab and line ends (mnemonics, operands,
+#: punctuation of every export)
+_STL_SAMPLE = "".join(map(chr, range(32, 127))) + "\t\r\n"
+
+
 def resolve_encoding(name: str | None) -> str | None:
     """Check an encoding name given by the user and return its codec name.
 
     ``None``, ``""`` and ``"auto"`` mean "detect".  A bare code page number
     (``936``, ``1252``) is the Windows code page of that number.  Raises
     :class:`PlcConfigError` for a name Python does not know as a text
-    encoding.
+    encoding, and for one that cannot write and read back the characters
+    of STL (``punycode``, ``idna``, ``utf-7``, ``undefined``: they fail or
+    mangle on any program).
     """
     if name is None:
         return None
     if not isinstance(name, str):
         raise PlcConfigError(f"encoding must be a name such as 'cp1252', 'gbk' or 'utf-8', "
-                             f"got {type(name).__name__} {name!r}")
+                             f"got {type(name).__name__} {printable(repr(name))[:40]}")
     key = name.strip()
     if key.lower() in ("", "auto"):
         return None
     if key.isdigit():
         key = "cp" + key
+    shown = printable(name)[:40]
     try:
         # str.encode accepts text encodings only (not hex, base64, rot13 ...)
         "".encode(key)
-        return codecs.lookup(key).name
-    except LookupError:
-        raise PlcConfigError(f"unknown encoding {name[:40]!r}; give a name such as cp1252, "
+        codec = codecs.lookup(key).name
+    except (LookupError, ValueError):
+        # ValueError: a NUL in the name; UnicodeError (a ValueError): a
+        # codec that refuses everything ("undefined")
+        raise PlcConfigError(f"unknown encoding {shown!r}; give a name such as cp1252, "
                              f"gbk, gb18030, cp1251, cp932, utf-8 or utf-16") from None
+    try:
+        data = _STL_SAMPLE.encode(codec)
+        # a file's beginning is the beginning of its bytes: not so for
+        # punycode, which moves what it encodes to the end
+        fits = data.decode(codec) == _STL_SAMPLE and all(
+            data.startswith(_STL_SAMPLE[:k].encode(codec)) for k in (1, 16, 64))
+    except (UnicodeError, ValueError):
+        fits = False
+    if not fits:
+        raise PlcConfigError(f"encoding {shown!r} cannot hold the characters of STL (letters, "
+                             f"digits, punctuation and line ends as Micro/WIN writes them); "
+                             f"give a code page or a Unicode encoding such as cp1252, gbk, "
+                             f"utf-8 or utf-16")
+    return codec
 
 
 def read_bytes(path: str | Path, max_bytes: int | None = None) -> bytes:
@@ -240,6 +266,11 @@ def _checked(raw: bytes, file: str, data: bytes, codec: str, how: str,
         text = data.decode(codec)
     except UnicodeDecodeError as exc:
         _raise_undecodable(data, file, codec, exc, offset=len(raw) - len(data))
+    except UnicodeError as exc:
+        # a codec that fails without saying where (punycode and the like
+        # pass resolve_encoding's sample, but not every text)
+        raise PlcSyntaxError(f"the file does not decode as {codec.upper()}: "
+                             f"{printable(str(exc))[:120]}", SourceLoc(file, 1, 1)) from None
     return _no_nul(Decoded(text, codec, how, confident), file)
 
 

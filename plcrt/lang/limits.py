@@ -27,6 +27,7 @@ import stat
 from pathlib import Path
 
 from ..errors import PlcConfigError, PlcSyntaxError, SourceLoc
+from ..paths import check_path
 
 #: default largest file read (program, symbol table, data block), in MiB.
 #: A real export is well under 1 MB; generated benchmark programs of
@@ -84,6 +85,8 @@ def read_capped(path: str | Path, limit: int) -> bytes:
             not a regular file (a device such as ``/dev/zero``, a FIFO),
             unreadable, or longer than ``limit`` bytes (the message names
             the limit and how to raise it).
+        PlcConfigError: a name no file can have (a NUL character:
+            :func:`plcrt.paths.check_path`).
     """
     name = str(path)
 
@@ -92,6 +95,7 @@ def read_capped(path: str | Path, limit: int) -> bytes:
 
     if name == "":
         raise fail("no file name given")
+    check_path(name)
     try:
         # O_NONBLOCK: opening a FIFO with no writer must not hang; the
         # mode is checked on the open descriptor, so nothing can swap the

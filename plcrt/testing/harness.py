@@ -24,7 +24,8 @@ from typing import Any, Union
 
 from ..devices import AxisState, DriveState
 from ..engine.runtime import Plc, load
-from ..engine.values import Duration, check_address, scan_number
+from ..engine.values import (Duration, check_address, duration_us, scan_number,
+                             shown_value, step_count)
 from ..engine.values import duration as parse_duration
 from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
 from .conditions import Condition, addresses_of, condition, quoted, reader
@@ -61,7 +62,7 @@ class Harness:
                                  f"...)), got {type(plc).__name__}")
         if isinstance(watch, str) or not isinstance(watch, (list, tuple)):
             raise PlcConfigError(f"watch is a list of addresses such as ['Q0.0', 'VW10'], "
-                                 f"got {type(watch).__name__} {watch!r:.40}")
+                                 f"got {type(watch).__name__} {shown_value(watch)}")
         history = scan_number(history, "history (a number of scans)")
         self.plc = plc
         self.name = name or str(plc.program.file)
@@ -81,7 +82,7 @@ class Harness:
         ``max_time`` (counted from power-up), whatever runs the scans: a
         per-test time limit, in simulated time, so a test that waits for
         something that never comes ends quickly and the same way everywhere."""
-        limit_us = int(round(seconds(max_time) * 1e6))
+        limit_us = duration_us(max_time)
         if self.max_time is None:
             self.plc.observers.append(self._check_time)
         self.max_time = limit_us / 1e6
@@ -202,9 +203,8 @@ class Harness:
         self.plc.run(seconds, scans)
         return self
 
-    def _scans_for(self, d: Duration) -> int:
-        us = int(round(seconds(d) * 1e6))
-        return -(-us // self.plc.scan_us)
+    def _scans_for(self, d: Duration, what: str = "") -> int:
+        return step_count(duration_us(d, what), self.plc.scan_us, d, what)
 
     def run_until(self, cond: Condition, *, timeout: Duration = 10.0,
                   message: str = "") -> float:
@@ -214,7 +214,7 @@ class Harness:
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         pred, what = condition(self, cond)
         t0 = self.plc.now_us
-        limit = self._scans_for(timeout)
+        limit = self._scans_for(timeout, "timeout")
         plc = self.plc
         for _ in range(limit):
             plc.scan(1)
@@ -253,7 +253,7 @@ class Harness:
         t0 = plc.time
         expected = (f"expected {quoted(what)} to stay true for {seconds(duration):g} s "
                     f"from t = {t0:.3f} s")
-        for _ in range(self._scans_for(duration)):
+        for _ in range(self._scans_for(duration, "duration")):
             plc.scan(1)
             if plc.mode != "RUN":
                 # time stands still in STOP: the duration would never pass
@@ -389,16 +389,20 @@ class Harness:
                 t, addr, value = row
             except (TypeError, ValueError):
                 raise PlcConfigError(f"stimulus row {i + 1}: expected (time, address, value), "
-                                     f"got {row!r}") from None
+                                     f"got {shown_value(row)}") from None
             try:
-                t_s = seconds(t)
+                t_us = duration_us(t)
+                self._scans_for(t)   # a time no run can reach is refused up front
             except PlcConfigError as e:
-                raise PlcConfigError(f"stimulus row {i + 1} {row!r}: {e.message}") from None
+                raise PlcConfigError(f"stimulus row {i + 1} {shown_value(row)}: "
+                                     f"{e.message}") from None
             try:   # every row is checked before the first scan runs
                 self.plc._writable(addr, value)
             except PlcError as e:
-                raise type(e)(f"stimulus row {i + 1} {row!r:.80}: {e.message}") from None
-            rows.append((int(round(t_s * 1e6)), i, addr, value))
+                raise type(e)(f"stimulus row {i + 1} {shown_value(row)}: {e.message}") from None
+            rows.append((t_us, i, addr, value))
+        if until is not None:
+            self._scans_for(until, "until")
         rows.sort()
         plc = self.plc
         t0 = plc.now_us
@@ -407,7 +411,7 @@ class Harness:
                 plc.scan(1)
             self.write(addr, value)
         if until is not None:
-            end = t0 + int(round(seconds(until) * 1e6))
+            end = t0 + duration_us(until, "until")
             while plc.now_us < end and plc.mode == "RUN":
                 plc.scan(1)
         return self

@@ -63,10 +63,12 @@ class WallTimeExceeded(PlcError):
     between two scans; the PLC is in the state of the last full scan."""
 
 
-def scan_count(plc: Any, seconds: float | None = None, scans: int | None = None) -> int:
+def scan_count(plc: Any, seconds: float | None = None, scans: int | None = None,
+               bounded: bool = True) -> int:
     """The number of scans ``plc.run(seconds=..., scans=...)`` runs
-    (a partial last scan counts as a scan, as in the engine)."""
-    return scan_total(plc.scan_us, seconds, scans)
+    (a partial last scan counts as a scan, as in the engine); ``bounded``:
+    at most :data:`~plcrt.engine.values.MAX_STEPS`, as ``plc.run``."""
+    return scan_total(plc.scan_us, seconds, scans, bounded=bounded)
 
 
 def _is_terminal(stream: Any) -> bool:
@@ -111,7 +113,8 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
         PlcRuntimeError: a fault of the program (as ``plc.run`` raises it).
         WallTimeExceeded: ``max_wall`` seconds passed before the run ended.
     """
-    total = scan_count(plc, seconds, scans)
+    # a wall-time limit ends a run of any simulated length
+    total = scan_count(plc, seconds, scans, bounded=max_wall is None)
     check_max_wall(max_wall)
     out = sys.stderr if stream is None else stream
     terminal = _is_terminal(out)

@@ -56,7 +56,7 @@ import canopen
 from canopen.nmt import NmtSlave
 from canopen.objectdictionary import ODRecord, ODVariable, datatypes
 
-from ...engine.values import Duration, duration
+from ...engine.values import Duration, duration_us, shown_value, step_count
 from ...errors import PlcConfigError
 from .canopen_od import object_dictionary
 from .drive import Drive
@@ -153,15 +153,23 @@ class CanopenDrive:
     def advance(self, seconds: Duration) -> None:
         """Run the drive *seconds* further (a duration: ``0.5``, ``"200ms"``),
         one bus cycle at a time (``clock="manual"`` or ``"step"``; in
-        wall-clock mode time follows the wall clock and this raises)."""
+        wall-clock mode time follows the wall clock and this raises).
+
+        Raises:
+            PlcConfigError: wall-clock mode, not a duration, a negative one,
+                or more than :data:`~plcrt.engine.values.MAX_STEPS` bus
+                cycles in one call.
+        """
         if self.clock == "wall":
             raise PlcConfigError("cia402: advance() needs clock='manual' or 'step'; "
                                  "this drive follows the wall clock")
+        what = "cia402: advance()"
         if isinstance(seconds, (int, float)) and not isinstance(seconds, bool) and seconds < 0:
-            raise PlcConfigError(f"cia402: advance({seconds}) cannot go back in time")
-        seconds = duration(seconds, "cia402: advance()")
+            raise PlcConfigError(f"{what}: {shown_value(seconds)} s cannot go back in time")
+        span = duration_us(seconds, what)
+        step_count(span, self.period_us, seconds, what, "bus cycle")
         with self._lock:
-            end = self.drive.now + round(seconds * 1e6)
+            end = self.drive.now + span
             while self.drive.now < end:
                 self.drive.tick(min(end, self._next_boundary()))
             self._fill_tpdo()

@@ -24,7 +24,7 @@ import time as _time
 import types
 import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, NoReturn, Sequence
+from typing import Any, Callable, NoReturn, Sequence
 
 from ..compiler import compile_program
 from ..compiler.cache import (Entry, compile_chunks, gc_paused, needed_paths, pair_objects,
@@ -35,6 +35,7 @@ from ..errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigErr
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
 from .clock import Clock, Station, start_time
+from .device import AxisState, DriveState
 from .counters import CounterBank
 from .coverage import CoverageMap
 from .timers import TimerBank
@@ -46,13 +47,12 @@ from ..compiler.entry import check_entry, main_block
 from .hsc import Encoder, make_counters
 from .pid import make_loops
 from .pulse import make_outputs
-from .ports import attach_devices, make_ports
+from .ports import make_ports
 from .netjobs import make_ethernet, netr_netw
-from .values import (MAX_STEPS, Duration, check_backend, check_load_options,
+from ..parts import Parts, supplied
+from .values import (MAX_STEPS, Duration, check_backend,
                      check_parsed_inputs, scan_number, scan_time_us, scan_total, source_items)
 
-if TYPE_CHECKING:
-    from ..devices import AxisState, DriveState
 
 #: Estimated execution time per instruction for the watchdog (µs).  Only
 #: loops (FOR/NEXT, backward jumps) are checked, and their instructions are
@@ -74,7 +74,7 @@ class Plc(AddressAccess):
                  plant: Any = None, instrument: bool = False, library: bool = False,
                  auto_symbols: bool = False, clock: Any = None, backend: str | None = None,
                  entry: str | None = None,
-                 _entry: Any = None, _template: bool = False) -> None:
+                 _entry: Any = None, _template: bool = False, _parts: Parts | None = None) -> None:
         scan_us = scan_time_us(scan_ms)
         if pace not in ("simulated", "realtime"):
             raise PlcConfigError(f"pace must be 'simulated' or 'realtime', got {pace!r}")
@@ -92,7 +92,10 @@ class Plc(AddressAccess):
         if not isinstance(program, ir.Program):
             raise PlcConfigError(f"Plc() needs a parsed program; load a file or text with "
                                  f"plcrt.load(), got {type(program).__name__}")
-        check_parsed_inputs(symbols, data, plant)
+        #: what the layers above fit this PLC with: devices, port devices,
+        #: library blocks (plcrt.parts; a fork gets the same)
+        self._parts = parts = _parts if _parts is not None else supplied()
+        check_parsed_inputs(symbols, data, plant, parts.is_plant)
         if system_symbols is not None and not isinstance(system_symbols, dict):
             raise PlcConfigError(f"system_symbols must be a dict of name -> address, got "
                                  f"{type(system_symbols).__name__}")
@@ -202,8 +205,7 @@ class Plc(AddressAccess):
         self.diagnostics: list[Any] = []
         self.modules: dict[int, Any] = {}
         if plant is not None:
-            from ..devices import build_devices
-            self.devices = build_devices(self, plant)
+            self.devices = parts.build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
         if _entry is None and _template:
             # a template of the program cache: compiled here, never run
@@ -237,7 +239,7 @@ class Plc(AddressAccess):
         # are read-only to the program, so they are written once.
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")
         self.mem.areas["SM"][22:28] = ms * 3
-        attach_devices(self.ports, plant)   # a plant device sends at given times
+        parts.attach_port_devices(self.ports, plant)   # a plant device sends at given times
         self._replain()
 
     # -- the plain scan ---------------------------------------------------------
@@ -285,12 +287,9 @@ class Plc(AddressAccess):
         cache entry (:mod:`plcrt.compiler.cache`): it never runs, so its
         run-time objects stay as they are at power-up for every PLC built
         from it."""
-        from ..blocks.call import library_call, protected_call
-
         def setup(unit: Any) -> None:
             unit.hooks["plc"] = self
-            unit.hooks["library_call"] = library_call
-            unit.hooks["protected_call"] = protected_call
+            unit.hooks.update(self._parts.compile_hooks)
             unit.hooks["timers"] = self.timers
             unit.hooks["counters"] = self.counters
 
@@ -340,7 +339,7 @@ class Plc(AddressAccess):
         entry = programs.get(key, program)
         if entry is None:
             try:
-                template = Plc(program, **cfg, _template=True)
+                template = Plc(program, **cfg, _template=True, _parts=self._parts)
             except PlcCompileError as e:
                 e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
                 raise
@@ -920,7 +919,7 @@ class Plc(AddressAccess):
         counters, edges, library blocks, devices, time, forces); running one
         never affects the other."""
         # the same compiled program (never compiled again, cached or not)
-        twin = Plc(self.program, **self._config, _entry=self._entry)
+        twin = Plc(self.program, **self._config, _entry=self._entry, _parts=self._parts)
         self._copy_state(twin)
         return twin
 
@@ -930,7 +929,7 @@ class Plc(AddressAccess):
         of the same compiled program with this one's memory (the data
         block).  Everything else already is as the load left it, so nothing
         needs deep-copying (perf: a fraction of a fork's time)."""
-        twin = Plc(self.program, **self._config, _entry=self._entry)
+        twin = Plc(self.program, **self._config, _entry=self._entry, _parts=self._parts)
         dareas = twin.mem.areas
         for k, buf in self.mem.areas.items():
             dareas[k][:] = buf
@@ -988,7 +987,7 @@ class Plc(AddressAccess):
             cfg["backend"] = check_backend(backend)
         if cfg == self._config:
             return self.fork()
-        twin = Plc(self.program, **cfg)
+        twin = Plc(self.program, **cfg, _parts=self._parts)
         self._copy_state(twin, across=True)
         return twin
 
@@ -1181,56 +1180,4 @@ def parse_sources(sources: str | Path | Sequence[str | Path], *,
                         max_bytes=file_limit(max_file_mb))[0]
 
 
-def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
-         data: Any = None, scan_ms: float = 10.0, cpu: str | None = None,
-         encoding: str | None = None, **kw: Any) -> Plc:
-    """Parse, compile and bind a program.
-
-    Args:
-        source: a path to a ``.awl`` file, program text (anything with a
-            newline), or a list of them whose blocks are merged.
-        symbols: path or text of a symbol table, or a parsed table.
-        data: path or text of a data block, or a parsed one.
-        scan_ms: simulated scan time in milliseconds, a whole number of
-            microseconds from 0.001 to 60000 (``0.0015`` is refused, not
-            rounded).
-        cpu: CPU model name (default CPU 226).
-        encoding: text encoding of the files (``"cp1252"``, ``"gbk"``,
-            ``"utf-8"`` ...); by default it is detected, one for all files
-            where one fits (:mod:`plcrt.lang.encoding`).
-        library: accept a program without OB1 (a subroutine library: it
-            compiles, a scan runs nothing); without it such a program, or an
-            empty one, is a :class:`PlcCompileError`.
-        max_file_mb: the largest program, symbol or data file read, in MB
-            (default: :data:`plcrt.lang.limits.MAX_FILE_MB`).
-        clock: the real-time clock's reading at power-up (TODR): a
-            ``datetime``, a text ``"2026-12-02T08:00:00"`` or ``"now"`` (the
-            host's clock); default the plant file's ``[cpu] clock``, else
-            2024-01-01 00:00:00 (:mod:`plcrt.engine.clock`).
-
-    Raises:
-        PlcSyntaxError, PlcCompileError, PlcConfigError: with locations.
-    """
-    from ..lang.limits import file_limit
-
-    check_load_options(symbols=symbols, data=data, plant=kw.get("plant"), options=kw)
-    plant = kw.pop("plant", None)
-    max_file_mb = kw.pop("max_file_mb", None)
-    limit = file_limit(max_file_mb)
-    if isinstance(plant, (str, Path, dict)):
-        from ..devices.plant import load_plant
-        plant = load_plant(plant)
-    from ..lang.sources import read_program
-    # the CPU's V size, so that data block entries past its end are
-    # reported in the same run as the syntax errors
-    # perf: parsing and compiling allocate millions of objects that all
-    # stay alive; automatic collections would only walk them (gc_paused)
-    with gc_paused():
-        program, symbols, data = read_program(source_items(source), symbols, data,
-                                              encoding=encoding, max_bytes=limit,
-                                              v_bytes=cpu_model(cpu).v_bytes)
-        return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
-                   **kw)
-
-
-__all__ = ["Plc", "load", "parse_sources"]
+__all__ = ["Plc", "parse_sources"]

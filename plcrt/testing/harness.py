@@ -23,11 +23,12 @@ from pathlib import Path
 from typing import Any, Union
 
 from ..devices import AxisState, DriveState
-from ..engine.runtime import Plc, load
+from ..engine.runtime import Plc
 from ..engine.values import (Duration, check_address, duration_us, scan_number,
                              shown_value, step_count)
 from ..engine.values import duration as parse_duration
 from ..errors import PlcAddressError, PlcConfigError, PlcError, SourceLoc
+from ..loader import load
 from .conditions import Condition, addresses_of, condition, quoted, reader
 
 Value = Union[int, float, bool]

@@ -89,7 +89,11 @@ def child(path: str, mode: str) -> dict[str, Any]:
     if mode == "gc-on":
         if not hasattr(runtime, "gc_paused"):
             return {"mode": mode, "skipped": "this plcrt does not pause the collector"}
-        runtime.gc_paused = contextlib.nullcontext   # type: ignore[attr-defined]
+        # where the engine pauses it: building a PLC and compiling its template
+        for name in ("plcrt.engine.runtime", "plcrt.engine.binding"):
+            module = sys.modules.get(name)
+            if module is not None and hasattr(module, "gc_paused"):
+                module.gc_paused = contextlib.nullcontext   # type: ignore[attr-defined]
     text = Path(path).read_text()
     gc.collect()
     if mode == "trace":

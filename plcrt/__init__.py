@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from .blocks import add_library_loader as _add_library_loader
+from .parts import add_parts_loader as _add_parts_loader
 from .errors import (Diagnostic, PlcAddressError, PlcCompileError, PlcConfigError,
                      PlcError, PlcRuntimeError, PlcSyntaxError, SourceLoc)
 
@@ -26,30 +27,41 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from .engine.link import Network, link
-    from .engine.runtime import Plc, load
+    from .engine.runtime import Plc
+    from .loader import load
 
 
 def __getattr__(name: str) -> Any:
     # perf: the engine (lark, the compiler) loads on first use, so that
     # `import plcrt` stays cheap for the pytest plugin and the CLI's --help
     if name in ("Plc", "load"):
-        from .engine import runtime
-        return getattr(runtime, name)
+        from . import loader
+        return getattr(loader, name)
     if name in ("link", "Network"):
         from .engine import link
         return getattr(link, name)
     raise AttributeError(f"module 'plcrt' has no attribute {name!r}")
 
 
+# The composition: the registries below hold what the layers above them
+# supply, and never import it; this module hands them the imports, run
+# when first needed (perf: not by `import plcrt`).
+
 def _load_device_libraries() -> None:
     """The library blocks of plcrt's devices, for the block registry, which
     sits below them and never imports them (plcrt.blocks)."""
-    # perf: imported by the first compiled call that needs a library block,
-    # not by `import plcrt`
     from .devices import libraries  # noqa: F401
 
 
+def _load_parts() -> None:
+    """What every PLC is fitted with (devices, port devices, the library
+    blocks' compiler hooks), for the engine, which sits below them and
+    never imports them (plcrt.parts): plcrt.loader supplies it."""
+    from . import loader  # noqa: F401
+
+
 _add_library_loader(_load_device_libraries)
+_add_parts_loader(_load_parts)
 
 __all__ = [
     "load", "Plc", "link", "Network", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",

@@ -35,7 +35,7 @@ from typing import Any, Callable, Optional
 
 from .serial import Framing, Inbox, framing_of, table_at
 
-__all__ = ["Port", "make_ports", "attach_devices", "PORTS_OF", "STATUS"]
+__all__ = ["Port", "make_ports", "PORTS_OF", "STATUS"]
 
 #: SM layout per port: (SMB30-style control, receive status, receive control,
 #: receive-character event, transmit-complete event, message event, SMB4 idle bit)
@@ -386,21 +386,3 @@ def make_ports(plc: Any, plant: Any) -> list[Port]:
             raise PlcConfigError(f"{cfg.where}: the {plc.model.name} has port 0 only")
         ports[k].address, ports[k].ppi_baud = cfg.address, cfg.ppi_baud
     return ports
-
-
-def attach_devices(ports: list[Port], plant: Any) -> None:
-    """Put the plant's scripted devices at the ports (once the scheduler
-    that their first messages wake exists)."""
-    for k, cfg in (getattr(plant, "ports", None) or {}).items():
-        if cfg.device is not None:
-            from ..devices.portdev import ScriptedDevice
-            ScriptedDevice(cfg.device).attach(ports[k])
-        elif cfg.modbus is not None:
-            from ..devices.modbus.slave import ModbusSlave
-            ModbusSlave(cfg.modbus).attach(ports[k])
-        elif getattr(cfg, "uss", None) is not None:
-            from ..devices.uss.drive import UssBus
-            UssBus(cfg.uss).attach(ports[k])
-        elif getattr(cfg, "modbus_master", None) is not None:
-            from ..devices.modbus.plantmaster import PlantMaster
-            PlantMaster(cfg.modbus_master).attach(ports[k])

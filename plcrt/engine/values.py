@@ -32,7 +32,7 @@ import math
 import numbers
 import re
 import struct
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any, Union
 
@@ -540,17 +540,19 @@ def check_load_options(*, symbols: Any, data: Any, plant: Any, options: dict[str
             _check_text_or_path(x, what, "a file path or the file's text")
 
 
-def check_parsed_inputs(symbols: Any, data: Any, plant: Any) -> None:
-    """Plc()'s symbols, data and plant: parsed, or None."""
-    from ..devices.plant import Plant
+def check_parsed_inputs(symbols: Any, data: Any, plant: Any,
+                        is_plant: Callable[[Any], bool]) -> None:
+    """Plc()'s symbols, data and plant: parsed, or None (*is_plant* tells a
+    parsed plant: :attr:`plcrt.parts.Parts.is_plant`)."""
     from ..lang import DataBlock, SymbolTable
-    for what, x, kind, forms in (
-            ("symbols", symbols, SymbolTable, "a symbol table's path or text, or a "
-                                              "plcrt.lang.SymbolTable"),
-            ("data", data, DataBlock, "a data block's path or text, or a plcrt.lang.DataBlock"),
-            ("plant", plant, Plant, "a plant file's path or TOML text, a dict, or a "
-                                    "plcrt.devices.plant.Plant")):
-        if x is not None and not isinstance(x, kind):
+    for what, x, ok, forms in (
+            ("symbols", symbols, isinstance(symbols, SymbolTable),
+             "a symbol table's path or text, or a plcrt.lang.SymbolTable"),
+            ("data", data, isinstance(data, DataBlock),
+             "a data block's path or text, or a plcrt.lang.DataBlock"),
+            ("plant", plant, plant is None or is_plant(plant),
+             "a plant file's path or TOML text, a dict, or a plcrt.devices.plant.Plant")):
+        if x is not None and not ok:
             raise PlcConfigError(f"{what} must be {forms}; got {_typed(x)}")
 
 

@@ -215,7 +215,7 @@ def load_from_args(args: argparse.Namespace, scan_ms: float = 10.0, *,
     plant = getattr(args, "plant", None)
     # perf: the engine (the compiler, lark) is imported when a command runs
     # a program, never for --help or a usage error
-    from ..engine.runtime import load
+    from ..loader import load
 
     pace = "realtime" if getattr(args, "realtime", False) else "simulated"
     # Path objects make load() read files, never take the argument as text.

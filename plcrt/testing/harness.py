@@ -27,10 +27,11 @@ from pathlib import Path
 from typing import Any
 
 from ..devices import AxisState
-from ..engine.runtime import Plc, load
+from ..engine.runtime import Plc
 from ..engine.values import Duration, duration_us, scan_number, shown_value, step_count
 from ..engine.values import duration as parse_duration
 from ..errors import PlcConfigError, PlcError, SourceLoc
+from ..loader import load
 from .conditions import Condition, Value, addresses_of, condition, quoted, reader
 from .motion import Motion
 from .stimuli import Stimuli

@@ -448,7 +448,7 @@ def test_internal_error_is_reported_without_traceback(
     def boom(*args: object, **kw: object) -> None:
         raise RuntimeError("something broke")
 
-    monkeypatch.setattr("plcrt.engine.runtime.load", boom)
+    monkeypatch.setattr("plcrt.loader.load", boom)
     monkeypatch.delenv("PLCRT_TRACEBACK", raising=False)
     code, _, err = run_cli(capsys, "check", SEAL_IN)
     assert code == 1

@@ -20,7 +20,7 @@ import pytest
 from plcrt.cli import main
 from plcrt.debug.session import Session
 from plcrt.devices import DriveState
-from plcrt.engine.runtime import load
+from plcrt.loader import load
 from plcrt.errors import PlcAddressError, PlcConfigError
 from plcrt.testing.harness import Harness
 

@@ -11,7 +11,7 @@ import pytest
 
 import plcrt
 from plcrt.compiler import cache, codegen
-from plcrt.engine import runtime
+from plcrt.engine import binding as engine_binding
 from plcrt.engine.runtime import Plc, parse_sources
 
 # Timers, counters, a subroutine with its own L buffer per call site, a
@@ -250,13 +250,13 @@ def test_generated_code_that_does_not_compile_is_an_internal_error(
 def test_the_collector_is_off_while_compiling_and_restored_after(
         monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
     seen: list[bool] = []
-    original = runtime.compile_program
+    original = engine_binding.compile_program
 
     def spy(*args: Any, **kw: Any) -> Any:
         seen.append(gc.isenabled())
         return original(*args, **kw)
 
-    monkeypatch.setattr(runtime, "compile_program", spy)
+    monkeypatch.setattr(engine_binding, "compile_program", spy)
     assert gc.isenabled()
     plcrt.load(PROGRAM)
     assert seen == [False] and gc.isenabled()

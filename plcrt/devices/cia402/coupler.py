@@ -71,8 +71,8 @@ from __future__ import annotations
 import struct
 from typing import Any, Optional
 
+from ...engine.device import AxisState, DriveState
 from ...errors import PlcConfigError, PlcError
-from ..state import AxisState, DriveState
 from .drive import Drive
 from .esm import EsmState
 from .od import DTYPES, SdoAbort

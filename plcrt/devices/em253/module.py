@@ -19,8 +19,8 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+from ...engine.device import AxisState
 from ...errors import PlcConfigError
-from ..state import AxisState
 from .axis import NEVER, Axis, AxisPlant
 
 CLR_PULSE_US = 200_000  #: CLR output pulse length (manual 2.1: "about 200 ms")

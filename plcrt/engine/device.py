@@ -5,8 +5,10 @@ states the API reports: :class:`AxisState` (an axis of a positioning
 module) and :class:`DriveState` (a CiA 402 drive on a fieldbus module),
 both also read-only mappings.  Re-exported by :mod:`plcrt.devices`.
 
-What it is not: any device.  The modules (:mod:`.em253.module`,
-:mod:`.cia402.coupler`) build on this module and report through it.
+What it is not: any device.  The devices sit above the engine: the modules
+(:mod:`plcrt.devices.em253.module`, :mod:`plcrt.devices.cia402.coupler`)
+build on this module and report through it, and the engine steps them
+through :class:`Device` without importing them (:mod:`plcrt.parts`).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from typing import Any, ClassVar, Protocol
 
 from ..errors import PlcKeyError
 from ..safetext import shown_value
-from .cia402.status import describe_statusword
+from .statusword import describe_statusword
 
 __all__ = ["AxisState", "Device", "DriveState"]
 

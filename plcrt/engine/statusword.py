@@ -1,10 +1,13 @@
-"""The statusword 6041h in words: what a display shows of a drive.
+"""The CiA 402 statusword 6041h in words: what a display shows of a drive.
 
 What it is: :func:`describe_statusword`, the names of the bits set in a
 statusword for the mode shown in 6061h and the model (HCFA §7.4.2 for the
 common bits, §7.5.3 PP, §7.5.4 HM, §7.6 PV/CSP; Kinco §2.6 for its bit 15),
-as tables.  The power state itself comes from
-:func:`~.states.state_of_statusword`.
+as tables, for :attr:`plcrt.engine.device.DriveState.flags`.  It sits in
+the engine with the states the API reports; the drives
+(:mod:`plcrt.devices.cia402`) build on it, never the other way round.  The
+power state itself comes from
+:func:`plcrt.devices.cia402.states.state_of_statusword`.
 
 What it is not: no state logic; the drive sets the bits, this only reads them.
 """

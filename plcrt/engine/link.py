@@ -110,7 +110,15 @@ class Network:
         return plc.ports[number]
 
     def ethernet_of(self, ip: bytes) -> Optional[Any]:
-        """The Ethernet interface with address *ip* in this network."""
+        """The Ethernet interface with address *ip* (4 bytes, as a GET/PUT
+        table holds it) in this network, or None.
+
+        Raises:
+            PlcConfigError: ``ip`` is not 4 bytes.
+        """
+        if not isinstance(ip, bytes) or len(ip) != 4:
+            raise PlcConfigError(f"an IP address is 4 bytes (b'\\xc0\\xa8\\x00\\x01'), got "
+                                 f"{type(ip).__name__} {shown_value(ip)}")
         for plc in self.plcs:
             # a CPU in STOP still serves GET/PUT (its server runs)
             if plc.ethernet.ip == ip:

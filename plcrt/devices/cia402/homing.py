@@ -542,6 +542,9 @@ class HomingSequence:
         if m is not None and m.signal == HARD_STOP and d == m.search:
             return self._fail(t, x, f"607Ch = {p.offset} points into the mechanical end "
                                     f"(offset mode 0 moves it, Kinco §2.3-3)")
+        if self.plant.limit_active(PLS if d > 0 else NLS, x):   # into it: docs/cia402.md
+            self.state = "offset"
+            return self._limit_error(t, x, PLS if d > 0 else NLS)
         segs, _ = plan_distance(Fraction(t), F0, F0, self.vh, F0, Fraction(abs(p.offset)),
                                 self.rate, self.rate)
         return self._phase("offset", t, x, d, segs, [])

@@ -18,37 +18,36 @@ Protocol (what the drive calls)::
   and moves in ``direction`` (+1 / -1, or standing still) along ``segs``
   (:mod:`plcrt.devices.motion` segments of travel from 0, in absolute time).
   ``position_at(t)`` / ``speed_at(t)`` give the axis state inside it.
-* The drive reports the first of: a watched position reached
-  (``Watch.event``), the end of a finite phase (``"end"``; a phase with no
-  segments stands still until ``until``), the ``deadline`` (``"timeout"``,
-  HCFA P03.07).  :meth:`Phase.first_event` finds it exactly.  The position
-  reported for a watch is the watched position itself.
-* :class:`Done` carries the home point (mechanical, where the home event
-  was latched), the final mechanical position and ``position_shift``: the
-  value to add to mechanical positions so that 6064h reads as the model's
-  offset rule says.  :class:`Failed` carries the explanation (method, the
-  missing or unexpected signal, the manual section) and the alarm number
-  where the manual gives one (HCFA 62 invalid method, 63 timeout).
+* The drive reports the first of: a watched position reached (``Watch.event``),
+  the end of a finite phase (``"end"``; a phase with no segments stands still
+  until ``until``), the ``deadline`` (``"timeout"``, HCFA P03.07).
+  :meth:`Phase.first_event` finds it exactly.  The position reported for a
+  watch is the watched position itself.  A watch reached at the µs a phase ends
+  comes before the end.
+* :class:`Done` carries the home point (mechanical, where the home event was
+  latched), the final mechanical position and ``position_shift``: the value to
+  add to mechanical positions so that 6064h reads as the model's offset rule
+  says.  :class:`Failed` carries the explanation (method, the missing or
+  unexpected signal, the manual section) and the alarm number where the manual
+  gives one (HCFA 62 invalid method, 63 timeout).
 * ``seq.abort(t)`` (controlword bit 4 1 -> 0, halt, quick stop) ends the
   sequence; the drive stops the axis by its own rules.
 
-Paths (HCFA §10.1, applied to both models; Kinco §2.5 is silent on speeds):
-search at 6099h:01 with 609Ah; on the first switch edge slow to 6099h:02
-(continuing, when the next target lies ahead) or decelerate with 609Ah to a
-stop and reverse; every approach of the defining edge and every index
-search runs at 6099h:02; a start on the switch leaves it at 6099h:02,
-except methods 4, 6, 20, 22, which leave at 6099h:01 (HCFA §10.1 4A, 6B,
-20B, 22B) and off the switch approach at 6099h:02 at once.  A limit switch
-in the search direction of 7-14 / 23-30 stops the axis at once and
-reverses the search (path B).  Phases at 6099h:02 start and stop at once;
-the axis stops at once at the home event.  Kinco latches the defining edge
-in the search when the search crosses it in the final direction (§2.5,
-method 12 from the positive side); HCFA re-approaches it at 6099h:02.
-Kinco -17 / -18 (§2.5) search at 6099h:01 toward the mechanical end
-(limits are not watched); from the end on, a standing "stall" phase lasts
-until the first armed criterion (6065h, 6099h:04, 60F9h:0A) holds, timed on
-the command that still runs at 6099h:01; a start at the end stalls at once,
-the command starting from rest.
+Paths (HCFA §10.1, for both models; Kinco is silent on speeds): search at
+6099h:01 with 609Ah; on the first switch edge slow to 6099h:02 (continuing,
+when the next target lies ahead) or decelerate with 609Ah to a stop and
+reverse; the defining edge is approached and the index searched at 6099h:02; a
+start on the switch leaves it at 6099h:02, except methods 4, 6, 20, 22, which
+leave at 6099h:01 (HCFA §10.1 4A, 6B, 20B, 22B) and off the switch approach at
+6099h:02 at once.  A limit switch in the search direction of 7-14 / 23-30 stops
+the axis at once and reverses the search (path B). Phases at 6099h:02 start and
+stop at once; the axis stops at once at the home event.  Kinco latches the
+defining edge in the search when the search crosses it in the final direction
+(§2.5, method 12 from the + side); HCFA re-approaches it at 6099h:02. Kinco
+-17/-18 (§2.5) search at 6099h:01 toward the mechanical end, past the limits;
+from the end on, a standing "stall" phase lasts until the first armed criterion
+(6065h, 6099h:04, 60F9h:0A) holds, timed on the command that still runs at
+6099h:01; a start at the end stalls at once, the command starting from rest.
 Decisions are logged in docs/cia402.md, "Homing".
 """
 
@@ -259,7 +258,7 @@ class HomingSequence:
         self.state = "failed"
         return Failed(t, x, f"{self._label()} failed: {why}; no home was set", alarm)
 
-    def _limit_error(self, t: int, x: int, which: str) -> Failed:
+    def _limit_error(self, t: int, x: int, which: str, phase: str = "") -> Failed:
         m = self.method
         assert m is not None
         if self.reversed and which != m.reverse_at:
@@ -269,7 +268,7 @@ class HomingSequence:
         else:
             rule = ("the method does not use this limit in this phase (plcrt extends the "
                     "§7.5.4 error table, docs/cia402.md)")
-        return self._fail(t, x, f"{LIMIT_NAME[which]} active at {x} in the {self.state} "
+        return self._fail(t, x, f"{LIMIT_NAME[which]} active at {x} in the {phase or self.state} "
                                 f"phase; {rule}")
 
     # -- phase builders -------------------------------------------------------------
@@ -306,8 +305,7 @@ class HomingSequence:
         d = self.phase.direction if self.phase else 0
         if v <= self.vl:
             return self._position(t, x)
-        seg = ramp(Fraction(t), F0, v, F0, self.rate)
-        return self._phase("decelerate", t, x, d, [seg], [])
+        return self._phase("decelerate", t, x, d, [ramp(Fraction(t), F0, v, F0, self.rate)], [])
 
     # -- start ----------------------------------------------------------------------
     def start(self, t: int, x: int) -> Step:
@@ -542,6 +540,8 @@ class HomingSequence:
         if m is not None and m.signal == HARD_STOP and d == m.search:
             return self._fail(t, x, f"607Ch = {p.offset} points into the mechanical end "
                                     f"(offset mode 0 moves it, Kinco §2.3-3)")
+        if self.plant.limit_active(PLS if d > 0 else NLS, x):   # into it: docs/cia402.md
+            return self._limit_error(t, x, PLS if d > 0 else NLS, "offset")
         segs, _ = plan_distance(Fraction(t), F0, F0, self.vh, F0, Fraction(abs(p.offset)),
                                 self.rate, self.rate)
         return self._phase("offset", t, x, d, segs, [])

@@ -27,8 +27,10 @@ The translation (HCFA §7.5.4, Kinco §2.1):
   once.  A start at the end pushes into it at 6099h:01.  The sequence's
   watch of the end is not a count watch: the drive's :mod:`.stops` reports
   it (``stop_watch``) at the µs the demand reaches the end;
-* the drive's ``"stopped"`` event is the phase's ``"end"``; a watch reports
-  the watched position itself, as :meth:`Phase.first_event` does;
+* the drive's ``"stopped"`` event is the phase's ``"end"``, unless the
+  motion ends on a watched position it moved to: then it is that watch, as
+  in :meth:`Phase.first_event`, where a watch reached at the µs the phase
+  ends comes first; a watch reports the watched position itself;
 * :class:`~.homing.Done` is ``"attained"`` with ``home_position`` = the
   final mechanical position plus ``position_shift`` (the model's offset
   rule); :class:`~.homing.Failed` is ``"error"`` with its explanation, and a
@@ -90,10 +92,26 @@ class SequencePlan:
     def event(self, name: str, t_us: int, position: int) -> HomingStep:
         assert self.seq is not None
         if name in ("stopped", STALL_TIMER):
-            step = self.seq.on_event(t_us, position, "end")
+            event = self._watch_at_end(position)
+            step = self.seq.on_event(t_us, self._watch_at.get(event, position), event)
         else:
             step = self.seq.on_event(t_us, self._watch_at.get(name, position), name)
         return self._step(step, moving=True)
+
+    def _watch_at_end(self, position: int) -> str:
+        """The event the sequence sees when the phase's motion ends at ``position``.
+
+        A watched position the motion reaches exactly where it ends is reached at
+        the µs it ends: :meth:`Phase.first_event` reports the watch then, not the
+        end (the first such watch in the phase's order), so the drive does too -
+        a Kinco offset move that ends on a limit switch meets the limit.
+        """
+        ph = self.phase
+        if ph is not None and ph.segs:
+            for w in ph.watches:
+                if w.position == position and (w.position - ph.x0) * ph.direction > 0:
+                    return w.event
+        return "end"
 
     # -- translation ------------------------------------------------------------------
     def _step(self, step: Step, moving: bool) -> HomingStep:

@@ -328,6 +328,49 @@ def test_kinco_hard_stop_moves_off_by_a_positive_offset():
     assert result.position == -12000 + 300 and result.position + result.position_shift == 0
 
 
+@pytest.mark.parametrize("n,start,offset,end", [
+    (18, 0, 1, PL), (17, 0, -1, NL),                         # home next to the limit
+    (19, -5000, PL - (LO - 1), PL), (19, -5000, NL - (LO - 1), NL),
+    (19, -5000, PL - LO, None), (19, -5000, NL - LO + 2, None),   # one count short
+])
+def test_kinco_offset_move_that_ends_on_a_limit_is_a_homing_error(n, start, offset, end):
+    """Kinco 6099h:05 = 0: an offset move that ends where a limit goes active meets
+    it, as every phase that does not use the limit: bit 13 at the limit, naming it
+    and the offset phase; a move that stops one count short homes there."""
+    result, phases = home(KINCO, n, start, offset=offset, offset_mode=0)
+    assert phases[-1].name == "offset"
+    if end is None:
+        assert isinstance(result, Done) and result.position == result.home_point + offset
+        return
+    which = "positive limit (PLS)" if end == PL else "negative limit (NLS)"
+    assert isinstance(result, Failed) and result.position == end
+    assert f"{which} active at {end} in the offset phase" in result.explanation
+
+
+@pytest.mark.parametrize("start,offset,fails", [
+    (PL, 250, True), (PL + 5, 1, True), (NL, -250, True),    # further into the active limit
+    (PL, -250, False), (NL - 5, 250, False),                 # off it
+])
+def test_kinco_offset_move_from_an_active_limit(start, offset, fails):
+    """Kinco 35 started on a limit, 6099h:05 = 0: an offset move further into the
+    active limit is a homing error at once (the limit is active all the way); one
+    that leaves the limit homes."""
+    result, phases = home(KINCO, 35, start, offset=offset, offset_mode=0)
+    if fails:
+        assert isinstance(result, Failed) and phases == [] and result.position == start
+        assert "in the offset phase" in result.explanation
+    else:
+        assert isinstance(result, Done) and result.position == start + offset
+
+
+def test_on_a_limit_without_an_offset_move_35_homes():
+    """35 moves nothing with HCFA's rule or Kinco offset mode 1: a start on a limit
+    homes there."""
+    for model, mode in ((HCFA, 0), (KINCO, 1)):
+        result, phases = home(model, 35, PL, offset=250, offset_mode=mode)
+        assert isinstance(result, Done) and phases == [] and result.position == PL
+
+
 # -- methods 35 / 37 and the method tables ------------------------------------------------------------
 def test_kinco_35_zeroes_here_without_motion():
     result, phases = home(KINCO, 35, 777)

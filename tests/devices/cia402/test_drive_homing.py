@@ -10,9 +10,10 @@ count shift, statusword bits, faults and explanations - not the geometry.
 from __future__ import annotations
 
 import math
+import os
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from plcrt.devices.cia402.drive import Drive
 from plcrt.devices.cia402.homing import Done, Failed, HomingParams, HomingSequence, run
@@ -218,18 +219,26 @@ def test_registry_holds_every_method_of_both_models():
         assert all(f is SequencePlan for f in plans.values())
 
 
-@settings(max_examples=60, deadline=None)
-@given(model=st.sampled_from([HCFA, KINCO]), data=st.data(),
+#: a model and one of its methods, each model as likely as the other
+MODEL_METHOD = st.sampled_from([HCFA, KINCO]).flatmap(
+    lambda model: st.tuples(st.just(model), st.sampled_from(sorted(method_table(model)))))
+
+
+@settings(max_examples=int(os.environ.get("PLCRT_PROPERTY_EXAMPLES", "60")), deadline=None)
+@given(model_method=MODEL_METHOD,
        start=st.integers(NL - 200, PL + 200), lo=st.integers(-8000, 7000),
        width=st.integers(1, 2500), period=st.integers(50, 4000),
        phase=st.integers(0, 3999), offset=st.integers(-5000, 5000),
        offset_mode=st.integers(0, 1), blind_zone=st.integers(0, 2))
-def test_drive_and_sequence_agree(model, data, start, lo, width, period, phase, offset,
+# the Kinco offset move of method 18 ends on PLS (home at PL - 1, 607Ch = 1)
+@example(model_method=(KINCO, 18), start=0, lo=0, width=1, period=50, phase=0, offset=1,
+         offset_mode=0, blind_zone=0)
+def test_drive_and_sequence_agree(model_method, start, lo, width, period, phase, offset,
                                   offset_mode, blind_zone):
     """For any method, start, switch, index pattern, offset and (Kinco) offset mode
     and index blind zone the drive ends as the pure sequence does (outcome,
     position, 6064h, alarm, time)."""
-    n = data.draw(st.sampled_from(sorted(method_table(model))))
+    model, n = model_method
     drive_plant, pure = shifted(start, lo=lo, hi=lo + width, period=period,
                                 phase=phase % period)
     ref = reference(model, n, pure, offset=offset, offset_mode=offset_mode,
@@ -237,6 +246,24 @@ def test_drive_and_sequence_agree(model, data, start, lo, width, period, phase, 
     d = home_on_drive(model, n, drive_plant, offset=offset, offset_mode=offset_mode,
                       blind_zone=blind_zone)
     assert_agrees(d, ref)
+
+
+@pytest.mark.parametrize("n,start,offset", [
+    (18, 0, 1), (17, 0, -1),                                  # ends on the limit
+    (19, -5000, PL - (LO - 1)), (19, -5000, NL - (LO - 1)),
+    (35, PL, 250), (35, NL, -250),                            # starts on it, goes further
+])
+def test_kinco_offset_move_onto_or_along_a_limit_fails_on_the_drive(n, start, offset):
+    """Kinco 6099h:05 = 0: the drive's offset move that ends on a limit, or starts
+    on an active one and points further into it, is the sequence's homing error:
+    bit 13 without a fault, the axis standing where the limit stopped it, no home
+    set - even when the move's end and the limit fall on the same µs."""
+    drive_plant, pure = shifted(start)
+    ref = reference(KINCO, n, pure, offset=offset)
+    assert isinstance(ref, Failed) and "in the offset phase" in ref.explanation
+    d = home_on_drive(KINCO, n, drive_plant, offset=offset)
+    assert_agrees(d, ref)
+    assert not d.sm.homed and d.position == d.axis.mechanical(d.now)
 
 
 def test_halt_and_bit_4_falling_end_homing_with_the_hcfa_words():

@@ -28,6 +28,7 @@ engine locates them and passes the width.
 
 from __future__ import annotations
 
+import itertools
 import math
 import numbers
 import re
@@ -496,6 +497,12 @@ def check_backend(backend: Any) -> str:
 _SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"
 
 
+#: most files (or texts) one program is merged from: Micro/WIN exports a
+#: project as one file, libraries add a few; the bound keeps an endless
+#: iterable from being read without end
+MAX_SOURCES = 1000
+
+
 def source_items(sources: Any) -> list[str | Path]:
     """The program sources of load() as a list, each checked.
 
@@ -506,9 +513,18 @@ def source_items(sources: Any) -> list[str | Path]:
             or not isinstance(sources, Iterable):
         items = [sources]
     else:
-        items = list(sources)
+        try:
+            # one more than allowed, so that a longer (or endless) iterable
+            # is refused without being read to its end
+            items = list(itertools.islice(iter(sources), MAX_SOURCES + 1))
+        except TypeError:
+            # an object that says it is iterable and is not (a 0-d array)
+            items = [sources]
         if not items:
             raise PlcConfigError("no program given: the list of program files is empty")
+        if len(items) > MAX_SOURCES:
+            raise PlcConfigError(f"a program is at most {MAX_SOURCES} files (or texts) "
+                                 f"whose blocks are merged; got more")
     for x in items:
         _check_text_or_path(x, "the program", _SOURCE_FORMS + ", or a list of them")
     return items

@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import PlcConfigError
-from ..safetext import excerpt
+from ..safetext import excerpt, shown_value
 
 #: blocks a scan can run as its main program (an interrupt routine runs on
 #: its event, so it is not one)
@@ -37,7 +37,7 @@ def check_entry(entry: Any) -> None:
     """
     if not isinstance(entry, str) or not entry.strip() or len(entry) > 64:
         raise PlcConfigError(f"entry must name a block (OB1, SBR0 or a subroutine's name), "
-                             f"got {excerpt(repr(entry))}")
+                             f"got {shown_value(entry)}")
 
 
 def block_list(pous: Any) -> str:

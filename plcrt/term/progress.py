@@ -17,7 +17,6 @@ parses no option (see :mod:`plcrt.term.options`).
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from typing import Any, Callable, TextIO
@@ -80,15 +79,20 @@ def _is_terminal(stream: Any) -> bool:
         return False
 
 
+#: the largest finite float: a limit at or past it cannot be added to a clock
+_FLOAT_MAX = sys.float_info.max
+
+
 def check_max_wall(max_wall: float | None) -> None:
-    """Refuse a wall-time limit that is not a positive finite number.
+    """Refuse a wall-time limit that is not a positive finite number (an
+    int too large for a float is no finite number of seconds either).
 
     Raises:
         PlcConfigError: naming ``--max-wall``.
     """
     if max_wall is not None and (isinstance(max_wall, bool)
                                  or not isinstance(max_wall, (int, float))
-                                 or not 0 < max_wall < math.inf):
+                                 or not 0 < max_wall < _FLOAT_MAX):
         raise PlcConfigError(f"--max-wall must be a positive number of seconds, "
                              f"got {type(max_wall).__name__} {_shown(max_wall)}")
 

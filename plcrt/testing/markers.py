@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..safetext import excerpt
+
 #: keyword arguments of the marker and of ``plc_factory``
 OPTIONS = ("symbols", "data", "plant", "scan_ms", "cpu", "watch", "history", "max_time",
            "encoding", "clock")
@@ -87,8 +89,13 @@ def _resolve(value: Any, what: str, bases: list[Path]) -> Path:
         raise PlcUsageError(e.message) from None
     candidates = [p] if p.is_absolute() else [b / p for b in bases]
     for c in candidates:
-        if c.is_file():
-            return c.resolve()
+        try:
+            if c.is_file():
+                return c.resolve()
+        except OSError as e:
+            # a name the file system cannot look up (too long, a bad mount)
+            raise PlcUsageError(f"{what} file {excerpt(os.fspath(value))!r}: "
+                                f"{e.strerror or e}") from None
     looked = ", ".join(str(c) for c in candidates)
     raise PlcUsageError(f"{what} file {os.fspath(value)!r} not found (looked for {looked})")
 

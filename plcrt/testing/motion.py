@@ -89,12 +89,13 @@ class Motion:
         current when this returns."""
         __tracebackhide__ = True  # pytest: report the test's line, not ours
         total = parse_duration(limit)   # a bad limit is reported before anything runs
+        moving = self.axis(slot, axis).moving   # a bad axis, before any message
         plc = self.plc
         t0 = plc.now_us
         who = f"axis {slot}.{axis}"
         expected = f"expected the move of {who} to be done within {total:g} s"
         signals = [f"axis{slot}.{axis}.position", f"axis{slot}.{axis}.speed"]
-        if not self.axis(slot, axis).moving:
+        if not moving:
             start = min(total, 1.0)
             for _ in range(self._scans_for(start)):
                 plc.scan(1)

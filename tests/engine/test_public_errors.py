@@ -505,3 +505,32 @@ def test_the_longest_run_is_allowed() -> None:
     assert scan_total(10_000, scans=MAX_STEPS) == MAX_STEPS
     with pytest.raises(PlcConfigError):
         scan_total(10_000, seconds=MAX_STEPS * 0.01 + 0.001)
+
+
+def _progress_with_huge_wall() -> None:
+    from plcrt.trace import run_with_progress
+    run_with_progress(_plc(), scans=1, max_wall=10**400)
+
+
+def _marker_with_a_name_too_long() -> None:
+    from plcrt.testing.markers import PlcUsageError, _resolve
+    try:
+        _resolve("x" * 5000, "data", [ROOT])
+    except PlcUsageError as e:
+        raise PlcConfigError(str(e)) from None
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda: plcrt.load(TIMERS, entry=10**5000), "entry must name a block"),
+    (lambda: Harness.load(EM253 / "pos_goto_r.awl", plant=EM253 / "plant.toml")
+     .axis_done_within(1.0, axis=10**5000), "-bit integer"),
+    (_progress_with_huge_wall, "--max-wall must be a positive number of seconds"),
+    (_marker_with_a_name_too_long, "File name too long"),
+], ids=["entry huge int", "axis huge int", "max_wall huge int", "marker file name too long"])
+def test_values_no_message_or_file_system_can_take_are_plc_errors(call: Call, words: str) -> None:
+    """Found by the API fuzz: a huge int quoted in a message, an int too
+    large for a float added to a clock, a file name the file system cannot
+    look up."""
+    with pytest.raises(PlcError) as info:
+        call()
+    assert words in str(info.value)

@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from .engine.link import Network, link
     from .engine.runtime import Plc
     from .loader import load
+    from .net.serving import serve
 
 
 def __getattr__(name: str) -> Any:
@@ -37,6 +38,9 @@ def __getattr__(name: str) -> Any:
     if name in ("Plc", "load"):
         from . import loader
         return getattr(loader, name)
+    if name == "serve":
+        from .net import serving
+        return serving.serve
     if name in ("link", "Network"):
         from .engine import link
         return getattr(link, name)
@@ -64,7 +68,7 @@ _add_library_loader(_load_device_libraries)
 _add_parts_loader(_load_parts)
 
 __all__ = [
-    "load", "Plc", "link", "Network", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",
+    "load", "Plc", "link", "Network", "serve", "Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError",
     "PlcCompileError", "PlcRuntimeError", "PlcAddressError", "PlcConfigError",
     "__version__",
 ]

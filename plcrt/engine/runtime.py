@@ -131,6 +131,7 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
         self._t_us = 0
         self._prev_start: int | None = None
         self._stop = False         #: see stop_requested
+        self._entered_run = False  #: see set_mode: the next scan is a first scan
         #: perf: the scan loop's one test (_replain): False until the end of
         #: __init__ and whenever a scan needs more than the plain path
         self._plain = False

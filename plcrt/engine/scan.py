@@ -27,6 +27,7 @@ from __future__ import annotations
 import time as _time
 
 from ..errors import PlcConfigError
+from ..safetext import shown_value
 from .values import MAX_STEPS, Duration, scan_number, scan_total
 
 __all__ = ["ScanLoop", "SMB0"]
@@ -183,6 +184,37 @@ class ScanLoop:
             if self.mode != "RUN":
                 return
 
+    def set_mode(self, mode: str) -> None:
+        """Switch the CPU to ``"RUN"`` or ``"STOP"``, as the mode switch or a
+        programming device does (System Manual, "Selecting the operating
+        mode of the S7-200").
+
+        STOP: the program stops at this scan boundary and the outputs take
+        their STOP state (off, as after a STOP instruction).  RUN from STOP:
+        the next scan is a first scan (SM0.1 on, SM0.3 off: SM0.3 is for
+        RUN entered from power-up); memory keeps its values.  A CPU stopped
+        by a fatal error stays in STOP (the real CPU needs a power cycle).
+
+        Raises:
+            PlcConfigError: ``mode`` is neither, or RUN after a fatal error.
+        """
+        if mode not in ("RUN", "STOP"):
+            raise PlcConfigError(f"CPU mode must be RUN or STOP, not {shown_value(mode)}")
+        if mode == self.mode:
+            return
+        if mode == "STOP":
+            self.mode = "STOP"
+            pq = self._bufs_end[2]
+            pq[:] = bytes(len(pq))
+            return
+        if self.fault is not None:
+            raise PlcConfigError("the CPU stopped on a fatal error and stays in STOP until "
+                                 "it is powered up again (reset)")
+        self.stop_requested = False
+        self._entered_run = True
+        self._calm_hi = 0       # the next scan start recomputes SMB0 (_calm_start)
+        self.mode = "RUN"
+
     def run(self, seconds: Duration | None = None, scans: int | None = None) -> None:
         """Run for a simulated duration (``1.5``, ``"1.5s"``, ``"200ms"``,
         rounded up to whole scans) or a number of ``scans``.
@@ -262,7 +294,14 @@ class ScanLoop:
         # other scan, the clocks SM0.4 and SM0.5
         if not self._clk_lo <= now < self._clk_hi:
             self._clock(now)
-        sm[0] = self._smb0[scans & 1] if scans else 0x8B | 0x40 | self._smb0[0]
+        if scans and not self._entered_run:
+            sm[0] = self._smb0[scans & 1]
+        elif scans:   # RUN entered from STOP (set_mode): SM0.1 on, SM0.3 off
+            sm[0] = 0x83 | 0x40 | self._smb0[0]
+            self._entered_run = False
+            scans = 0   # no calm window for this first scan
+        else:
+            sm[0] = 0x8B | 0x40 | self._smb0[0]
         timers = self.timers
         if timers.quiet(now):
             timers.ms1 = now // 1000

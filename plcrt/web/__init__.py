@@ -4,7 +4,7 @@ switches and push-buttons, the outputs as lamps, a watch table, trends and
 the axes of the plant.
 
 :mod:`plcrt.web.session` runs the PLC (no web code in it) and composes
-:mod:`~plcrt.web.running` (run modes), :mod:`~plcrt.web.pacing` (speed),
+:mod:`~plcrt.web.running` (run modes), :mod:`~plcrt.net.pacing` (speed),
 :mod:`~plcrt.web.builds` (breakpoints), :mod:`~plcrt.web.watch` (watch
 table, set and force), :mod:`~plcrt.web.trend` and
 :mod:`~plcrt.web.program` (the program as the pages draw it),

@@ -3,7 +3,7 @@ continue after a breakpoint; and a chunk of scans run under them.
 
 The run state is ``stopped``, ``running``, ``stepping``, ``until`` or
 ``paused`` (inside a scan, at a breakpoint).  A chunk is as many scans as
-the :class:`~plcrt.web.pacing.Pacer` allows; a plain run hands it to
+the :class:`~plcrt.net.pacing.Pacer` allows; a plain run hands it to
 :meth:`plcrt.Plc.scan` whole, a step, a run until a condition and a run
 with breakpoints scan one scan at a time, to stop at the right one.  A
 command given while a scan is paused takes effect when that scan has run
@@ -12,7 +12,7 @@ to its end (a stop, a power-up reset).
 What it is: the state of one run and the loop over the scans of a chunk.
 What it is not: the thread, the command queue or the pause itself (the
 session waits for commands while paused, :mod:`plcrt.web.session`), nor
-the speed (:mod:`plcrt.web.pacing`).  It tells what happens through the
+the speed (:mod:`plcrt.net.pacing`).  It tells what happens through the
 ``notice`` function it is handed and asks for a power-up through
 ``reset``.
 """
@@ -25,7 +25,7 @@ from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcRuntimeError
 from ..safetext import printable
-from .pacing import Pacer
+from ..net.pacing import Pacer
 
 #: default timeout of ``until`` (simulated seconds)
 UNTIL_TIMEOUT = 10.0

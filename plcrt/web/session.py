@@ -15,7 +15,7 @@ never waits for it.
 
 The session composes the parts, each in a module of its own: the run
 modes and a chunk of scans (:mod:`plcrt.web.running`), the speed
-(:mod:`plcrt.web.pacing`), breakpoints and the builds with and without
+(:mod:`plcrt.net.pacing`), breakpoints and the builds with and without
 probes (:mod:`plcrt.web.builds`), the watch table, set and force
 (:mod:`plcrt.web.watch`), the trend (:mod:`plcrt.web.trend`) and the
 program as the pages draw it (:mod:`plcrt.web.program`).  What the session
@@ -50,7 +50,7 @@ from ..testing.harness import Harness, condition
 from .builds import Builds
 from .diagnostics import DiagnosticLog
 from .mailbox import Client, Mailbox
-from .pacing import CHUNK_S, DISPLAY_HZ, Pacer
+from ..net.pacing import CHUNK_S, DISPLAY_HZ, Pacer
 from .present import INPUT_KINDS, input_kinds, io_bits
 from .program import ProgramView
 from .protocol import finite

@@ -207,6 +207,10 @@ def _call(fn: Callable[..., Any], k: dict[str, Any]) -> Any:
 CALLS: dict[str, tuple[Call, dict[str, Any]]] = {
     "plcrt.load": (plcrt.load, {"source": TIMERS}),
     "plcrt.link": (plcrt.link, {"plc_a": PLC, "port_a": 0, "plc_b": PLC, "port_b": 0}),
+    # a served PLC is closed again at once (its servers and runner thread)
+    "plcrt.serve": (lambda **k: plcrt.serve(**k).close(),
+                    {"plc": PLC, "lockstep": 0, "speed": "lockstep"}),
+    "Plc.set_mode": (lambda **k: _plc().set_mode(k["mode"]), {"mode": "STOP"}),
     "Plc.__init__": (plcrt.Plc, {"program": Fresh(lambda: parse_sources(TIMERS))}),
     "Plc.__getitem__": (lambda **k: _plc()[k["address"]], {"address": "VW0"}),
     "Plc.__setitem__": (lambda **k: _plc().__setitem__(k["address"], k["value"]),

@@ -3,7 +3,8 @@ one way only.
 
 The runner's parts (run modes, pacing, builds and breakpoints, watch table,
 trend, the program's drawing) import nothing of the session that composes
-them, of the server or of each other (except the run modes their pacing);
+them, of the server or of each other (the pacing, shared with the network
+servers' runner, lives in plcrt.net);
 no module of plcrt.web is on an import cycle; the panel never imports the
 debugger.  Every import counts, also one inside a function or under
 TYPE_CHECKING (the graph is read from the source with ast).
@@ -17,8 +18,7 @@ WEB = PLCRT / "web"
 
 #: the parts PanelSession composes -> the modules of plcrt.web each may import
 PARTS = {
-    "running": {"pacing"},
-    "pacing": set(),
+    "running": set(),
     "builds": set(),
     "watch": {"present", "protocol"},
     "trend": {"protocol"},

@@ -1,5 +1,5 @@
-"""The panel's speed: how many scans the next chunk runs, and how fast the
-simulated time is going.
+"""The speed of a served PLC (the panel's, the network servers'): how many
+scans the next chunk runs, and how fast the simulated time is going.
 
 ``realtime`` paces simulated time to the wall clock, ``factor`` runs N
 simulated seconds per wall second, ``max`` runs as fast as it can in
@@ -9,8 +9,8 @@ up rather than caught up.
 
 What it is: arithmetic on the wall clock and the PLC's simulated time, with
 the clock and the sleep handed in (tests pass their own).  What it is not:
-the loop that runs the chunks (:mod:`plcrt.web.running`) or the thread
-(:mod:`plcrt.web.session`); it never scans.
+the loops that run the chunks (:mod:`plcrt.net.runner`,
+:mod:`plcrt.web.running`) or their threads; it never scans.
 """
 
 from __future__ import annotations

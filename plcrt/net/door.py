@@ -65,6 +65,10 @@ class ScanDoor:
         self._cond = threading.Condition()
         self._limit = limit
         self._closed = False
+        self._poked = False
+        #: how the thread serving the door runs the PLC: a runner's speed
+        #: (``"realtime"``, ``"max"``, ``"lockstep"``, a factor) or ``"panel"``
+        self.speed: str | float = "panel"
         #: jobs run so far (a figure for benches and the panel)
         self.served = 0
         #: jobs refused because the door was full
@@ -117,14 +121,24 @@ class ScanDoor:
         self.served += len(batch)
         return len(batch)
 
-    def wait(self, timeout: float) -> bool:
-        """Block up to ``timeout`` seconds until a job waits (True) or the
-        door closes; the PLC thread's sleep between chunks."""
+    def wait(self, timeout: float, *, jobs: bool = True) -> bool:
+        """Block up to ``timeout`` seconds until a job waits (True), the
+        door is woken (:meth:`wake`) or closed; the PLC thread's sleep
+        between chunks.  ``jobs=False``: waiting jobs do not end the wait
+        (the thread is inside a scan, paused at a breakpoint, and must not
+        serve them now)."""
         with self._cond:
-            if self._jobs or self._closed:
-                return bool(self._jobs)
-            self._cond.wait(timeout)
+            if not (jobs and self._jobs or self._poked or self._closed):
+                self._cond.wait(timeout)
+            self._poked = False
             return bool(self._jobs)
+
+    def wake(self) -> None:
+        """End a :meth:`wait` now (something else for the PLC's thread
+        arrived: a command of the panel)."""
+        with self._cond:
+            self._poked = True
+            self._cond.notify_all()
 
     def close(self) -> None:
         """Refuse new jobs; those waiting fail with :class:`DoorClosed`."""

@@ -5,7 +5,7 @@ Speeds (:class:`Speed`): ``realtime`` (simulated time follows the wall
 clock: what an HMI or a plant simulator expects of a CPU), a factor
 (``2.0``: two simulated seconds per wall second), ``max`` (as fast as the
 machine can) and ``lockstep`` (the PLC does not run by itself; clients
-advance it with :meth:`Runner.advance`, as PLCSIM Advanced's single-step
+advance it with :func:`advance` jobs, as PLCSIM Advanced's single-step
 mode does for virtual commissioning).
 
 Between two chunks, and whenever the pacing waits for the wall clock, the
@@ -35,7 +35,7 @@ from ..safetext import shown_value
 from .door import ScanDoor
 from .pacing import DISPLAY_HZ, Pacer
 
-__all__ = ["Runner", "Speed", "parse_speed"]
+__all__ = ["Runner", "Speed", "advance", "parse_speed"]
 
 #: ``"realtime"``, ``"max"``, ``"lockstep"`` or simulated seconds per wall second
 Speed = str | float
@@ -67,6 +67,35 @@ def parse_speed(speed: Any) -> Speed:
     return float(speed)
 
 
+def advance(plc: Plc, *, scans: int | None = None, seconds: Duration | None = None,
+            to_us: int | None = None) -> int:
+    """Run ``scans`` scans, ``seconds`` of simulated time, or up to the
+    simulated instant ``to_us`` (µs, whole scans: up to the first scan end
+    at or after it) — a lockstep step, run as a door job in the thread
+    that runs the PLC.  Returns the scans run (fewer if the CPU stops).
+
+    Raises:
+        PlcConfigError: none or more than one of them, or a bad value.
+    """
+    given = [x is not None for x in (scans, seconds, to_us)]
+    if sum(given) != 1:
+        raise PlcConfigError("advance by scans, seconds or to a time: exactly one")
+    if to_us is not None:
+        if isinstance(to_us, bool) or not isinstance(to_us, int) or to_us < 0:
+            raise PlcConfigError(f"a time to advance to is whole µs >= 0, "
+                                 f"not {shown_value(to_us)}")
+        left = to_us - plc.now_us
+        n = 0 if left <= 0 else -(-left // plc.scan_us)
+        if n > MAX_STEPS:
+            raise PlcConfigError(f"advancing to {shown_value(to_us)} µs would run {n} scans; "
+                                 f"at most {MAX_STEPS} at once")
+    else:
+        n = scan_total(plc.scan_us, seconds, scans)
+    before = plc.scans
+    plc.scan(n)
+    return plc.scans - before
+
+
 class Runner:
     """Runs ``plc`` in a thread of its own at ``speed``, serving ``door``.
 
@@ -95,7 +124,7 @@ class Runner:
 
     # -- speed -------------------------------------------------------------
     def _apply_speed(self) -> None:
-        s = self.speed
+        s = self.door.speed = self.speed
         if isinstance(s, float):
             self.pacer.set("factor", s, self.plc.now_us)
         elif s in ("realtime", "max"):
@@ -105,34 +134,6 @@ class Runner:
         """Change the speed (from the runner's thread: a door job)."""
         self.speed = parse_speed(speed)
         self._apply_speed()
-
-    # -- lockstep ----------------------------------------------------------
-    def advance(self, plc: Plc, *, scans: int | None = None,
-                seconds: Duration | None = None, to_us: int | None = None) -> int:
-        """Run ``scans`` scans, ``seconds`` of simulated time, or up to the
-        simulated instant ``to_us`` (µs, whole scans: the first scan end at
-        or after it).  A door job; returns the scans run.
-
-        Raises:
-            PlcConfigError: none or more than one of them, or a bad value.
-        """
-        given = [x is not None for x in (scans, seconds, to_us)]
-        if sum(given) != 1:
-            raise PlcConfigError("advance by scans, seconds or to a time: exactly one")
-        if to_us is not None:
-            if isinstance(to_us, bool) or not isinstance(to_us, int) or to_us < 0:
-                raise PlcConfigError(f"a time to advance to is whole µs >= 0, "
-                                     f"not {shown_value(to_us)}")
-            left = to_us - plc.now_us
-            n = 0 if left <= 0 else -(-left // plc.scan_us)
-            if n > MAX_STEPS:
-                raise PlcConfigError(f"advancing to {to_us} µs would run {n} scans; at "
-                                     f"most {MAX_STEPS} at once")
-        else:
-            n = scan_total(plc.scan_us, seconds, scans)
-        before = plc.scans
-        plc.scan(n)
-        return plc.scans - before
 
     # -- the thread --------------------------------------------------------
     def start(self) -> "Runner":

@@ -17,9 +17,12 @@ from ..errors import PlcConfigError
 from ..safetext import shown_value
 from .door import ScanDoor
 from .host import SERVICES, Serving
+from .lockstep import LockstepServer
 from .options import ServerOptions, WriteGuard, parse_listen, parse_ranges
 
 __all__ = ["serve"]
+
+SERVICES["lockstep"] = LockstepServer
 
 
 def _options(name: str, spec: Any, *, max_connections: int, idle_timeout: float,

@@ -1,8 +1,13 @@
-"""The ``plcrt serve`` subcommand: the browser panel on a local port.
+"""The ``plcrt serve`` subcommand: the browser panel on a local port, and
+the network servers (S7, Modbus TCP, lockstep) beside it or alone
+(``--no-panel``).
 
 Registered by :mod:`plcrt.cli` through :func:`register`.  Only argument
-handling, loading and starting the server live here; aiohttp is imported
-when the command runs, so other commands do not need it.
+handling, loading and starting the servers live here; aiohttp is imported
+when the panel starts, so other commands do not need it.  With the panel,
+the panel's session runs the PLC and serves the network servers' door
+(:mod:`plcrt.net.door`); without it, a :class:`plcrt.net.runner.Runner`
+does.
 """
 
 from __future__ import annotations
@@ -41,10 +46,34 @@ def register(sub: Any) -> None:
     p.add_argument("--no-breakpoints", action="store_true",
                    help="no breakpoints (scans never move to the build with network probes "
                         "that a breakpoint needs)")
+    net = p.add_argument_group(
+        "network servers", "HMIs, SCADA, plant simulators and S7 or Modbus client libraries "
+        "connect to the running program (docs/network.md); each listens on this machine "
+        "only unless a host is named (here or with --host)")
+    net.add_argument("--s7", nargs="?", const="102", metavar="[HOST:]PORT",
+                     help="S7 server (ISO-on-TCP; V memory is DB1); default port 102")
+    net.add_argument("--modbus", nargs="?", const="502", metavar="[HOST:]PORT",
+                     help="Modbus TCP server with the S7-200 Modbus slave map; default port 502")
+    net.add_argument("--lockstep", metavar="[HOST:]PORT",
+                     help="lockstep server: a client advances the PLC step by step "
+                          "(JSON lines; plcrt.net.client.LockstepClient)")
+    net.add_argument("--no-panel", action="store_true",
+                     help="no browser panel: only the network servers")
+    net.add_argument("--speed", default="realtime", metavar="SPEED",
+                     help="realtime (default), max, lockstep (only clients advance it) or "
+                          "simulated seconds per wall second (2, 0.5)")
+    net.add_argument("--read-only", action="store_true", help="clients may not write")
+    net.add_argument("--allow-writes", metavar="RANGES",
+                     help="the only addresses clients may write, e.g. VB0-VB99,I0.0-I1.7")
+    net.add_argument("--max-connections", type=int, default=8, metavar="N",
+                     help="clients per server at once (default 8; more are refused)")
+    net.add_argument("--idle-timeout", type=float, default=60.0, metavar="S",
+                     help="seconds a silent client keeps its connection (default 60; 0: "
+                          "forever)")
     p.set_defaults(func=cmd_serve)
 
 
-def build_panel(args: argparse.Namespace) -> Any:
+def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
     """Load the program (or the lesson) of the command line into a
     :class:`~plcrt.web.server.Panel`.
 
@@ -70,7 +99,8 @@ def build_panel(args: argparse.Namespace) -> Any:
         ns.plant = str(les.plant) if les.plant else args.plant
         plc = load_from_args(ns, args.scan_ms)
         print_diagnostics(plc.diagnostics)
-        return PanelSession(plc, breakpoints=not args.no_breakpoints, kinds=les.kinds())
+        return PanelSession(plc, breakpoints=not args.no_breakpoints, kinds=les.kinds(),
+                            door=door)
 
     # --host NAME (not an address) is a name the page is opened under
     hosts = [*getattr(args, "allow_host", []),
@@ -87,7 +117,7 @@ def build_panel(args: argparse.Namespace) -> Any:
         current = course.lesson(first.parent)
     lessons = course.lessons(first.parent.parent) if current else []
     session = PanelSession(plc, breakpoints=not args.no_breakpoints,
-                           kinds=current.kinds() if current else None)
+                           kinds=current.kinds() if current else None, door=door)
     return Panel(session, lessons=lessons, current=current,
                  load_lesson=load_lesson if current else None, hosts=hosts)
 
@@ -113,21 +143,110 @@ def cmd_serve(args: argparse.Namespace) -> int:
     """``plcrt serve``: 0 after Ctrl-C, 1 a program, option or port error."""
     from ..term.report import EXIT_ERROR, EXIT_OK, print_diagnostics
     from ..errors import PlcConfigError, PlcError
+    serving = None
     try:
         if not 0 <= args.port <= 65535:
             raise PlcConfigError(f"--port must be between 0 and 65535, got {args.port}")
+        servers = _server_options(args)
+        if args.no_panel:
+            if not servers:
+                raise PlcConfigError("--no-panel: name a server to run (--s7, --modbus or "
+                                     "--lockstep)")
+            return _serve_headless(args, servers, EXIT_OK)
         try:
             import aiohttp  # noqa: F401
         except ImportError:
             raise PlcConfigError("plcrt serve needs aiohttp: pip install aiohttp") from None
-        panel = build_panel(args)
+        from ..net.door import ScanDoor
+        from ..net.host import Serving
+        from ..net.runner import parse_speed
+        speed = parse_speed(args.speed)
+        door = ScanDoor()
+        panel = build_panel(args, door)
+        if servers:
+            serving = Serving(panel.session.plc, servers, runner=False, door=door).start()
+            _say_servers(serving)
+            if speed == "lockstep":   # lockstep clients step it on the panel's thread
+                door.speed = "lockstep"
+            else:
+                _panel_speed(panel.session, speed)
+                panel.session.control.run(panel.session.plc)
     except PlcError as e:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR
     if not _loopback(args.host):
         print(f"plcrt serve: warning: listening on {args.host}: anyone who can reach this "
               f"address can run and force the PLC", file=sys.stderr)
-    return _serve(panel, args.host, args.port, args.open, EXIT_OK, EXIT_ERROR)
+    try:
+        return _serve(panel, args.host, args.port, args.open, EXIT_OK, EXIT_ERROR)
+    finally:
+        if serving is not None:
+            serving.close()
+
+
+def _server_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The network servers the command line names, with their options."""
+    from ..net.options import Listen, ServerOptions, WriteGuard, exposed, parse_listen, \
+        parse_ranges
+    guard = WriteGuard(read_only=args.read_only,
+                       allow=parse_ranges(args.allow_writes) if args.allow_writes else None)
+    out: dict[str, Any] = {}
+    for name in ("s7", "modbus", "lockstep"):
+        spec = getattr(args, name)
+        if spec is None:
+            continue
+        listen = parse_listen(spec, what=f"--{name}")
+        if ":" not in spec:                     # no host of its own: --host's
+            listen = Listen(args.host, listen.port)
+        if exposed(listen.host):
+            print(f"plcrt serve: warning: the {name} server listens on {listen.host}: anyone "
+                  f"who can reach this address can read and write the PLC", file=sys.stderr)
+        out[name] = ServerOptions(listen=listen, max_connections=args.max_connections,
+                                  idle_timeout=args.idle_timeout, guard=guard)
+    return out
+
+
+def _say_servers(serving: Any) -> None:
+    for name, (host, port) in serving.addresses.items():
+        shown = f"[{host}]" if ":" in host else host
+        print(f"plcrt {name} server: {shown}:{port}", flush=True)
+
+
+def _panel_speed(session: Any, speed: Any) -> None:
+    if isinstance(speed, float):
+        session.pacer.set("factor", speed, session.plc.now_us)
+    else:
+        session.pacer.set(speed, None, session.plc.now_us)
+
+
+def _serve_headless(args: argparse.Namespace, servers: dict[str, Any], ok: int) -> int:
+    """The network servers alone, until Ctrl-C (or SIGTERM)."""
+    import signal
+    import threading
+
+    from ..net.host import Serving
+    from ..term.options import load_from_args
+    from ..term.report import print_diagnostics
+
+    plc = load_from_args(args, args.scan_ms)
+    print_diagnostics(plc.diagnostics)
+    done = threading.Event()
+    previous = signal.signal(signal.SIGTERM, lambda *_: done.set())
+    try:
+        with Serving(plc, servers, speed=args.speed) as serving:
+            _say_servers(serving)
+            print("(Ctrl-C stops)", flush=True)
+            try:
+                while not done.wait(0.5):
+                    pass
+            except KeyboardInterrupt:
+                pass
+            runner = serving.runner
+            for e in runner.errors if runner is not None else []:
+                print_diagnostics(e.diagnostics)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    return ok
 
 
 def _serve(panel: Any, host: str, port: int, open_browser: bool, ok: int, bad: int) -> int:

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import PlcConfigError
+from ..net.jsonmsg import finite, load, nesting
 
 #: the longest text field a client may send (an address, a condition ...)
 MAX_TEXT = 200
@@ -126,52 +127,8 @@ def parse(text: str | bytes) -> dict[str, Any]:
         ProtocolError: not JSON, not an object, an unknown type, a missing,
             unknown or badly typed field, or a value out of range.
     """
-    size = len(text.encode("utf-8", "surrogatepass") if isinstance(text, str) else text)
-    if size > MAX_MESSAGE:
-        raise ProtocolError(f"message too long ({size} bytes, at most {MAX_MESSAGE})")
-    if isinstance(text, bytes):
-        try:
-            text = text.decode("utf-8")
-        except UnicodeDecodeError:
-            raise ProtocolError("a message must be UTF-8 JSON text") from None
-    # perf: every normal message has fewer brackets than the limit
-    if text.count("[") + text.count("{") > MAX_DEPTH:
-        depth = nesting(text)
-        if depth > MAX_DEPTH:
-            raise ProtocolError(f"a message may nest arrays and objects {MAX_DEPTH} deep at "
-                                f"most (this one: {depth})")
-    try:
-        msg = json.loads(text)
-    except (ValueError, RecursionError):
-        # RecursionError cannot happen after nesting(); kept so that no
-        # parser limit ever escapes as a traceback
-        raise ProtocolError("a message must be a JSON object") from None
+    msg = load(text, max_bytes=MAX_MESSAGE, max_depth=MAX_DEPTH, error=ProtocolError)
     return validate(msg)
-
-
-def nesting(text: str) -> int:
-    """How deep arrays and objects nest in JSON ``text`` (brackets inside
-    strings do not count), found before parsing: Python's JSON decoder
-    recurses once per level and fails with RecursionError near 1000.  One
-    pass over the text, whatever it holds."""
-    depth = deepest = 0
-    in_str = escaped = False
-    for ch in text:
-        if in_str:
-            if escaped:
-                escaped = False
-            elif ch == "\\":
-                escaped = True
-            elif ch == '"':
-                in_str = False
-        elif ch == '"':
-            in_str = True
-        elif ch in "[{":
-            depth += 1
-            deepest = max(deepest, depth)
-        elif ch in "]}":
-            depth -= 1
-    return deepest
 
 
 def validate(msg: Any) -> dict[str, Any]:
@@ -253,13 +210,6 @@ def _default(o: Any) -> Any:
     if isinstance(o, (set, frozenset, tuple)):
         return list(o)
     raise TypeError(f"not JSON: {type(o).__name__}")
-
-
-def finite(v: int | float) -> int | float | str:
-    """A value JSON can carry: NaN and the infinities as text."""
-    if isinstance(v, float) and not math.isfinite(v):
-        return "NaN" if v != v else ("Infinity" if v > 0 else "-Infinity")
-    return v
 
 
 __all__ = ["CLIENT", "Field", "MAX_DEPTH", "MAX_MESSAGE", "MAX_WATCH", "ProtocolError",

@@ -45,12 +45,13 @@ from typing import Any
 from ..engine.coverage import NetworkRef
 from ..engine.runtime import Plc
 from ..errors import PlcConfigError, PlcError
+from ..net.door import ScanDoor
+from ..net.pacing import CHUNK_S, DISPLAY_HZ, Pacer
 from ..safetext import printable
 from ..testing.harness import Harness, condition
 from .builds import Builds
 from .diagnostics import DiagnosticLog
 from .mailbox import Client, Mailbox
-from ..net.pacing import CHUNK_S, DISPLAY_HZ, Pacer
 from .present import INPUT_KINDS, input_kinds, io_bits
 from .program import ProgramView
 from .protocol import finite
@@ -76,24 +77,32 @@ class PanelSession:
             (:func:`plcrt.web.present.input_kinds`).  Inputs that rest at 1
             (normally closed) read 1 from power-up on.
         display_hz: frames per wall second.
-        clock, sleep: the wall clock (tests pass their own).
+        clock, sleep: the wall clock (tests pass their own); without a
+            ``sleep``, the pacing waits on the door, so a command or a
+            network client's request ends the wait.
+        door: the scan-boundary door of the network servers
+            (:mod:`plcrt.net.door`): this session's thread runs the PLC, so
+            it serves the door between chunks (a new one if not given).
     """
 
     def __init__(self, plc: Plc, *, breakpoints: bool = True,
                  kinds: dict[str, str] | None = None,
                  display_hz: float = DISPLAY_HZ,
                  clock: Callable[[], float] = time.monotonic,
-                 sleep: Callable[[float], None] = time.sleep) -> None:
+                 sleep: Callable[[float], None] | None = None,
+                 door: ScanDoor | None = None) -> None:
         self.plc = plc
         self.inputs, self.outputs = io_bits(plc)
         self.kinds = self._rest_inputs(kinds)     # before the power-up snapshot
         self.harness = Harness(plc)
         self.display_hz = display_hz
-        self.clock, self.sleep = clock, sleep
+        self.door = door if door is not None else ScanDoor()
+        self.clock = clock
+        self.sleep: Callable[[float], None] = sleep if sleep is not None else self.door.wait
         self.program = ProgramView(plc)
         self.builds = Builds(plc, breakpoints=breakpoints, blocks=self.program.blocks,
                              on_break=self._on_break)
-        self.pacer = Pacer(clock, sleep, display_hz, plc.now_us)
+        self.pacer = Pacer(clock, self.sleep, display_hz, plc.now_us)
         self.control = RunControl(self.pacer, self._notice, self._reset)
         self.watch_table = WatchTable()
         self.trend = Trend()
@@ -147,6 +156,7 @@ class PanelSession:
         """Queue a checked message (:func:`plcrt.web.protocol.validate`);
         it is applied in the runner thread between two chunks of scans."""
         self._queue.put((client, msg))
+        self.door.wake()
 
     def _rest_inputs(self, declared: dict[str, str] | None) -> dict[str, str]:
         """Each input's kind; the inputs that rest at 1 (normally closed)
@@ -177,6 +187,7 @@ class PanelSession:
     def close(self) -> None:
         self._closed = True
         self._queue.put((None, {"type": "_wake"}))
+        self.door.wake()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5)
 
@@ -196,23 +207,26 @@ class PanelSession:
         self._drain(block=wait and not control.busy, timeout=1 / self.display_hz)
         if self._closed:
             return
+        # at a scan boundary: the network clients' reads and writes
+        self.door.serve(self.plc)
         if not self.builds.breaks and control.state != "paused":
             self._use_build(probes=self.builds.home[0])
         if control.busy:
             control.chunk(self.plc, bool(self.builds.breaks))
         self._maybe_frame()
 
-    def _drain(self, block: bool, timeout: float) -> None:
-        try:
-            item = self._queue.get(timeout=timeout) if block else self._queue.get_nowait()
-        except queue.Empty:
-            return
+    def _drain(self, block: bool, timeout: float, jobs: bool = True) -> None:
+        """Apply the queued commands; ``block``: first wait up to
+        ``timeout`` for one (or, with ``jobs``, for a network client's
+        request, which :meth:`tick` serves)."""
+        if block and self._queue.empty():
+            self.door.wait(timeout, jobs=jobs)
         while True:
-            self._apply(*item)
             try:
                 item = self._queue.get_nowait()
             except queue.Empty:
                 return
+            self._apply(*item)
 
     # ------------------------------------------------------------------
     # Commands
@@ -383,7 +397,8 @@ class PanelSession:
                                            f" scan {self.plc.scans + 1})"))
             self._publish()
             while control.state == "paused" and not self._closed:
-                self._drain(block=True, timeout=1 / self.display_hz)
+                # inside a scan: network requests wait for its end
+                self._drain(block=True, timeout=1 / self.display_hz, jobs=False)
                 if self._dirty and control.state == "paused":
                     self._publish()
             control.resumed(before)

@@ -1,0 +1,94 @@
+"""``plcrt serve`` with network servers: headless (``--no-panel``) and beside
+the panel, each listening where it says, on loopback by default; Ctrl-C
+ends it with status 0; bad options are errors, never tracebacks."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from plcrt.cli import main
+from plcrt.net.client import LockstepClient
+
+COUNT = """ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1
+LD SM0.0
++I 1, VW0
+END_ORGANIZATION_BLOCK
+"""
+
+
+def _start(args: list[str], tmp_path: Path) -> tuple[subprocess.Popen, dict[str, int]]:
+    prog = tmp_path / "count.awl"
+    prog.write_text(COUNT)
+    p = subprocess.Popen([sys.executable, "-m", "plcrt", "serve", str(prog), *args],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    ports: dict[str, int] = {}
+    deadline = time.monotonic() + 60
+    assert p.stdout is not None
+    while time.monotonic() < deadline:
+        line = p.stdout.readline()
+        if not line:
+            break
+        m = re.match(r"plcrt (\w+) server: 127\.0\.0\.1:(\d+)", line)
+        if m:
+            ports[m.group(1)] = int(m.group(2))
+        if line.startswith("(Ctrl-C") or line.startswith("plcrt panel:"):
+            return p, ports
+    p.kill()
+    pytest.fail(f"plcrt serve did not start: {p.stderr.read() if p.stderr else ''}")
+
+
+def _stop(p: subprocess.Popen) -> int:
+    p.send_signal(signal.SIGINT)
+    try:
+        return p.wait(20)
+    finally:
+        if p.poll() is None:
+            p.kill()
+
+
+def test_headless_lockstep_server_steps_the_program(tmp_path: Path) -> None:
+    p, ports = _start(["--no-panel", "--lockstep", "0", "--speed", "lockstep"], tmp_path)
+    try:
+        with LockstepClient("127.0.0.1", ports["lockstep"]) as c:
+            assert c.advance(seconds="1s") == 100
+            assert c.read("VW0") == {"VW0": 100}
+    finally:
+        assert _stop(p) == 0
+
+
+def test_beside_the_panel_the_program_runs_in_real_time(tmp_path: Path) -> None:
+    p, ports = _start(["--port", "0", "--lockstep", "0"], tmp_path)
+    try:
+        with LockstepClient("127.0.0.1", ports["lockstep"]) as c:
+            assert c.hello()["speed"] == "panel"
+            first = c.read("VW0")["VW0"]
+            time.sleep(0.3)
+            assert c.read("VW0")["VW0"] > first      # the panel's thread scans it
+    finally:
+        assert _stop(p) == 0
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--no-panel"], "name a server"),
+    (["--no-panel", "--lockstep", "70000"], "outside 0..65535"),
+    (["--no-panel", "--lockstep", "a:b:c"], "[HOST:]PORT"),
+    (["--no-panel", "--lockstep", "0", "--speed", "warp"], "speed"),
+    (["--no-panel", "--lockstep", "0", "--allow-writes", "VB9-MB2"], "two areas"),
+    (["--no-panel", "--lockstep", "0", "--max-connections", "0"], "max_connections"),
+])
+def test_bad_options_are_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                args: list[str], message: str) -> None:
+    prog = tmp_path / "count.awl"
+    prog.write_text(COUNT)
+    assert main(["serve", str(prog), *args]) == 1
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err

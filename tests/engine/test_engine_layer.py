@@ -8,48 +8,28 @@ through plcrt.parts (docs/architecture.md, "The load path").
 
 from __future__ import annotations
 
-import ast
 import subprocess
 import sys
-from pathlib import Path
 
-import pytest
+from import_graph import PLCRT, graph, long_modules
 
-ENGINE = Path(__file__).resolve().parents[2] / "plcrt" / "engine"
+ENGINE = PLCRT / "engine"
 
 #: packages and modules above the engine (or the composition root over all)
 ABOVE = ("plcrt.devices", "plcrt.blocks", "plcrt.loader", "plcrt.testing", "plcrt.web",
-         "plcrt.debug", "plcrt.cli", "plcrt.view", "plcrt.trace", "plcrt.cia402")
+         "plcrt.debug", "plcrt.cli", "plcrt.view", "plcrt.trace", "plcrt.cia402",
+         "plcrt.net", "plcrt.term", "plcrt.dump", "plcrt.cli_commands")
 
 
-def _imports(path: Path) -> list[tuple[int, str]]:
-    """(line, absolute module) of every import in *path*, wherever it is."""
-    package = "plcrt.engine"
-    found = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
-            found += [(node.lineno, a.name) for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
-                module = ".".join(base + ([node.module] if node.module else []))
-            else:
-                module = node.module or ""
-            found += [(node.lineno, f"{module}.{a.name}") for a in node.names]
-    return found
+def test_the_engine_imports_nothing_above_it() -> None:
+    climbing = {mod: sorted(t for t in targets
+                            if any(t == a or t.startswith(a + ".") for a in ABOVE))
+                for mod, targets in graph().items() if mod.startswith("plcrt.engine")}
+    assert {m: t for m, t in climbing.items() if t} == {}
 
 
-@pytest.mark.parametrize("path", sorted(ENGINE.glob("*.py")), ids=lambda p: p.name)
-def test_the_engine_imports_nothing_above_it(path: Path) -> None:
-    climbing = [(line, name) for line, name in _imports(path)
-                if any(name == a or name.startswith(a + ".") for a in ABOVE)]
-    assert climbing == [], f"{path.name} imports from above the engine: {climbing}"
-
-
-@pytest.mark.parametrize("path", sorted(ENGINE.glob("*.py")), ids=lambda p: p.name)
-def test_every_engine_module_is_at_most_500_lines(path: Path) -> None:
-    lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()]
-    assert len(lines) <= 500, f"{path.name}: {len(lines)} non-blank lines"
+def test_every_engine_module_is_at_most_500_lines() -> None:
+    assert long_modules(ENGINE) == {}
 
 
 def test_a_plc_built_by_the_engine_alone_is_fitted_with_devices_and_library_blocks() -> None:

@@ -53,9 +53,10 @@ from .store import Store, Write
 __all__ = ["Drive", "DriveEvent"]
 
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
-#: (no speed limit then) and no P03.07 (no homing time limit).
+#: (no speed limit then), no 60C5h/60C6h (no ramp limit) and no P03.07 (no
+#: homing time limit).
 _ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0,
-           (0x6099, 4): 0, (0x60F9, 10): 0}
+           (0x6099, 4): 0, (0x60F9, 10): 0, (0x60C5, 0): 0xFFFFFFFF, (0x60C6, 0): 0xFFFFFFFF}
 
 #: compiled struct codecs cannot be copied: a fork of a drive starts these
 #: caches afresh (they are rebuilt on first use)

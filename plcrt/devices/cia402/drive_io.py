@@ -55,12 +55,13 @@ MISSING = object()
 #: that changes takes the general cycle.
 _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
+_K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
 _PLAIN_PLANT = {f.name for f in fields(DrivePlant)} == {
     "neg_limit", "pos_limit", "home_switch", "index_period", "index_phase",
-    "neg_stop", "pos_stop"}
+    "neg_stop", "pos_stop", "probe", "probe2"}
 
 
 def _picker(at: list) -> Callable[[object], tuple]:
@@ -88,6 +89,7 @@ class ProcessData:
     plant: DrivePlant
     store: Any
     stops: Any
+    probe: Any
     _live: dict[tuple[int, int], Any]
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
@@ -225,6 +227,8 @@ class ProcessData:
             num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
             bits, vel = _B12, num // den if num >= 0 else -(-num // den)
         sm.set_mode_bits(bits)
+        if self.probe.function or live.get(_K60B8):
+            self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         # a plant without switches gives 60FDh = 0 wherever the axis is
         inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
             and plant.home_switch is None else plant.inputs(mech)
@@ -376,6 +380,8 @@ class ProcessData:
                 sm.set_mode_bits(bits)
         mech = ax.mechanical(t)
         pos = mech + ax.shift                      # axis.position(t)
+        if self.probe.function or self._live.get(_K60B8):
+            self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         if self.mode_number == 8:
             csp = self.engines[8]
             assert isinstance(csp, CyclicPosition)

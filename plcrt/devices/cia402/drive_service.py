@@ -233,6 +233,8 @@ class Service:
         """A master wrote a parameter that acts after power-up: alarm 83
         (HCFA §4.7 "变更参数需要重新接通电源生效"); the value waits."""
         e = w.entry
+        if w.value == self.store.get(e.index, e.sub):
+            return                      # the active value again: nothing waits
         self.fault(self.now, 83, 83,                      # type: ignore[attr-defined]
                        f"{e.index:04X}h:{e.sub:02X} ({e.name}) := {w.value} acts after the "
                        f"next power cycle; the drive keeps {w.old} until then")

@@ -155,7 +155,7 @@ def plant_of(value: Any, where: str = "plant") -> DrivePlant:
             text = read_capped(value, file_limit(1.0)).decode("utf-8")
             value = tomllib.loads(text)
         except PlcError as e:
-            raise PlcConfigError(e.message) from None
+            raise PlcConfigError(f"{where}: {e.message.removeprefix('error: ')}") from None
         except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
             raise PlcConfigError(f"{where}: not a TOML file: {str(e)[:200]}") from None
     if not isinstance(value, dict):

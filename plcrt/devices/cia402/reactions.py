@@ -124,6 +124,16 @@ FAULT_CODES: dict[int, FaultCode] = {f.code: f for f in (
     _f(0x7305, "incremental sensor 1 fault (CiA 402, not in the seeds)", True,
        "CiA 402", alarm=False),
     _f(0x5441, "E-stop input (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
+    _f(0x8612, "reference limit (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
+    # The Kinco note numbers no fault: its injectable ones take CiA 402 codes,
+    # power-cycle-only as HCFA's over-current and op-amp faults (§4.7).
+    _f(0x2310, "continuous over-current (CiA 402, not in the seeds)", False, "CiA 402",
+       alarm=False),
+    _f(0x5400, "power stage (CiA 402, not in the seeds)", False, "CiA 402", alarm=False),
+    _f(0x3210, "DC link over-voltage (CiA 402, not in the seeds)", True, "CiA 402",
+       alarm=False),
+    _f(0x3220, "DC link under-voltage (CiA 402, not in the seeds)", False, "CiA 402",
+       alarm=False),
 )}
 
 

@@ -176,3 +176,39 @@ def test_kinco_pp_against_a_mechanical_end_sets_bit_13_following_error():
         assert d.statusword & 0x2000 == expect, model
         d.advance(2_000_000)
         assert d.read(0x603F) == 0x8611
+
+
+# ---------------------------------------------------------------- 605Ah
+
+@pytest.mark.parametrize("model", ["hcfa-am0520b", "kinco-servo"])
+def test_605ah_out_of_range_aborts_with_too_high_or_too_low(model):
+    """HCFA §8.3 gives 605Ah as "0–65535"; the codes 0–8 are CiA 402's.  A
+    value outside 0..8 is refused as every ranged object is (CiA 301:
+    0x06090031 above the maximum, 0x06090032 below the minimum), as
+    docs/cia402.md says; nothing changes."""
+    d = Drive(model)
+    for value, code in ((9, 0x06090031), (-1, 0x06090032)):
+        with pytest.raises(SdoAbort) as e:
+            d.write(0x605A, 0, value)
+        assert e.value.code == code
+    assert d.read(0x605A) == 2
+    text = DOCS.read_text(encoding="utf-8")
+    assert "setting 605Ah outside 0–8 is refused (SDO abort 0x06090031 above, 0x06090032 " \
+           "below)" in text
+
+
+# ---------------------------------------------------------------- the audit table
+
+def test_every_test_the_audit_table_names_exists():
+    """docs/cia402.md, "Audit against the manuals": each row names a test of
+    tests/devices/cia402/ that exists."""
+    text = DOCS.read_text(encoding="utf-8")
+    section = text.split("## Audit against the manuals", 1)[1].split("\n## ", 1)[0]
+    named = re.findall(r"`(test_[a-z0-9_]+)`", section)
+    assert len(named) >= 15
+    here = Path(__file__).parent
+    defined = set()
+    for f in here.glob("test_*.py"):
+        defined |= set(re.findall(r"^def (test_[a-z0-9_]+)", f.read_text(encoding="utf-8"),
+                                  re.M))
+    assert sorted(set(named) - defined) == []

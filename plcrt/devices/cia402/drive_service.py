@@ -216,8 +216,9 @@ class Service:
             mech = self.axis.mechanical(t)
             self.axis.stop_at_once(t)
             self.axis.shift = -mech                   # the count restarts at 0 here
-            for index in (0x6040, 0x6060):            # process data start from their defaults
-                self.store.set(index, 0, self.od.entry(index, 0).default)  # type: ignore
+            for index in (0x6040, 0x6060, 0x60B8):    # process data start from their defaults
+                if self.od.find(index, 0) is not None:  # type: ignore[attr-defined]
+                    self.store.set(index, 0, self.od.entry(index, 0).default)  # type: ignore
             self._power_up(t)                         # type: ignore[attr-defined]
             self.probe.configure(0, mech)
             self.note(t, "HCFA §4.7, §5.1",           # type: ignore[attr-defined]

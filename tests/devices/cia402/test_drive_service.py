@@ -294,3 +294,27 @@ def test_log_lines_cite_their_own_models_manual_and_print_the_time_once():
         assert all(other not in line for line in lines), lines
         assert any(own in line for line in lines)
         assert all(line.count("t=") == 1 for line in lines), lines
+
+
+# ---------------------------------------------------------------- from a PLC
+
+IDLE = "ORGANIZATION_BLOCK MAIN:OB1\nTITLE=t\nBEGIN\nNetwork 1\nLD     SM0.0\nEND_ORGANIZATION_BLOCK\n"
+
+
+def test_a_fieldbus_drive_takes_power_up_start_up_values_and_injected_faults():
+    """A plant file's start-up params of a power-up parameter (P00.01) act from
+    the start, without alarm 83 (the module power-cycles the drive after
+    them); plc.module(slot).drive(node) is the Drive, whose faults the
+    program's side sees in plc.drive(node)."""
+    import plcrt
+
+    plant = ('[module.0]\nkind = "FIELDBUS"\n[module.0.drive.1]\nmodel = "hcfa-am0520b"\n'
+             'probe = [100, 200]\nparams = { "2000:01" = 1 }\n')
+    plc = plcrt.load(IDLE, plant=plant, scan_ms=10)
+    d = plc.module(0).drive(1)
+    assert d.store.get(0x2000, 1) == 1 and d.plant.probe == (100, 200)
+    plc.scan()
+    assert plc.drive(1).error_code == 0
+    d.inject_fault("encoder")
+    plc.scan()
+    assert plc.drive(1).error_code == 10256 and plc.drive(1).fault

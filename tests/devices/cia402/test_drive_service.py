@@ -5,8 +5,11 @@ that cite their own model's manual."""
 
 from __future__ import annotations
 
+import logging
+
 import canopen
 import pytest
+from hypothesis import given, settings, strategies as st
 from canopen.profiles.p402 import BaseNode402
 
 from plcrt import cia402
@@ -270,6 +273,34 @@ def test_touch_probe_latches_the_index_pulse_at_its_exact_position():
     assert d.read(0x60B9) == 0x3 and d.read(0x60BA) == 3234     # moving back
 
 
+@settings(max_examples=60, deadline=None)
+@given(period=st.integers(1, 5000), phase=st.integers(-10_000, 10_000),
+       step=st.integers(-800, 800).filter(bool))
+def test_touch_probe_index_latch_is_the_first_pulse_ahead(period, phase, step):
+    """Whatever the pulse pattern and the CSP step, probe 1 on the index
+    latches the first pulse strictly ahead of the count it was armed at, in
+    the direction of motion (a pulse on that count is behind it)."""
+    d = Drive(plant={"index_period": period, "index_phase": phase})
+    start = 0
+    for s_ in (EsmState.PREOP, EsmState.SAFEOP, EsmState.OP):
+        d.request_esm(s_)
+    t, x = 0, start
+    img = lambda cw, x, fn: (cw.to_bytes(2, "little") + x.to_bytes(4, "little", signed=True)
+                             + fn.to_bytes(2, "little"))
+    for cw in (0x06, 0x07, 0x0F, 0x0F):
+        t += 1000
+        d.cycle(t, img(cw, x, 0))
+    t += 1000
+    d.cycle(t, img(0x0F, x, 0x15))
+    for _ in range(-(-2 * period // abs(step)) + 2):
+        t += 1000
+        x += step
+        d.cycle(t, img(0x0F, x, 0x15))
+    k = (start - phase) // period + 1 if step > 0 else -((phase - start) // period) - 1
+    assert d.read(0x60B9) == 0x3
+    assert d.read(0x60BA) == phase + k * period
+
+
 def test_touch_probe_latches_both_edges_of_a_probe_input_continuously():
     """Probe 1 on its input (60B8h bit 2 = 0), both edges (bits 4, 5),
     continuous (bit 1): a PV pass over the plant's probe zone [3000, 3100]
@@ -282,6 +313,41 @@ def test_touch_probe_latches_both_edges_of_a_probe_input_continuously():
     d.write(0x60FF, 0, -5000)
     d.advance(3_000_000)
     assert d.read(0x60BA) == 3100 and d.read(0x60BB) == 2999
+
+
+def test_canopens_master_reads_exact_touch_probe_latches():
+    """canopen's BaseNode402 over the virtual bus: PV at 7000 P/s past index
+    pulses every 1000 counts from 137; 60B8h = 0x15 (probe 1, index, rising,
+    first event) set at rest latches 137 exactly, 60B9h = 0x3; re-armed
+    (0 then 0x15) at a count between pulses it latches the next pulse."""
+    logging.getLogger("canopen.profiles.p402").setLevel(logging.ERROR)
+    dev, mst = canopen.Network(), canopen.Network()
+    dev.connect(interface="virtual", channel="svc-probe")
+    mst.connect(interface="virtual", channel="svc-probe")
+    try:
+        sim = cia402.attach(dev, 5, plant={"index_period": 1000, "index_phase": 137},
+                            clock="manual")
+        n = BaseNode402(5, cia402.object_dictionary())
+        mst.add_node(n)
+        n.nmt.state = "PRE-OPERATIONAL"
+        n.setup_402_state_machine()
+        n.op_mode = "PROFILED VELOCITY"
+        n.state = "OPERATION ENABLED"
+        n.sdo[0x6083].raw = n.sdo[0x6084].raw = 7_000_000
+        n.sdo[0x60B8].raw = 0x15
+        assert n.sdo[0x60B9].raw == 0x1
+        n.sdo[0x60FF].raw = 7000
+        sim.advance(0.5)
+        assert n.sdo[0x60B9].raw == 0x3 and n.sdo[0x60BA].raw == 137
+        pos = n.sdo[0x6064].raw
+        n.sdo[0x60B8].raw = 0
+        n.sdo[0x60B8].raw = 0x15
+        sim.advance(0.5)
+        assert n.sdo[0x60BA].raw == 137 + 1000 * ((pos - 137) // 1000 + 1)
+        sim.close()
+    finally:
+        mst.disconnect()
+        dev.disconnect()
 
 
 # ---------------------------------------------------------------- the log

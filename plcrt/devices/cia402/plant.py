@@ -3,8 +3,10 @@
 What it is: :class:`DrivePlant`, the positions (in counts) at which the
 negative / positive limit switches (NLS / PLS) and the home switch are active,
 the index (Z) pulse pattern, the mechanical ends (hard stops) the axis cannot
-pass, and :meth:`DrivePlant.inputs`, the 60FDh digital-input bits for a count
-(HCFA §8.3: bit 0 NLS, bit 1 PLS, bit 2 home).
+pass, the touch probe inputs, and :meth:`DrivePlant.inputs`, the 60FDh
+digital-input bits for a count (HCFA §8.3: bit 0 NLS, bit 1 PLS, bit 2
+home); :func:`plant_of`, a plant from a dict or a TOML file of
+:data:`PLANT_KEYS`, every problem a ``PlcConfigError`` naming the key.
 
 What it is not: it does not move; :class:`~plcrt.devices.cia402.drive.Drive`
 asks it where the switches are and finds the crossing times exactly.

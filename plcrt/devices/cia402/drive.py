@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Callable, Optional
 
 from .axis import Axis
@@ -84,11 +85,13 @@ class DriveEvent:
 class Drive(Service, ProcessData, Timeline):
     """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``).
 
-    *plant*: its switches (none by default); *node_id*: the bus address a
-    port gives it; *t_us*: the time it powers up; *homing*: the homing
+    *plant*: its switches (none by default), a :class:`DrivePlant`, a dict
+    or the path of a TOML file (:func:`~.plant.plant_of`); *node_id*: the
+    bus address a port gives it; *t_us*: the time it powers up; *homing*: the homing
     methods by 6098h value (default :func:`~.homing_plan.homing_plans`)."""
 
-    def __init__(self, model: str = "hcfa-am0520b", *, plant: Any = None,
+    def __init__(self, model: str = "hcfa-am0520b", *,
+                 plant: DrivePlant | dict[str, Any] | str | Path | None = None,
                  node_id: int = 1, t_us: int = 0,
                  homing: Optional[dict[int, Callable[[], HomingPlan]]] = None) -> None:
         self.model = model

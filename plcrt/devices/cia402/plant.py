@@ -26,7 +26,7 @@ from typing import Any, Optional
 
 from ...errors import PlcConfigError, PlcError
 from ...lang.limits import file_limit, read_capped
-from ...safetext import shown_value
+from ...safetext import printable, shown_value
 from .states import Cia402Error
 
 __all__ = ["DrivePlant", "DI_NLS", "DI_PLS", "DI_HOME", "plant_of", "PLANT_KEYS"]
@@ -152,7 +152,7 @@ def plant_of(value: Any, where: str = "plant") -> DrivePlant:
     if isinstance(value, DrivePlant):
         return value
     if isinstance(value, (str, Path)):
-        where = str(value)[:200]
+        where = printable(str(value))[:200]
         try:
             text = read_capped(value, file_limit(1.0)).decode("utf-8")
             value = tomllib.loads(text)
@@ -166,7 +166,7 @@ def plant_of(value: Any, where: str = "plant") -> DrivePlant:
                              f"{type(value).__name__}")
     kwargs: dict[str, Any] = {}
     for key, v in value.items():
-        name = str(key)[:40]
+        name = printable(str(key))[:40]
         if key in _NOT_MODELLED:
             raise PlcConfigError(f"{where}.{name}: {_NOT_MODELLED[key]} is not simulated (the "
                                  "axis follows its demand exactly; docs/cia402.md, \"The "

@@ -101,7 +101,10 @@ def capped_ramps(d: ModeDrive, t: int, acc: int, dec: int, acc_name: str,
     for name, value, cap_index, cap_name in ((acc_name, acc, 0x60C5, "60C5h (max acceleration)"),
                                              (dec_name, dec, 0x60C6, "60C6h (max deceleration)")):
         cap = d.param(cap_index)
-        if value > cap:
+        if cap == 0:
+            # a zero limit would never move: taken as no limit (docs/cia402.md decisions)
+            d.note(t, "HCFA §7.5.1", f"{cap_name} = 0 is no limit (a ramp at 0 never moves)")
+        elif value > cap:
             d.note(t, "HCFA §7.5.1", f"{name} = {value} P/s² above {cap_name} = {cap}: "
                    "limited to it")
             if cap_index == 0x60C5:

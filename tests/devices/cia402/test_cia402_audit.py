@@ -97,6 +97,16 @@ def test_pp_ramps_below_60c5h_60c6h_are_untouched():
     assert not any("60C5h" in e.text or "60C6h" in e.text for e in d.log)
 
 
+def test_60c5h_zero_is_no_limit():
+    """HCFA §7.5.1 gives 60C5h no range: 0 would never move, so it limits
+    nothing, and the log says so."""
+    d = enable(Drive(), 1, x6081=20_000, x6083=100_000, x6084=100_000, x60C5=0)
+    pp_move(d, 10_000)
+    d.advance(700_000)
+    assert d.position == 10_000
+    assert any("60C5h (max acceleration) = 0 is no limit" in e.text for e in d.log)
+
+
 def test_60c5h_and_6080h_limit_homing():
     """HCFA §7.5.1, §7.5.4: 6080h caps the homing speeds and 60C5h/60C6h the
     homing acceleration 609Ah.  Method 35 is no motion, so method 17 (NLS

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from .devices.cia402 import canopen_od
 from .devices.cia402.canopen_od import eds_text, models
+from .devices.cia402.plant import plant_of
 from .errors import PlcConfigError
 from .safetext import printable
 
@@ -59,10 +60,16 @@ def object_dictionary(model: str = "hcfa-am0520b", node_id: int | None = None
 
 
 def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
-           plant: "DrivePlant | None" = None, *, clock: "Clock" = "wall") -> "CanopenDrive":
+           plant: "DrivePlant | dict | str | None" = None, *,
+           clock: "Clock" = "wall") -> "CanopenDrive":
     """Put a simulated drive of *model* on the connected ``canopen.Network``
     *network* as node *node_id*; a master drives it with SDOs, NMT and
     heartbeat (``BaseNode402(node_id, object_dictionary(model))``).
+
+    *plant*: the machine around the drive: a dict of
+    ``plcrt.devices.cia402.plant.PLANT_KEYS`` (limit switches, mechanical
+    ends, home switch, index, probe inputs), the path of a TOML file of them,
+    or a ``DrivePlant``.
 
     *clock*: ``"wall"`` (the drive's time follows the wall clock, one bus
     cycle per bus period in a background thread), ``"manual"`` (time moves
@@ -75,7 +82,8 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
 
     Raises:
         PlcConfigError: unknown model, bad node id, a network that is not a
-            connected ``canopen.Network``, an unknown clock.
+            connected ``canopen.Network``, an unknown clock, a bad plant
+            (naming the key).
     """
     from .devices.cia402.canopen_node import CanopenDrive   # perf: as in object_dictionary
 
@@ -83,4 +91,5 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
         shown = printable(model)[:40] if isinstance(model, str) else type(model).__name__
         raise PlcConfigError(f"cia402.attach: unknown drive model {shown!r}; models: "
                              + ", ".join(models()))
-    return CanopenDrive(network, node_id, model, plant, clock=clock)
+    return CanopenDrive(network, node_id, model, plant_of(plant, "cia402.attach: plant"),
+                        clock=clock)

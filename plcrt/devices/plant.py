@@ -30,6 +30,7 @@
     index_phase = 0             # ... at this position (and +/- periods)
     neg_stop = -60000           # mechanical ends (hard stops), beyond the limits
     pos_stop = 60000
+    probe = [2000, 2100]        # touch probe input 1 active in this closed range (probe2: DI5)
     params = { "6099:01" = 20000, "6099:02" = 2000 }   # written by SDO at start-up
 
     [pto.0]                     # the Position Control wizard of Q0.0 (docs/pto-wizard.md)
@@ -81,7 +82,7 @@ _AXIS_KEYS = {"start", "rps", "limit_neg", "limit_pos", "z_period", "z_offset", 
 _MODULE_KEYS = {"EM253": {"kind", "axis"},
                 "FIELDBUS": {"kind", "v", "cycle_ms", "drive"}}
 _DRIVE_KEYS = {"model", "image", "neg_limit", "pos_limit", "home_switch", "index_period",
-               "index_phase", "neg_stop", "pos_stop", "params"}
+               "index_phase", "neg_stop", "pos_stop", "probe", "probe2", "params"}
 _PARAM_RE = re.compile(r"(?:0x)?([0-9A-Fa-f]{4})(?::(?:0x)?([0-9A-Fa-f]{1,2}))?h?")
 
 
@@ -460,12 +461,13 @@ def _drive(node: int, d: dict, where: str, default_image: int) -> DriveConfig:
     for k in ("neg_limit", "pos_limit", "index_period", "index_phase", "neg_stop", "pos_stop"):
         if k in d:
             plant[k] = _int(d[k], f"{where}.{k}")
-    if "home_switch" in d:
-        r = d["home_switch"]
+    for k in ("home_switch", "probe", "probe2"):      # closed ranges (cia402.plant)
+        if k not in d:
+            continue
+        r = d[k]
         if not (isinstance(r, list) and len(r) == 2):
-            raise PlcConfigError(f"{where}.home_switch must be [low, high]")
-        plant["home_switch"] = (_int(r[0], f"{where}.home_switch"),
-                                _int(r[1], f"{where}.home_switch"))
+            raise PlcConfigError(f"{where}.{k} must be [low, high]")
+        plant[k] = (_int(r[0], f"{where}.{k}"), _int(r[1], f"{where}.{k}"))
     params = []
     raw = d.get("params", {})
     if not isinstance(raw, dict):

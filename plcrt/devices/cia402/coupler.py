@@ -179,6 +179,11 @@ class FieldbusModule:
             except SdoAbort as e:
                 raise PlcConfigError(f"{where}: the drive refuses {index:04X}h:{sub:02X} = "
                                      f"{value}: {e.message}") from None
+        if drive.store.pending:
+            # start-up values of parameters that act after power-up (HCFA §5.1):
+            # the drive is switched on with them, as after a real power cycle
+            drive.power_cycle()
+            drive.request_esm(EsmState.PREOP)
         for state in (EsmState.SAFEOP, EsmState.OP):
             res = drive.request_esm(state)
             if drive.esm.state is not state:

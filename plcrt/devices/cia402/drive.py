@@ -14,12 +14,14 @@ exact µs, as for the EM253, and the cost does not depend on the speed.
 :meth:`Drive.cycle` is one bus cycle: advance, apply the RxPDO image, run
 the cycle, return the TxPDO image.
 
-The drive is one class in three modules: this one (construction, the
+The drive is one class in four modules: this one (construction, the
 master's SDO side, the write hook, mode selection, the power and EtherCAT
 state machines, the stages of a bus cycle), :mod:`.drive_time` (the time
-line: events in exact µs, :class:`~.drive_time.Timeline`) and
+line: events in exact µs, :class:`~.drive_time.Timeline`),
 :mod:`.drive_io` (process data in and out, the drive's own objects,
-:class:`~.drive_io.ProcessData`).
+:class:`~.drive_io.ProcessData`) and :mod:`.drive_service` (the test
+surface: injected faults, the power cycle, digital inputs, P18 display
+values, the touch probe, :class:`~.drive_service.Service`).
 
 Every refusal and diagnostic goes to :attr:`Drive.log` with its time and the
 manual section.
@@ -32,10 +34,12 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Callable, Optional
+from pathlib import Path
+from typing import Any, Callable, Optional
 
 from .axis import Axis
 from .drive_io import CW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS, ProcessData
+from .drive_service import Service, TouchProbe, cite
 from .drive_time import Timeline
 from .esm import AlResult, Esm, EsmState
 from . import homing_adapter  # noqa: F401  (registers the homing methods)
@@ -44,7 +48,7 @@ from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, Profi
                     MODE_NAMES)
 from .od import ObjectDictionary, SdoAbort
 from .pdo import ASSIGN, MapLayout, PdoConfig
-from .plant import DrivePlant
+from .plant import DrivePlant, plant_of
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
 from .stops import HardStops
@@ -53,9 +57,10 @@ from .store import Store, Write
 __all__ = ["Drive", "DriveEvent"]
 
 #: Values of objects a model's dictionary lacks: the Kinco note gives no 6080h
-#: (no speed limit then) and no P03.07 (no homing time limit).
+#: (no speed limit then), no 60C5h/60C6h (no ramp limit) and no P03.07 (no
+#: homing time limit).
 _ABSENT = {(0x6080, 0): 0xFFFFFFFF, (0x2003, 7): 0, (0x6099, 5): 0, (0x6099, 6): 0,
-           (0x6099, 4): 0, (0x60F9, 10): 0}
+           (0x6099, 4): 0, (0x60F9, 10): 0, (0x60C5, 0): 0xFFFFFFFF, (0x60C6, 0): 0xFFFFFFFF}
 
 #: compiled struct codecs cannot be copied: a fork of a drive starts these
 #: caches afresh (they are rebuilt on first use)
@@ -77,49 +82,39 @@ class DriveEvent:
         return f"t={self.t_us / 1e6:.6f}s [{self.source}] {self.text} ({self.section})"
 
 
-class Drive(ProcessData, Timeline):
+class Drive(Service, ProcessData, Timeline):
     """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``).
 
-    *plant*: its switches (none by default); *node_id*: the bus address a
-    port gives it; *t_us*: the time it powers up; *homing*: the homing
+    *plant*: its switches (none by default), a :class:`DrivePlant`, a dict
+    or the path of a TOML file (:func:`~.plant.plant_of`); *node_id*: the
+    bus address a port gives it; *t_us*: the time it powers up; *homing*: the homing
     methods by 6098h value (default :func:`~.homing_plan.homing_plans`)."""
 
-    def __init__(self, model: str = "hcfa-am0520b", *, plant: Optional[DrivePlant] = None,
+    def __init__(self, model: str = "hcfa-am0520b", *,
+                 plant: DrivePlant | dict[str, Any] | str | Path | None = None,
                  node_id: int = 1, t_us: int = 0,
                  homing: Optional[dict[int, Callable[[], HomingPlan]]] = None) -> None:
         self.model = model
         self.node_id = node_id
         self.od = ObjectDictionary.load(model)
         self.store = Store(self.od)
-        self.plant = plant or DrivePlant()
+        self.plant = plant_of(plant)
+        #: DI levels set by :meth:`set_input` (DI number -> level), over the plant's
+        self.forced_inputs: dict[int, bool] = {}
         self.homing_plans = homing_plans(model) if homing is None else dict(homing)
         self.now = t_us
         self.log: list[DriveEvent] = []
         self.axis = Axis(0)
-        self.controlword = int(self.store.get(0x6040))
         self.pdo = PdoConfig(self._lookup, lambda: self.esm.state, self._default_maps(),
                              self._map_layout())
-        self.esm = Esm(self.pdo.activate)
-        mode = int(self.store.get(0x6060))
-        self.sm = Drive402(model, t=t_us / 1e6, mode=mode or None)
-        self._sm_seen = 0
-        self.engines: dict[int, Mode] = {0: NoMode(self), 1: ProfilePosition(self),
-                                         3: ProfileVelocity(self), 6: Homing(self),
-                                         8: CyclicPosition(self)}
-        self.mode_number = mode
-        self._qs_wait = False
         self._out: dict[tuple[int, int], int] = {}
-        self._cache_version = -1
-        self._cache: dict[tuple, Optional[int]] = {}
         self._signed = frozenset((e.index, e.sub) for e in self.od if e.dtype.startswith("I"))
         self._absent = {k: v for k, v in _ABSENT.items() if self.od.find(*k) is None}
         self._own = frozenset((i, 0) for i in OUTPUTS if self.od.find(i, 0) is not None)
         self._codecs: dict[int, tuple] = {}   # id(entries) -> (entries, codec)
         self._batch = False
-        self._rx_noted = False
-        self.stops = HardStops(self) if (self.plant.neg_stop is not None
-                                         or self.plant.pos_stop is not None) else None
         self._live = self.store.live          # perf: the store's values, read directly
+        self._power_up(t_us)
         self._rx_codec: tuple = ((), None)    # perf: (active_rx, codec) of the last cycle
         self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, _tx_fast_codec of it)
@@ -132,6 +127,27 @@ class Drive(ProcessData, Timeline):
         self.store.on_write(self._hook)
         self._mirror()
         self.publish()
+
+    def _power_up(self, t_us: int) -> None:
+        """The drive's state at power-up (transitions 0 and 1, ESM INIT, no
+        fault, modes idle, the mechanical ends watched afresh): at
+        construction and at :meth:`~.drive_service.Service.power_cycle`."""
+        self.controlword = int(self.store.get(0x6040))
+        self.esm = Esm(self.pdo.activate)
+        mode = int(self.store.get(0x6060))
+        self.sm = Drive402(self.model, t=t_us / 1e6, mode=mode or None)
+        self._sm_seen = 0
+        self.engines: dict[int, Mode] = {0: NoMode(self), 1: ProfilePosition(self),
+                                         3: ProfileVelocity(self), 6: Homing(self),
+                                         8: CyclicPosition(self)}
+        self.mode_number = mode
+        self._qs_wait = False
+        self._cache_version = -1
+        self._cache: dict[tuple, Optional[int]] = {}
+        self._rx_noted = False
+        self.stops = HardStops(self) if (self.plant.neg_stop is not None
+                                         or self.plant.pos_stop is not None) else None
+        self.probe = TouchProbe()
 
     def __deepcopy__(self, memo: dict) -> "Drive":
         # a fork of a PLC copies its drives; compiled struct codecs are not
@@ -159,6 +175,7 @@ class Drive(ProcessData, Timeline):
         return int(self.store.get(index, sub))
 
     def note(self, t: int, section: str, text: str, source: str = "") -> None:
+        text, section = cite(self.model, text, section)
         self.log.append(DriveEvent(t, source or MODE_NAMES.get(self.mode_number, "drive"),
                                    text, section))
 
@@ -223,6 +240,9 @@ class Drive(ProcessData, Timeline):
         """SDO upload (the store's rules)."""
         if index in self.pdo.entries:
             return self.od.entry(index, sub).encode(self.pdo.read(index, sub))
+        if index == 0x2012:
+            with self.store.lock:
+                self._display(index, sub)      # P18: computed when read (HCFA §5.1)
         return self.store.sdo_read(index, sub)
 
     def sdo_write(self, index: int, sub: int, data: bytes) -> None:
@@ -256,7 +276,9 @@ class Drive(ProcessData, Timeline):
     def _on_write(self, w: Write) -> None:
         index, sub, value = w.entry.index, w.entry.sub, w.value
         t = self.now
-        if index == 0x6040:
+        if w.pending:
+            self._pending_write(w)             # alarm 83 (HCFA §4.7)
+        elif index == 0x6040:
             self._controlword(t, int(value))
         elif index == 0x6060:
             self._select_mode(t, int(value))
@@ -325,7 +347,13 @@ class Drive(ProcessData, Timeline):
     # ---------------------------------------------------------------- state machine
     def _mirror(self) -> None:
         for ev in self.sm.log[self._sm_seen:]:
-            self.log.append(DriveEvent(round(ev.t * 1e6), "state machine", str(ev), ev.section))
+            # the event without its time and section: the log line prints them once
+            what = f"transition {ev.transition}" if ev.transition is not None \
+                else "no transition"
+            self.note(round(ev.t * 1e6), ev.section,
+                      f"#{ev.seq} {what} ({ev.source}): {ev.before} -> {ev.after}, 6041h "
+                      f"0x{ev.sw_before:04X} -> 0x{ev.sw_after:04X}"
+                      + (f" {ev.note}" if ev.note else ""), "state machine")
         self._sm_seen = len(self.sm.log)
 
     def _do(self, t: int, res: Result) -> None:

@@ -32,10 +32,14 @@ from .store import key
 __all__ = ["ProcessData", "CW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS", "STATE_KEYS"]
 
 #: The drive's own objects, written by :meth:`ProcessData.publish`.
-OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD)
+#: 6063h (position actual internal value) reads as 6064h: neither model has a
+#: factor group (6091h/6092h), so one increment is one count; 606Bh (velocity
+#: demand) is the speed of the demand 6062h (docs/decisions.md).
+OUTPUTS = (0x6041, 0x6061, 0x6062, 0x6064, 0x606C, 0x603F, 0x1001, 0x60F4, 0x60FD,
+           0x6063, 0x606B)
 _OUTPUT_KEYS = tuple(key(i, 0) for i in OUTPUTS)
-MOTION_KEYS = _K6062, _K6064, _K606C, _K60F4 = tuple(
-    key(i, 0) for i in (0x6062, 0x6064, 0x606C, 0x60F4))
+MOTION_KEYS = _K6062, _K6064, _K606C, _K60F4, _K6063, _K606B = tuple(
+    key(i, 0) for i in (0x6062, 0x6064, 0x606C, 0x60F4, 0x6063, 0x606B))
 STATE_KEYS = _K6041, _K6061, _K603F, _K1001, _K60FD = tuple(
     key(i, 0) for i in (0x6041, 0x6061, 0x603F, 0x1001, 0x60FD))
 #: Objects whose write the drive's hook acts on whatever the mode (6040h
@@ -51,12 +55,13 @@ MISSING = object()
 #: that changes takes the general cycle.
 _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
+_K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
 _PLAIN_PLANT = {f.name for f in fields(DrivePlant)} == {
     "neg_limit", "pos_limit", "home_switch", "index_period", "index_phase",
-    "neg_stop", "pos_stop"}
+    "neg_stop", "pos_stop", "probe", "probe2"}
 
 
 def _picker(at: list) -> Callable[[object], tuple]:
@@ -84,6 +89,7 @@ class ProcessData:
     plant: DrivePlant
     store: Any
     stops: Any
+    probe: Any
     _live: dict[tuple[int, int], Any]
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
@@ -221,10 +227,12 @@ class ProcessData:
             num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
             bits, vel = _B12, num // den if num >= 0 else -(-num // den)
         sm.set_mode_bits(bits)
+        if self.probe.function or live.get(_K60B8):
+            self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         # a plant without switches gives 60FDh = 0 wherever the axis is
         inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
             and plant.home_switch is None else plant.inputs(mech)
-        self._publish_values((target, pos, vel, fe),
+        self._publish_values((target, pos, vel, fe, pos, vel),
                              (sm.statusword, 8, sm.error_code, sm.error_register, inputs))
         return True
 
@@ -372,6 +380,8 @@ class ProcessData:
                 sm.set_mode_bits(bits)
         mech = ax.mechanical(t)
         pos = mech + ax.shift                      # axis.position(t)
+        if self.probe.function or self._live.get(_K60B8):
+            self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         if self.mode_number == 8:
             csp = self.engines[8]
             assert isinstance(csp, CyclicPosition)
@@ -382,15 +392,17 @@ class ProcessData:
         if self.stops is not None and self.mode_number != 8:
             demand = ax.demand_position(t)      # past a mechanical end (stops.py)
             fe = demand - pos
+        vel = ax.velocity(t)
         self._publish_values(
-            (demand, pos, ax.velocity(t), fe),
+            (demand, pos, vel, fe, pos,
+             vel if self.stops is None else int(ax.demand(t)[1])),
             (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
              self.plant.inputs(mech)))
 
     def _publish_values(self, motion: tuple[int, int, int, int],
                         state: tuple[int, int, int, int, int]) -> None:
         """Write the drive's own objects: *motion* = 6062h, 6064h, 606Ch,
-        60F4h and *state* = 6041h, 6061h, 603Fh, 1001h, 60FDh."""
+        60F4h, 6063h, 606Bh and *state* = 6041h, 6061h, 603Fh, 1001h, 60FDh."""
         # perf: two groups, each written only when one of its values changed
         # (the motion values change every cycle of a move, the state values
         # seldom); a group is written whole, unchanged values as they are
@@ -405,7 +417,8 @@ class ProcessData:
             # perf: each group's dict is kept and refilled, then merged whole
             if new_motion:
                 group = self._motion_out
-                group[_K6062], group[_K6064], group[_K606C], group[_K60F4] = motion
+                (group[_K6062], group[_K6064], group[_K606C], group[_K60F4], group[_K6063],
+                 group[_K606B]) = motion
                 store.set_status_group(group)
                 out.update(group)
             if new_state:
@@ -416,7 +429,7 @@ class ProcessData:
         else:
             # each changed value in the order of OUTPUTS, up to one out of range
             values = (state[0], state[1], motion[0], motion[1], motion[2], state[2], state[3],
-                      motion[3], state[4])
+                      motion[3], state[4], motion[4], motion[5])
             own = self._own
             changed = {key: v for key, v in zip(_OUTPUT_KEYS, values)
                        if out.get(key) != v and key in own}

@@ -63,7 +63,13 @@ class Timeline:
 
         def offer(te: Optional[int], kind: str, data: object) -> None:
             nonlocal best
-            if te is not None and te <= t_to and (best is None or te < best[0]):
+            if te is not None and te <= t_to and (
+                    best is None or te < best[0]
+                    # a move that ends on a limit switch's first count reaches
+                    # the switch at its end: the limit stop comes first, or the
+                    # end settles the axis and the switch is never watched again
+                    # (HCFA §7.4.2 bit 11, §7.5.3 note 1)
+                    or (te == best[0] and kind == "limit" and best[1] == "end")):
                 best = (te, kind, data)
 
         end = ax.end_time()

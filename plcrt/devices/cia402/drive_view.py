@@ -30,6 +30,7 @@ class ModeDrive(Protocol):
     sm: Drive402              #: the power state machine (homing sets ``homed``)
     controlword: int          #: 6040h as the drive holds it
     homing_plans: dict[int, Callable[[], HomingPlan]]
+    stops: Any                #: the mechanical ends (stops.HardStops) or None
     #: the store's values by (index, sub), read directly on the CSP cycle
     #: (perf: what :meth:`param` does first)
     _live: dict[tuple[int, int], Any]

@@ -18,6 +18,7 @@ what they use of the drive is :class:`~.drive_view.ModeDrive`.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional
 
 from .drive_view import ModeDrive
@@ -93,6 +94,42 @@ class Mode:
         return (B11 if self.d.limit_active(t) else 0) | (B8 if self.limit_stop else 0)
 
 
+def capped_ramps(d: ModeDrive, t: int, acc: int, dec: int, acc_name: str,
+                 dec_name: str) -> tuple[int, int]:
+    """*acc* and *dec* limited to 60C5h / 60C6h (max acceleration /
+    deceleration, HCFA §7.5.1: they act in PP and HM), with a note."""
+    for name, value, cap_index, cap_name in ((acc_name, acc, 0x60C5, "60C5h (max acceleration)"),
+                                             (dec_name, dec, 0x60C6, "60C6h (max deceleration)")):
+        cap = d.param(cap_index)
+        if cap == 0:
+            # a zero limit would never move: taken as no limit (docs/cia402.md decisions)
+            d.note(t, "HCFA §7.5.1", f"{cap_name} = 0 is no limit (a ramp at 0 never moves)")
+        elif value > cap:
+            d.note(t, "HCFA §7.5.1", f"{name} = {value} P/s² above {cap_name} = {cap}: "
+                   "limited to it")
+            if cap_index == 0x60C5:
+                acc = cap
+            else:
+                dec = cap
+    return acc, dec
+
+
+def homing_limits(d: ModeDrive, t: int, req: HomingRequest) -> HomingRequest:
+    """The homing speeds limited to 6080h (max motor speed) and 609Ah to
+    60C5h / 60C6h (HCFA §7.5.1, §7.5.4: 6080h and 60C5h/60C6h act in HM;
+    609Ah is both ramps of a homing, so the lower of the two caps it)."""
+    v_max = d.param(0x6080)
+    fast, slow = min(req.fast, v_max), min(req.slow, v_max)
+    if (fast, slow) != (req.fast, req.slow):
+        d.note(t, "HCFA §7.5.1, §7.5.4", f"homing speeds 6099h:01 = {req.fast}, 6099h:02 = "
+               f"{req.slow} P/s limited to 6080h (max motor speed) = {v_max}")
+    acc, dec = capped_ramps(d, t, req.accel, req.accel, "609Ah", "609Ah")
+    accel = min(acc, dec)
+    if (fast, slow, accel) == (req.fast, req.slow, req.accel):
+        return req
+    return replace(req, fast=fast, slow=slow, accel=accel)
+
+
 class NoMode(Mode):
     """6061h = 0 (Kinco's default): nothing moves."""
 
@@ -151,6 +188,7 @@ class ProfilePosition(Mode):
         if v > v_max:
             d.note(t, "HCFA §7.5.1", f"6081h = {v} P/s above 6080h = {v_max}: limited to 6080h")
             v = v_max
+        acc, dec = capped_ramps(d, t, acc, dec, "6083h", "6084h")
         immediate = bool(cw & CHANGE_IMMEDIATELY)
         if self.pending is not None and not immediate:
             d.note(t, "HCFA §7.5.3 bit 12",
@@ -220,6 +258,10 @@ class ProfilePosition(Mode):
         b |= B10 if at_rest_done else 0
         b |= B12 if self.ack else 0
         b |= B14 if self.param_zero else 0
+        stops = self.d.stops
+        if stops is not None and stops.over is not None \
+                and self.d.sm.personality.pp_following_error_bit13:
+            b |= B13                       # Kinco §2.6: |60F4h| beyond 6065h (stops.py)
         if not self.ack and not self.halted:
             b |= B15                       # HCFA §7.5.3: bit 15 = NOT bit 12
         return b
@@ -407,8 +449,10 @@ class Homing(Mode):
                             timeout_ms=d.param(0x2003, 7),
                             following_error_window=d.param(0x6065),
                             max_current=d.param(0x6099, 4), velocity_window=d.param(0x60F9, 10))
-        zero = [n for n, x in (("6099h:01", req.fast), ("6099h:02", req.slow),
-                               ("609Ah", req.accel)) if x == 0]
+        req = homing_limits(d, t, req)
+        zero = [n for n, x in (("6098h", method), ("6099h:01", req.fast),
+                               ("6099h:02", req.slow), ("609Ah", req.accel))
+                if x == 0 and (n != "6098h" or 0 not in d.homing_plans)]
         if zero and method not in (35, 37):
             self.param_zero = True
             d.note(t, "HCFA §7.5.4 bit 14", f"homing method {method} refused: "

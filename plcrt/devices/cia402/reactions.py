@@ -124,6 +124,16 @@ FAULT_CODES: dict[int, FaultCode] = {f.code: f for f in (
     _f(0x7305, "incremental sensor 1 fault (CiA 402, not in the seeds)", True,
        "CiA 402", alarm=False),
     _f(0x5441, "E-stop input (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
+    _f(0x8612, "reference limit (CiA 402, not in the seeds)", True, "CiA 402", alarm=False),
+    # The Kinco note numbers no fault: its injectable ones take CiA 402 codes,
+    # power-cycle-only as HCFA's over-current and op-amp faults (§4.7).
+    _f(0x2310, "continuous over-current (CiA 402, not in the seeds)", False, "CiA 402",
+       alarm=False),
+    _f(0x5400, "power stage (CiA 402, not in the seeds)", False, "CiA 402", alarm=False),
+    _f(0x3210, "DC link over-voltage (CiA 402, not in the seeds)", True, "CiA 402",
+       alarm=False),
+    _f(0x3220, "DC link under-voltage (CiA 402, not in the seeds)", False, "CiA 402",
+       alarm=False),
 )}
 
 
@@ -143,6 +153,7 @@ class Personality:
     limit_stops_as_6085h: bool
     idle_statuswords: bool                  # use the HCFA §7.3 per-mode idle table
     default_quick_stop_option: int
+    pp_following_error_bit13: bool          # PP bit 13 = following error (6065h/6066h)
     sources: dict[str, str] = field(default_factory=dict)
 
 
@@ -153,6 +164,7 @@ PERSONALITIES: dict[str, Personality] = {
         auto_qsa_to_sod_options=frozenset({0, 1, 2, 3, 4}),
         enable_from_ready="two-step", limit_stops_as_6085h=True,
         idle_statuswords=True, default_quick_stop_option=2,
+        pp_following_error_bit13=False,
         sources={
             "bit15": "HCFA §7.5.3 / §7.5.4: bit 15 = a move or homing can be triggered",
             "transition_16_options": "HCFA §7.2 row 16 lists QSA->OE; allowed only for "
@@ -163,6 +175,7 @@ PERSONALITIES: dict[str, Personality] = {
             "limit_stops_as_6085h": "a stepper has no torque-limited stop (digest §1.4)",
             "idle_statuswords": "HCFA §7.3 per-mode table",
             "default_quick_stop_option": "HCFA §8.3: 605Ah default 2",
+            "pp_following_error_bit13": "HCFA §7.5.3 defines no PP bit 13",
         }),
     "kinco-servo": Personality(
         model="kinco-servo", bit15="reference-found",
@@ -170,6 +183,7 @@ PERSONALITIES: dict[str, Personality] = {
         auto_qsa_to_sod_options=frozenset({0, 1, 2, 3, 4}),
         enable_from_ready="through", limit_stops_as_6085h=False,
         idle_statuswords=False, default_quick_stop_option=2,
+        pp_following_error_bit13=True,
         sources={
             "bit15": "Kinco §2.6: bit 15 Reference_Found, stays set once homed",
             "transition_16_options": "CiA 402-2 (Kinco seed silent)",
@@ -178,6 +192,8 @@ PERSONALITIES: dict[str, Personality] = {
             "limit_stops_as_6085h": "a servo stops at its current limit (CiA 402)",
             "idle_statuswords": "Kinco §2.6 gives the bits only, no per-mode values",
             "default_quick_stop_option": "CiA 402 default 2 (Kinco seed silent)",
+            "pp_following_error_bit13": "Kinco §2.6: bit 13 following error (CiA 402 PP: "
+                                        "|60F4h| beyond 6065h for 6066h)",
         }),
 }
 

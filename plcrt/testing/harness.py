@@ -410,6 +410,13 @@ class Harness(Stimuli, Motion):
         self.plc.request_stop()
         return self
 
+    def set_mode(self, mode: str) -> Harness:
+        """Switch the CPU to ``"RUN"`` or ``"STOP"`` now, as the mode switch
+        or a programming device does (:meth:`Plc.set_mode`): RUN from STOP
+        makes the next scan a first scan."""
+        self.plc.set_mode(mode)
+        return self
+
     def warn(self, message: str, loc: SourceLoc | None, key: str) -> Harness:
         """Add a run-time warning (reported once per ``key``), as :meth:`Plc.warn`."""
         self.plc.warn(message, loc, key)

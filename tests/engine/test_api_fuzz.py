@@ -210,7 +210,6 @@ CALLS: dict[str, tuple[Call, dict[str, Any]]] = {
     # a served PLC is closed again at once (its servers and runner thread)
     "plcrt.serve": (lambda **k: plcrt.serve(**k).close(),
                     {"plc": PLC, "lockstep": 0, "speed": "lockstep"}),
-    "Plc.set_mode": (lambda **k: _plc().set_mode(k["mode"]), {"mode": "STOP"}),
     "Plc.__init__": (plcrt.Plc, {"program": Fresh(lambda: parse_sources(TIMERS))}),
     "Plc.__getitem__": (lambda **k: _plc()[k["address"]], {"address": "VW0"}),
     "Plc.__setitem__": (lambda **k: _plc().__setitem__(k["address"], k["value"]),
@@ -280,7 +279,7 @@ _PLC_SANE: dict[str, dict[str, Any]] = {
     "force": {"address": "VW0", "value": 1}, "fork": {}, "locate": {"spec": "VW0"},
     "module": {"slot": 0}, "read": {"address": "VW0"}, "reader": {"spec": "VW0"},
     "recompiled": {}, "request_stop": {}, "restore": {"snapshot": PLC}, "run": {"scans": 1},
-    "scan": {}, "snapshot": {}, "unforce": {},
+    "scan": {}, "set_mode": {"mode": "STOP"}, "snapshot": {}, "unforce": {},
     "warn": {"message": "m", "loc": None, "key": "k"},
     "write": {"address": "VW0", "value": 1},
 }

@@ -12,7 +12,6 @@ with the blocks), ``state_of`` (made by :func:`per_cpu_state`),
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Callable, TypeVar
 
 from ..gen.recipe import CPU, Call
@@ -27,13 +26,13 @@ def per_cpu_state(make: Callable[[Any], T]) -> Callable[[Any], T]:
     master, its USS master ...), made by ``make(plc)`` at the first call
     for that CPU: every PLC has its own, shared by its call sites (a fork's
     state is copied into the twin's own, through the binding
-    :meth:`LibraryBlock.at_load` makes)."""
-    states: "weakref.WeakKeyDictionary[Any, T]" = weakref.WeakKeyDictionary()
-
+    :meth:`LibraryBlock.at_load` makes).  It is kept in the PLC's
+    ``family_states``."""
     def state_of(plc: Any) -> T:
-        state = states.get(plc)
+        states = plc.family_states
+        state = states.get(state_of)
         if state is None:
-            state = states[plc] = make(plc)
+            state = states[state_of] = make(plc)
         return state
 
     return state_of

@@ -205,6 +205,11 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
         self._warned: set[str] = set()
         self.diagnostics: list[Any] = []
         self.modules: dict[int, Any] = {}
+        #: what a library family keeps per CPU (its Modbus master, a pulse
+        #: wizard's axes ...), by the family's key; made when this PLC's
+        #: library blocks are (kept here, not in a table outside the PLC
+        #: that would keep every PLC alive)
+        self.family_states: dict[Any, Any] = {}
         if plant is not None:
             self.devices = parts.build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}

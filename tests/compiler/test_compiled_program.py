@@ -226,3 +226,22 @@ def test_a_compiled_program_holds_no_engine_object(options: dict[str, Any],
         found = [o for o in _reachable(plc.compiled) if _engine_object(o)]
         assert not found, f"engine objects in the compiled program: {found[:3]}"
         assert not any(o is plc for o in _reachable(plc.compiled))
+
+
+@pytest.mark.parametrize("program", ["modbus/poll.awl", "uss/drive.awl", "events/pto_wizard.awl"])
+def test_a_plc_with_library_blocks_is_freed_with_its_last_reference(
+        program: str, fresh_cache: cache.ProgramCache) -> None:
+    """A library family's state per CPU lives in the PLC
+    (``family_states``), so nothing outside keeps a dropped PLC alive; the
+    compiled program, kept by the cache, holds none of its objects."""
+    import weakref
+    path = ROOT / "programs" / program
+    plant = next(iter(sorted(path.parent.glob(f"{path.stem}*.toml"))
+                      or sorted(path.parent.glob("*plant.toml"))), None)
+    plc = plcrt.load(path, plant=plant)
+    assert plc.family_states, "the program keeps a family's state"
+    plc.scan()
+    gone = weakref.ref(plc)
+    del plc
+    gc.collect()
+    assert gone() is None and len(fresh_cache) == 1

@@ -20,7 +20,6 @@ plcrt.blocks.call.protected_call).
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block, register_protected
@@ -51,9 +50,6 @@ COUNTER_OF = {0: 0, 1: 3}
 KINDS = ("CTRL", "RUN", "MAN", "LDPOS", "ADV")
 NAMES = tuple(f"PTO{n}_{k}" for n in (0, 1) for k in KINDS) + ("PWM0_RUN", "PWM1_RUN")
 
-#: plc -> {output: WizardAxis}, used only while the program compiles (the
-#: blocks keep their axis; a fork copies blocks and axis together)
-_AXES: "weakref.WeakKeyDictionary[Any, dict[int, WizardAxis]]" = weakref.WeakKeyDictionary()
 
 
 def _plant(plc: Any, key: str) -> dict:
@@ -173,7 +169,9 @@ class WizardAxis:
 
 
 def _axis(plc: Any, output: int) -> WizardAxis:
-    axes = _AXES.setdefault(plc, {})
+    """The axis of ``output`` the PTOx_* blocks of ``plc`` share, made with
+    the first of them (a fork copies blocks and axis together)."""
+    axes = plc.family_states.setdefault(_axis, {})
     if output not in axes:
         axes[output] = WizardAxis(plc, output)
     return axes[output]

@@ -55,7 +55,8 @@ from .values import check_backend, check_parsed_inputs, scan_time_us, shown_valu
 
 
 class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
-    """A loaded program, ready to scan.  Create it with :func:`plcrt.load`."""
+    """A loaded program, ready to scan.  Create it with :func:`plcrt.load`
+    (or :meth:`from_program`, another instance of a compiled program)."""
 
     def __init__(self, program: ir.Program, *, symbols: Any = None, data: Any = None,
                  scan_ms: float = 10.0, cpu: str | None = None,

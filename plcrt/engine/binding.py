@@ -25,7 +25,7 @@ from typing import Any
 from ..compiler.cache import program_key, programs
 from ..compiler.program import CompiledProgram, compile_to_program
 from ..compiler.rt import CODECS, make_indirect
-from ..errors import Diagnostic, PlcCompileError
+from ..errors import Diagnostic, PlcCompileError, PlcConfigError, PlcError
 from ..gen.recipe import resolve
 from ..lang import ir
 from .coverage import CoverageMap
@@ -74,7 +74,15 @@ class Binding:
         self.unit, self.line_locs = compiled.unit, compiled.line_locs
         self.diagnostics = auto_diags + list(self.unit.diag.items) + self.diagnostics
         # library blocks made now report to this PLC's diagnostics
-        self._bindings = resolve(compiled.bindings, self)
+        try:
+            self._bindings = resolve(compiled.bindings, self)
+        except PlcError:
+            raise
+        except Exception as e:  # a plcrt bug (a block's factory), never the user's
+            raise PlcConfigError(f"internal error: the compiled program's bindings cannot "
+                                 f"be made for this PLC ({type(e).__name__}: "
+                                 f"{str(e)[:200]}); please report it with the program"
+                                 ) from None
         self._filename = f"<plcrt {self.program.file}>"
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)

@@ -245,3 +245,26 @@ def test_a_plc_with_library_blocks_is_freed_with_its_last_reference(
     del plc
     gc.collect()
     assert gone() is None and len(fresh_cache) == 1
+
+
+class _Broken:
+    """A library block whose factory fails (a plcrt bug)."""
+
+    def __init__(self, plc: Any, loc: Any, itf: Any) -> None:
+        raise RuntimeError("broken factory")
+
+    def __call__(self, *args: int) -> tuple:
+        return ()
+
+
+def test_a_block_that_cannot_be_made_for_a_plc_is_an_internal_error(
+        monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
+    """The compiler never makes a block (each PLC does, from its recipe):
+    a factory that fails is reported as plcrt's error, not a traceback."""
+    from plcrt.blocks import BLOCK_FACTORIES, load_libraries
+    load_libraries()
+    monkeypatch.setitem(BLOCK_FACTORIES, "GET_ABSPOS", _Broken)
+    text = ("ORGANIZATION_BLOCK OB1\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+            "CALL   GET_AbsPos, 0, 0, VD0, VW4\nEND_ORGANIZATION_BLOCK\n")
+    with pytest.raises(plcrt.PlcConfigError, match="internal error.*broken factory"):
+        plcrt.load(text)

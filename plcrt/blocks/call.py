@@ -32,6 +32,7 @@ from typing import Any
 
 from ..compiler.operands import Addr, Const, Indirect
 from ..compiler.resolve import ResolveError, check_role
+from ..gen.recipe import CPU, Attr, Call
 from ..isa.registry import Role
 from ..safetext import excerpt
 from . import BLOCK_FACTORIES, PROTECTED, load_libraries
@@ -93,16 +94,15 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         if p.dir == "OUT" or p.written:
             target = op if isinstance(op, (Addr, Indirect)) else None
             writes.append((target, p.type))
-    plc = g.unit.hooks["plc"]
     at_load = getattr(factory, "at_load", None)
     if at_load is not None:
-        at_load(g, itf, plc)          # load-time warnings of the block's family
-    block = factory(plc, g.loc, itf)
-    told = getattr(block, "constant_args", None)
-    if told is not None:
-        told(frozenset(constants))     # perf: see the module docstring
-    call = getattr(type(block), "__call__", None)
-    if not (isinstance(call, FunctionType) and hasattr(block, "__dict__")):
+        at_load(g, itf)               # load-time warnings of the block's family
+    # each PLC of the program makes its own block of this call site
+    block = Call(make_block, (factory, CPU, g.loc, itf, frozenset(constants)))
+    cls = factory if isinstance(factory, type) else None
+    call = getattr(cls, "__call__", None)
+    # (a factory is a block class; its instances have a __dict__ unless slotted)
+    if not (isinstance(call, FunctionType) and getattr(cls, "__dictoffset__", 0)):
         fn = g.bind(block, "blk")
     else:
         # perf: the generated code calls the block's bound __call__: a
@@ -112,8 +112,8 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         # fork() and snapshots copy its state through that binding, and the
         # method, rebound for each PLC, is bound to that PLC's block.
         g.unit.bind(block, "blk")
-        fn = g.bind(block.__call__, "call")
-    exact = getattr(type(block), "exact_results", None)
+        fn = g.bind(Attr(block, "__call__"), "call")
+    exact = getattr(cls, "exact_results", None)
     with g.box(alone=True):
         args = ', '.join(_bit_reads(g, reads))
         if exact is None:
@@ -133,6 +133,17 @@ def library_call(g: Any, insn: Any, resolver: Any, name: str | None = None) -> b
         else:
             g.line(f"{fn}({args})")
     return True
+
+
+def make_block(factory: Any, plc: Any, loc: Any, itf: Any, constants: frozenset[str]) -> Any:
+    """The block of one call site for ``plc``: ``factory(plc, loc, itf)``,
+    told the IN parameters the site gives as constants (perf: see the
+    module docstring)."""
+    block = factory(plc, loc, itf)
+    told = getattr(block, "constant_args", None)
+    if told is not None:
+        told(constants)
+    return block
 
 
 def _bit_reads(g: Any, reads: list[Any]) -> list[str]:

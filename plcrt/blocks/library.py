@@ -12,12 +12,11 @@ with the blocks), ``state_of`` (made by :func:`per_cpu_state`),
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Callable, TypeVar
 
-from ..compiler.cache import per_cpu
+from ..gen.recipe import CPU, Call
 
-__all__ = ["LibraryBlock", "per_cpu_state"]
+__all__ = ["LibraryBlock", "library_state", "per_cpu_state"]
 
 T = TypeVar("T")
 
@@ -25,18 +24,24 @@ T = TypeVar("T")
 def per_cpu_state(make: Callable[[Any], T]) -> Callable[[Any], T]:
     """A function giving a CPU's state of a library family (its Modbus
     master, its USS master ...), made by ``make(plc)`` at the first call
-    for that CPU.  The states are registered with the program cache
-    (:func:`plcrt.compiler.cache.per_cpu`), so a PLC built from a cached
-    program gets its own copy, the one its blocks were rebound to."""
-    states: "weakref.WeakKeyDictionary[Any, T]" = per_cpu(weakref.WeakKeyDictionary())
-
+    for that CPU: every PLC has its own, shared by its call sites (a fork's
+    state is copied into the twin's own, through the binding
+    :meth:`LibraryBlock.at_load` makes).  It is kept in the PLC's
+    ``family_states``."""
     def state_of(plc: Any) -> T:
-        state = states.get(plc)
+        states = plc.family_states
+        state = states.get(state_of)
         if state is None:
-            state = states[plc] = make(plc)
+            state = states[state_of] = make(plc)
         return state
 
     return state_of
+
+
+def library_state(cls: type["LibraryBlock"], plc: Any) -> Any:
+    """The state of ``cls``'s family for ``plc`` (what the generated code
+    binds as ``cls.bind_as``)."""
+    return cls.state_of(plc)
 
 
 class LibraryBlock:
@@ -64,12 +69,12 @@ class LibraryBlock:
         self.plc.warn(f"{self.name}: {msg}", self.loc, f"{self.name}:{code}:{id(self)}")
 
     @classmethod
-    def at_load(cls, g: Any, itf: Any, plc: Any) -> None:
+    def at_load(cls, g: Any, itf: Any) -> None:
         """Once per program and family: bind the shared state into the code
-        and warn :meth:`notice`."""
+        (each PLC's own, :func:`library_state`) and warn :meth:`notice`."""
         once = g.unit.hooks.setdefault("library-once", set())
         if cls.family in once:
             return
         once.add(cls.family)
-        g.bind(cls.state_of(plc), cls.bind_as)
+        g.bind(Call(library_state, (cls, CPU)), cls.bind_as)
         g.warn(cls.notice(itf), f"{cls.family}-library")

@@ -2,7 +2,9 @@
 
 ``compile_program`` runs resolution, checks and code generation, collects
 every diagnostic, and raises one :class:`~plcrt.errors.PlcCompileError`
-listing all errors.  It does not bind memory: :class:`plcrt.engine.Plc` does.
+listing all errors.  :func:`plcrt.compiler.program.compile_to_program`
+makes of it the compiled program every PLC of it shares; it does not bind
+memory: :class:`plcrt.engine.Plc` does.
 """
 
 from __future__ import annotations
@@ -21,16 +23,16 @@ from .unit import Compiled, Unit
 
 def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None,
                     system_symbols: dict[str, str] | None = None,
-                    bindings: dict[str, Any] | None = None,
-                    setup: Any = None, probes: Any = None,
+                    hooks: Any = None, plant: Any = None, probes: Any = None,
                     library: bool = False, native: bool = False
                     ) -> tuple[Unit, str, dict]:
     """Check and generate code; returns the unit, module source and line map.
 
     Args:
-        setup: optional callable ``setup(unit)`` run before generation, used by
-            the engine to provide run-time objects (timer bank, ...) that
-            emitters bind.
+        hooks: compile-time hooks of the layers above, by name
+            (``library_call``, ``protected_call``: :mod:`plcrt.parts`).
+        plant: the parsed plant the program is compiled for (what the
+            library blocks' load-time checks read), or None.
         probes: a :class:`plcrt.engine.coverage.CoverageMap` to instrument
             the code for (network and output coverage, breakpoints).
         library: accept a program without OB1 (a subroutine library, for
@@ -49,8 +51,8 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
     if native and probes is None:
         from .native import NativePlan
         unit.native = NativePlan()
-    if setup is not None:
-        setup(unit)
+    unit.plant = plant
+    unit.hooks.update(hooks or {})
     try:
         source, line_locs = generate(unit)
     except PlcError:

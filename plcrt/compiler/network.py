@@ -15,6 +15,7 @@ from typing import Any
 from ..errors import PlcError, SourceLoc
 from ..gen.emit import CodegenError, Gen
 from ..gen.limits import MAX_STACK
+from ..gen.recipe import CPU, Attr
 from ..gen.resolve import ResolveError, Resolver
 from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
@@ -24,16 +25,22 @@ from .constpower import ConstantPower, contact_value
 from .unit import Piece, Unit
 
 
+#: the probe tables the instrumented code reaches: the PLC's own copy of
+#: the program's coverage map (one recipe each, so one name each)
+PROBES = {name: Attr(CPU, f"coverage.{name}")
+          for name in ("hits", "breakpoints", "call_hit", "power", "closed")}
+
+
 def network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:
     """Mark the network as run; the first piece also checks for a breakpoint."""
     net = piece.network
     k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
                                 net.loc.within(piece.pou.ident, net.number))
-    nc = gen.bind(unit.probes.hits, "NC")
+    nc = gen.bind(PROBES["hits"], "NC")
     gen.line(f"{nc}[{k}] = 1")
     if not piece.suffix:
-        bp = gen.bind(unit.probes.breakpoints, "BP")
-        hit = gen.bind(unit.probes.call_hit, "HIT")
+        bp = gen.bind(PROBES["breakpoints"], "BP")
+        hit = gen.bind(PROBES["call_hit"], "HIT")
         with gen.block(f"if {bp}[{k}]:"):
             gen.line(f"{hit}({k})")
 
@@ -52,7 +59,7 @@ def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: Source
                                 net.loc.within(piece.pou.ident, net.number))
     j = unit.probes.add_output(k, insn.mnemonic,
                                insn.operands[0].text if insn.operands else "", loc)
-    oc = gen.bind(unit.probes.power, "OC")
+    oc = gen.bind(PROBES["power"], "OC")
     # the first power input (EN; CU of a counter) is the deepest of them
     gen.line(f"{oc}[{j}] |= {gen.level(shp.inputs - 1)} + 1")  # perf: 0/1 -> bit 0/1
 
@@ -86,7 +93,7 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     k = unit.probes.add_network(piece.pou.ident, net.number, net.title,
                                 net.loc.within(piece.pou.ident, net.number))
     j = unit.probes.add_contact(k, m, insn.operands[0].text if insn.operands else "", loc)
-    cc = gen.bind(unit.probes.closed, "CC")
+    cc = gen.bind(PROBES["closed"], "CC")
     load_spec.emit(gen, *ops)
     gen.line(f"{cc}[{j}] |= {gen.top} + 1")  # perf: a stack value is 0 or 1
     if shp.op != "load":

@@ -75,6 +75,9 @@ class Unit:
         self.symbols = symbols
         self.system_symbols = system_symbols
         self.diag = diag
+        #: generated name -> what it is bound to: a recipe each PLC resolves
+        #: for itself (:mod:`plcrt.gen.recipe`), a buffer (made anew for
+        #: each PLC from its contents) or a constant every PLC shares
         self.bindings: dict[str, Any] = {}
         #: names of the bindings that are constants (lookup tables, string
         #: constants): shared by every PLC built from this unit, never
@@ -88,7 +91,11 @@ class Unit:
         self.timer_use: dict[int, list[tuple[str, SourceLoc]]] = {}
         self.counter_use: dict[int, list[tuple[str, SourceLoc]]] = {}
         self.edge_count = 0
-        self.hooks: dict[str, Any] = {}       #: family-specific run-time tables
+        #: compile-time tables of the emitters and the hooks of the layers
+        #: above (``library_call``); emptied when the program is compiled
+        self.hooks: dict[str, Any] = {}
+        #: the parsed plant the program is compiled for, or None
+        self.plant: Any = None
         self.current: PouInfo | None = None
         self.current_piece: Piece | None = None
         #: a :class:`plcrt.engine.coverage.CoverageMap` to add probes for

@@ -11,7 +11,8 @@ what it reports of its devices (``axis``, ``drive``...), and
 * :mod:`.eventcalls` -- interrupts, HSC, PLS, ports: what the generated code
   and the time line call in the CPU;
 * :mod:`.faults` -- faults, the watchdog, run-time warnings;
-* :mod:`.binding` -- compiling (the program cache's template) and binding;
+* :mod:`.binding` -- the compiled program (from the cache or compiled) and
+  the PLC made an instance of it;
 * :mod:`.forking` -- forks, snapshots, recompiled twins.
 
 What it is not: reading files or plant files and fitting the PLC with
@@ -26,6 +27,7 @@ from typing import Any, Callable, Sequence
 
 from ..compiler.cache import gc_paused
 from ..compiler.entry import check_entry, main_block
+from ..compiler.program import CompiledProgram
 from ..errors import Diagnostic, PlcAddressError, PlcConfigError, PlcError
 from ..lang import ir
 from ..memory import MemoryImage, cpu_model
@@ -53,7 +55,8 @@ from .values import check_backend, check_parsed_inputs, scan_time_us, shown_valu
 
 
 class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
-    """A loaded program, ready to scan.  Create it with :func:`plcrt.load`."""
+    """A loaded program, ready to scan.  Create it with :func:`plcrt.load`
+    (or :meth:`from_program`, another instance of a compiled program)."""
 
     def __init__(self, program: ir.Program, *, symbols: Any = None, data: Any = None,
                  scan_ms: float = 10.0, cpu: str | None = None,
@@ -62,7 +65,7 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
                  plant: Any = None, instrument: bool = False, library: bool = False,
                  auto_symbols: bool = False, clock: Any = None, backend: str | None = None,
                  entry: str | None = None,
-                 _entry: Any = None, _template: bool = False, _parts: Parts | None = None) -> None:
+                 _entry: Any = None, _parts: Parts | None = None) -> None:
         scan_us = scan_time_us(scan_ms)
         for name, flag in (("instrument", instrument), ("library", library),
                            ("auto_symbols", auto_symbols)):
@@ -113,6 +116,11 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
                             system_symbols=system_symbols, watchdog_ms=watchdog_ms,
                             pace=pace, plant=plant, instrument=instrument, library=library,
                             clock=clock, backend=backend, entry=entry)
+        if _entry is None:
+            # parse -> check -> compile, before anything of this PLC exists:
+            # the compiler is handed the program and options, never the PLC
+            with gc_paused():
+                _entry = self._compiled_program(program, auto_diags)
         #: the native segments' context over this PLC's buffers, or None
         self._native: Any = None
         #: network/output coverage and breakpoints (``instrument=True`` only)
@@ -199,16 +207,15 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
         self._warned: set[str] = set()
         self.diagnostics: list[Any] = []
         self.modules: dict[int, Any] = {}
+        #: what a library family keeps per CPU (its Modbus master, a pulse
+        #: wizard's axes ...), by the family's key; made when this PLC's
+        #: library blocks are (kept here, not in a table outside the PLC
+        #: that would keep every PLC alive)
+        self.family_states: dict[Any, Any] = {}
         if plant is not None:
             self.devices = parts.build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
-        if _entry is None and _template:
-            # a template of the program cache: compiled here, never run
-            self._compile_template(program, symbols, system_symbols, library)
-            return
         with gc_paused():
-            if _entry is None:
-                _entry = self._cached_entry(program, auto_diags)
             self._adopt(_entry, auto_diags)
         a = self.mem.areas
         # perf: the buffers a scan's start and end use, unpacked once each
@@ -236,6 +243,28 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
         self.mem.areas["SM"][22:28] = ms * 3
         parts.attach_port_devices(self.ports, plant)   # a plant device sends at given times
         self._replain()
+
+    @classmethod
+    def from_program(cls, compiled: CompiledProgram, *, data: Any = None,
+                     scan_ms: float = 10.0, watchdog_ms: float = WATCHDOG_MS,
+                     pace: str = "simulated", clock: Any = None,
+                     entry: str | None = None) -> "Plc":
+        """A new PLC of ``compiled`` (:attr:`compiled` of another PLC, or
+        one unpickled from another process) with its own memory, devices
+        and state, compiled with the program's options; nothing is
+        compiled again.  The arguments are those of :func:`plcrt.load`
+        that do not change the compiled program.
+
+        Raises:
+            PlcConfigError: ``compiled`` is not a compiled program, or a bad
+                run-time option.
+        """
+        if not isinstance(compiled, CompiledProgram):
+            raise PlcConfigError(f"Plc.from_program() needs a compiled program (plc.compiled), "
+                                 f"got {type(compiled).__name__}")
+        return cls(compiled.program, **compiled.options, data=data, scan_ms=scan_ms,
+                   watchdog_ms=watchdog_ms, pace=pace, clock=clock, entry=entry,
+                   _entry=compiled)
 
     @property
     def now_us(self) -> int:

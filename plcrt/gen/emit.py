@@ -24,6 +24,7 @@ from .errors import CodegenError
 from .exprs import VALUE_WIDTH, const_expr, is_atom, is_int_literal
 from .limits import MAX_STACK
 from .operands import Addr, Const, Indirect, Pointer
+from .recipe import CPU, Attr
 from .rt import EXACT_CODE, PACK_CODE, packer
 
 # Memory areas and the local names their buffers have in generated code.
@@ -125,6 +126,12 @@ class Gen:
         name = self.unit.bind(obj, hint)
         self.used.add(name)
         return name
+
+    def cpu(self, path: str, hint: str = "o") -> str:
+        """Bind the CPU's object at attribute ``path`` (``"timers.reset"``)
+        as a fast local: a recipe each PLC of the program resolves to its
+        own (:mod:`plcrt.gen.recipe`)."""
+        return self.bind(Attr(CPU, path), hint)
 
     def const(self, obj: object, hint: str = "k") -> str:
         """Bind a constant (a lookup table, a string constant's bytes) that

@@ -36,6 +36,7 @@ from decimal import ROUND_HALF_UP, Decimal
 from typing import Callable
 
 from ..gen.emit import Gen
+from ..gen.recipe import CPU, Call, Item
 from .region import region, runtime_error
 from .registry import Role, Span, insn
 
@@ -143,8 +144,8 @@ def _helpers(plc) -> dict[str, Callable]:
 def _helper(g: Gen, mn: str) -> str:
     hooks = g.unit.hooks
     if "ascii" not in hooks:
-        hooks["ascii"] = _helpers(hooks["plc"])
-    return g.bind(hooks["ascii"][mn], mn.lower())
+        hooks["ascii"] = Call(_helpers, (CPU,))
+    return g.bind(Item(hooks["ascii"], mn), mn.lower())
 
 
 #: the most characters RTA writes (FMT's ssss)

@@ -165,10 +165,10 @@ def _range(g: Gen, op: Addr, n: Const, value: int, phys: bool = False) -> None:
             if last >= limit:
                 g.fail(f"the range runs past {op.area}{limit - 1}")
             if op.area == "T":
-                bank = g.bind(g.unit.hooks["timers"].reset, "Treset")
+                bank = g.cpu("timers.reset", "Treset")
                 g.line(f"for _n in range({op.offset}, {last + 1}): {bank}(_n)")
             else:
-                bank = g.bind(g.unit.hooks["counters"].reset, "Creset")
+                bank = g.cpu("counters.reset", "Creset")
                 g.line(f"for _n in range({op.offset}, {last + 1}): {bank}(_n)")
             return
         start = op.offset * 8 + op.bit

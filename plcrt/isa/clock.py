@@ -17,6 +17,7 @@ ENO is 0.  No SMB1 bit changes.
 from __future__ import annotations
 
 from ..gen.emit import Gen
+from ..gen.recipe import CPU, Attr, Call
 from .region import region, runtime_error
 from .registry import Role, Span, insn
 
@@ -47,14 +48,13 @@ def _make(mn: str) -> None:
     nbytes, method, sets, summary = TOD[mn]
 
     def emit(g: Gen, t) -> None:
-        plc = g.unit.hooks["plc"]
         where = region(g, t, nbytes, "the clock buffer T")
         with g.box():
             if sets:
-                fn = g.bind(_checked(plc, mn, getattr(plc.clock, method)), mn.lower())
+                fn = g.bind(Call(_checked, (CPU, mn, Attr(CPU, f"clock.{method}"))), mn.lower())
                 g.eno(f"{fn}({where}, {g.insn_id})")
             else:
-                fn = g.bind(getattr(plc.clock, method), mn.lower())
+                fn = g.cpu(f"clock.{method}", mn.lower())
                 g.line(f"{fn}(*{where})")
 
     # TODW reads its buffer, TODR writes it

@@ -55,7 +55,7 @@ def _port_insn(name: str, method: str, kind: str = ""):
         tbl, port_text = operand_texts(g, insn_ir, 2, f"a table and a port ({name} TBL, PORT)")
         ptr = _table(g, resolver, tbl, name)
         port = _port(g, resolver, port_text, name)
-        fn = g.bind(getattr(g.unit.hooks["plc"], method), method.strip("_"))
+        fn = g.cpu(method, method.strip("_"))
         extra = f", '{kind}'" if kind else ""
         g.eno(f"1 if {g.top} and {fn}({port}, {ptr}{extra}) else 0")
     return emit
@@ -65,7 +65,7 @@ def _eth_insn(name: str):
     def emit(g: Gen, insn_ir, resolver, *_ops) -> None:
         tbl = operand_texts(g, insn_ir, 1, f"a table ({name} TBL)")[0]
         ptr = _table(g, resolver, tbl, name)
-        fn = g.bind(g.unit.hooks["plc"]._getput, "getput")
+        fn = g.cpu("_getput", "getput")
         g.eno(f"1 if {g.top} and {fn}({ptr}, '{name}') else 0")
     return emit
 

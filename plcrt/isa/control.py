@@ -66,7 +66,7 @@ def _mend(g: Gen) -> None:
 
 @insn("STOP", family=F, summary="go to STOP mode at the end of this scan")
 def _stop(g: Gen) -> None:
-    plc = g.bind(g.unit.hooks["plc"].request_stop, "stop")
+    plc = g.cpu("request_stop", "stop")
     with g.box():
         g.line(f"{plc}()")
 
@@ -185,7 +185,7 @@ def _lscr(g: Gen, bit: Addr) -> None:
         # An inactive segment resets the TOF timers inside it (manual, TOF:
         # "a TOF in an inactive SCR segment is reset").
         for n in _tofs_in_segment(g, info, here):
-            reset = g.bind(g.unit.hooks["timers"].reset, "Treset")
+            reset = g.cpu("timers.reset", "Treset")
             g.line(f"{reset}({int(n)})")
         g.line(f"return {int(exit_)}")
 
@@ -310,7 +310,7 @@ def _call(g: Gen, insn_ir, resolver, *_ops) -> None:
     wd = g.use("WD")
     with g.box():
         with g.block(f"if {wd}[3] >= {int(MAX_NESTING)}:"):
-            refuse = g.bind(g.unit.hooks["plc"]._nesting_exceeded, "nest")
+            refuse = g.cpu("_nesting_exceeded", "nest")
             g.line(f"{refuse}({int(g.insn_id)})")
             g.line("eno = 0")
         with g.block("else:"):

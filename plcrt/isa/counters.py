@@ -22,7 +22,7 @@ def _use(g: Gen, kind: str, c: Addr) -> str:
         g.warn(f"C{c.offset} is also used by a {uses[0][0]} box; both share one current "
                f"value and edge memory", "counter-twice")
     uses.append((kind, g.loc))
-    return g.bind(getattr(g.unit.hooks["counters"], kind.lower()), kind.lower())
+    return g.cpu(f"counters.{kind.lower()}", kind.lower())
 
 
 @insn("CTU", Role.COUNTER, Role.W_R, family=F, summary="count up (CU second level, R top)")

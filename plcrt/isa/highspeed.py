@@ -30,7 +30,7 @@ def _pls(g: Gen, insn_ir, resolver, *_ops) -> None:
         number = int_constant(g, resolver, text, "PLS", wrong)
         if number not in (0, 1):
             g.fail(wrong)
-    pls = g.bind(g.unit.hooks["plc"]._pls, "pls")
+    pls = g.cpu("_pls", "pls")
     with g.box():
         g.line(f"{pls}({number})")
 
@@ -50,7 +50,7 @@ def _hdef(g: Gen, insn_ir, resolver, *_ops) -> None:
         g.fail("HDEF is not allowed in an interrupt routine")
     n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
     mode = _const(g, resolver, ops[1], f"HSC{n} mode", MODES[n])
-    hdef = g.bind(g.unit.hooks["plc"]._hdef, "hdef")
+    hdef = g.cpu("_hdef", "hdef")
     with g.box():
         g.line(f"{hdef}({n}, {mode})")
 
@@ -60,6 +60,6 @@ def _hdef(g: Gen, insn_ir, resolver, *_ops) -> None:
 def _hsc(g: Gen, insn_ir, resolver, *_ops) -> None:
     ops = operand_texts(g, insn_ir, 1, "the counter number")
     n = _const(g, resolver, ops[0], "HSC", range(g.unit.model.hsc))
-    hsc = g.bind(g.unit.hooks["plc"]._hsc, "hsc")
+    hsc = g.cpu("_hsc", "hsc")
     with g.box():
         g.line(f"{hsc}({n})")

@@ -53,7 +53,7 @@ def _atch(g: Gen, insn_ir, resolver, *_ops) -> None:
     if callee.pou.kind != "INT":
         g.fail(f"{callee.pou.ident} is not an interrupt routine (INTERRUPT_BLOCK)")
     event = _event(g, resolver, evnt)
-    attach = g.bind(g.unit.hooks["plc"]._irq_attach, "atch")
+    attach = g.cpu("_irq_attach", "atch")
     with _guarded(g):
         g.line(f"{attach}({int(callee.pou.number)}, {event})")
 
@@ -62,7 +62,7 @@ def _atch(g: Gen, insn_ir, resolver, *_ops) -> None:
 def _dtch(g: Gen, insn_ir, resolver, *_ops) -> None:
     evnt, = operand_texts(g, insn_ir, 1, "an event (DTCH EVNT)")
     event = _event(g, resolver, evnt)
-    detach = g.bind(g.unit.hooks["plc"]._irq_detach, "dtch")
+    detach = g.cpu("_irq_detach", "dtch")
     with _guarded(g):
         g.line(f"{detach}({event})")
 
@@ -72,7 +72,7 @@ def _dtch(g: Gen, insn_ir, resolver, *_ops) -> None:
 def _cevnt(g: Gen, insn_ir, resolver, *_ops) -> None:
     evnt, = operand_texts(g, insn_ir, 1, "an event (CEVNT EVNT)")
     event = _event(g, resolver, evnt)
-    clear = g.bind(g.unit.hooks["plc"].interrupts.clear, "cevnt")
+    clear = g.cpu("interrupts.clear", "cevnt")
     with _guarded(g):
         g.line(f"{clear}({event})")
 
@@ -81,7 +81,7 @@ def _cevnt(g: Gen, insn_ir, resolver, *_ops) -> None:
 def _eni(g: Gen) -> None:
     if _kind(g) == "INT":
         g.fail("ENI is not allowed in an interrupt routine")
-    eni = g.bind(g.unit.hooks["plc"]._irq_enable, "eni")
+    eni = g.cpu("_irq_enable", "eni")
     with _guarded(g):
         g.line(f"{eni}()")
 
@@ -90,7 +90,7 @@ def _eni(g: Gen) -> None:
 def _disi(g: Gen) -> None:
     if _kind(g) == "INT":
         g.fail("DISI is not allowed in an interrupt routine")
-    disi = g.bind(g.unit.hooks["plc"].interrupts.disable, "disi")
+    disi = g.cpu("interrupts.disable", "disi")
     with _guarded(g):
         g.line(f"{disi}()")
 

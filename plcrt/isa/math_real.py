@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 
 from ..gen.emit import Gen
+from ..gen.recipe import Call
 from ..gen.rt import to_f32
 from .registry import Role, insn
 
@@ -41,6 +42,9 @@ def _div(a: float, o: float) -> float | None:
 
 
 def _unary(fn):
+    """``fn`` rounded to single precision, None for a domain error or an
+    overflow (bound as a recipe: each PLC makes its own, as a closure does
+    not pickle)."""
     def f(x: float) -> float | None:
         try:
             return _real_result(fn(x))
@@ -50,12 +54,12 @@ def _unary(fn):
 
 
 UNARY = {
-    "SQRT": (_unary(math.sqrt), "OUT := square root of IN"),
-    "SIN": (_unary(math.sin), "OUT := sine of IN (radians)"),
-    "COS": (_unary(math.cos), "OUT := cosine of IN (radians)"),
-    "TAN": (_unary(math.tan), "OUT := tangent of IN (radians)"),
-    "LN": (_unary(math.log), "OUT := natural logarithm of IN"),
-    "EXP": (_unary(math.exp), "OUT := e to the power IN"),
+    "SQRT": (Call(_unary, (math.sqrt,)), "OUT := square root of IN"),
+    "SIN": (Call(_unary, (math.sin,)), "OUT := sine of IN (radians)"),
+    "COS": (Call(_unary, (math.cos,)), "OUT := cosine of IN (radians)"),
+    "TAN": (Call(_unary, (math.tan,)), "OUT := tangent of IN (radians)"),
+    "LN": (Call(_unary, (math.log,)), "OUT := natural logarithm of IN"),
+    "EXP": (Call(_unary, (math.exp,)), "OUT := e to the power IN"),
 }
 BINARY = {"+R": (_add, "OUT := OUT + IN1"), "-R": (_sub, "OUT := OUT - IN1"),
           "*R": (_mul, "OUT := OUT * IN1"), "/R": (_div, "OUT := OUT / IN1")}

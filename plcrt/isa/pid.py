@@ -47,5 +47,5 @@ def _pid(g: Gen, insn_ir, resolver, *_ops) -> None:
         # the CPU runs both, but they share the loop's manual/auto memory
         g.warn(f"PID loop {loop} is also used at line {first.line}: two PID boxes with one "
                f"loop number interfere with each other (System Manual, PID)", "pid-loop")
-    pid = g.bind(g.unit.hooks["plc"].pid.execute, "pid")
+    pid = g.cpu("pid.execute", "pid")
     g.eno(f"{pid}({loop}, {op.offset}, {g.top})")

@@ -23,6 +23,7 @@ The settings live in :class:`plcrt.engine.clock.Station`.
 from __future__ import annotations
 
 from ..gen.emit import Gen
+from ..gen.recipe import CPU, Call
 from ..gen.operands import Const
 from ..memory.hardware import PORTS
 from .region import runtime_error
@@ -32,7 +33,7 @@ F = "smart"
 
 
 def _ms_timer(plc):
-    """The 1 ms system timer of *plc* (a closure: a fork compiles its own)."""
+    """The 1 ms system timer of *plc* (bound as a recipe: each PLC makes its own)."""
 
     def ms() -> int:
         return plc._irq_t // 1000 & 0xFFFFFFFF
@@ -43,7 +44,7 @@ def _ms_timer(plc):
 def _timer(g: Gen) -> str:
     hooks = g.unit.hooks
     if "ms_timer" not in hooks:
-        hooks["ms_timer"] = _ms_timer(hooks["plc"])
+        hooks["ms_timer"] = Call(_ms_timer, (CPU,))
     return g.bind(hooks["ms_timer"], "ms")
 
 
@@ -64,7 +65,7 @@ def _citim(g: Gen, start, out) -> None:
 
 @insn("DLED", Role.B_R, family=F, summary="diagnostic LED on for IN > 0, off for 0")
 def _dled(g: Gen, value) -> None:
-    fn = g.bind(g.unit.hooks["plc"].station.dled, "dled")
+    fn = g.cpu("station.dled", "dled")
     with g.box():
         g.line(f"{fn}({g.rd(value, 'B')})")
 
@@ -79,7 +80,7 @@ def _port(g: Gen, op) -> int:
 @insn("GPA", Role.B_W, Role.B_R, family=F, summary="ADDR := the station address of PORT")
 def _gpa(g: Gen, addr, port) -> None:
     p = _port(g, port)
-    fn = g.bind(g.unit.hooks["plc"].station.get_address, "gpa")
+    fn = g.cpu("station.get_address", "gpa")
     with g.box():
         g.wr(addr, "B", f"{fn}({p})", exact=True)
 
@@ -105,7 +106,7 @@ def _spa(g: Gen, addr, port) -> None:
     p = _port(g, port)
     hooks = g.unit.hooks
     if "spa" not in hooks:
-        hooks["spa"] = _spa_helper(hooks["plc"])
+        hooks["spa"] = Call(_spa_helper, (CPU,))
     fn = g.bind(hooks["spa"], "spa")
     with g.box():
         g.eno(f"{fn}({g.rd(addr, 'B')}, {p}, {g.insn_id})")

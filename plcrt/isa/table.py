@@ -30,6 +30,7 @@ import operator
 from typing import Callable
 
 from ..gen.emit import Gen
+from ..gen.recipe import CPU, Call, Item
 from ..gen.rt import s16
 from .region import region, runtime_error
 from .registry import Role, Span, insn
@@ -136,11 +137,10 @@ def _helpers(plc) -> dict[str, Callable]:
 
 
 def _helper(g: Gen, mn: str) -> str:
-    plc = g.unit.hooks["plc"]
     table = g.unit.hooks.get("tables")
     if table is None:
-        table = g.unit.hooks["tables"] = _helpers(plc)
-    return g.bind(table[mn], mn.lower().replace("=", "eq").replace("<>", "ne")
+        table = g.unit.hooks["tables"] = Call(_helpers, (CPU,))
+    return g.bind(Item(table, mn), mn.lower().replace("=", "eq").replace("<>", "ne")
                   .replace("<", "lt").replace(">", "gt"))
 
 

@@ -30,7 +30,7 @@ def _timer(g: Gen, kind: str, t: Addr, pt) -> None:
         g.warn(f"T{n} ({kind}) is executed from more than one place; a 100 ms timer "
                f"gains time when its box runs more than once per scan", "timer-twice")
     uses.append((kind, g.loc))
-    fn = g.bind(getattr(g.unit.hooks["timers"], kind.lower()), kind.lower())
+    fn = g.cpu(f"timers.{kind.lower()}", kind.lower())
     g.line(f"{fn}({n}, {g.top}, {g.rd(pt, 'W')})")
 
 

@@ -377,6 +377,12 @@ class Harness(Stimuli, Motion):
         return self.plc.source
 
     @property
+    def compiled(self) -> Any:
+        """The compiled program (:attr:`plcrt.Plc.compiled`: shared,
+        picklable; ``Plc.from_program`` builds another PLC of it)."""
+        return self.plc.compiled
+
+    @property
     def program(self) -> Any:
         """The parsed program (:class:`plcrt.lang.ir.Program`)."""
         return self.plc.program

@@ -11,7 +11,7 @@ import pytest
 
 import plcrt
 from plcrt.compiler import cache, codegen
-from plcrt.engine import binding as engine_binding
+from plcrt.compiler import program as compiled_program
 from plcrt.engine.runtime import Plc, parse_sources
 
 # Timers, counters, a subroutine with its own L buffer per call site, a
@@ -115,11 +115,10 @@ def _reachable(roots: list[Any], plc: Plc) -> Iterator[Any]:
 def test_plcs_of_one_cached_program_share_no_state(fresh_cache: cache.ProgramCache) -> None:
     program = parse_sources(PROGRAM)
     one, two = Plc(program), Plc(program)
-    template = one._entry.template
-    assert two._entry is one._entry and template is not one and template is not two
+    assert two._entry is one._entry
     functions = [v for k, v in two._ns.items() if k.startswith(("pou_", "n_"))]
     for obj in _reachable(functions + list(two._bindings.values()), two):
-        assert obj is not one and obj is not template, "a binding leads to another PLC"
+        assert obj is not one, "a binding leads to another PLC"
     _drive(one)
     assert bytes(two.mem.areas["V"]) == bytes(len(two.mem.areas["V"])) and two.scans == 0
     # the table helpers (closures over the CPU) work on this PLC: same run, same result
@@ -250,13 +249,13 @@ def test_generated_code_that_does_not_compile_is_an_internal_error(
 def test_the_collector_is_off_while_compiling_and_restored_after(
         monkeypatch: pytest.MonkeyPatch, fresh_cache: cache.ProgramCache) -> None:
     seen: list[bool] = []
-    original = engine_binding.compile_program
+    original = compiled_program.compile_program
 
     def spy(*args: Any, **kw: Any) -> Any:
         seen.append(gc.isenabled())
         return original(*args, **kw)
 
-    monkeypatch.setattr(engine_binding, "compile_program", spy)
+    monkeypatch.setattr(compiled_program, "compile_program", spy)
     assert gc.isenabled()
     plcrt.load(PROGRAM)
     assert seen == [False] and gc.isenabled()
@@ -278,32 +277,3 @@ def test_nested_pauses_restore_once() -> None:
             pass
         assert not gc.isenabled()
     assert gc.isenabled()
-
-
-class _Node:
-    def __init__(self, **kw: object) -> None:
-        self.__dict__.update(kw)
-
-
-def test_engine_objects_are_paired_however_deep_and_a_missing_one_is_reported() -> None:
-    """An engine object six attributes down (or an item of a long list) is
-    found by its path in the new PLC, so a binding refers to the new PLC's
-    own object; a path the new PLC lacks comes back as missing instead of
-    leaving the binding a private copy."""
-    def build() -> _Node:
-        deep = _Node(value=bytearray(4))
-        chain = _Node(a=_Node(b=_Node(c=_Node(d=_Node(e=deep)))))
-        return _Node(chain=chain, items=[_Node(k=i) for i in range(100)])
-
-    template, twin = build(), build()
-    deep = template.chain.a.b.c.d.e
-    binding = {"blk": _Node(target=deep, item=template.items[77])}
-    paths = cache.needed_paths(template, [binding])
-    memo: dict[int, object] = {}
-    assert cache.pair_objects(template, twin, paths, memo) == []
-    copy_ = cache.rebind(binding, memo)
-    assert copy_["blk"].target is twin.chain.a.b.c.d.e
-    assert copy_["blk"].item is twin.items[77]
-    del twin.chain.a.b.c.d.e
-    missing = cache.pair_objects(template, twin, paths, {})
-    assert any(step == "e" for path in missing for _, step in path)

@@ -211,6 +211,7 @@ CALLS: dict[str, tuple[Call, dict[str, Any]]] = {
     "plcrt.serve": (lambda **k: plcrt.serve(**k).close(),
                     {"plc": PLC, "lockstep": 0, "speed": "lockstep"}),
     "Plc.__init__": (plcrt.Plc, {"program": Fresh(lambda: parse_sources(TIMERS))}),
+    "Plc.from_program": (plcrt.Plc.from_program, {"compiled": Fresh(lambda: _plc().compiled)}),
     "Plc.__getitem__": (lambda **k: _plc()[k["address"]], {"address": "VW0"}),
     "Plc.__setitem__": (lambda **k: _plc().__setitem__(k["address"], k["value"]),
                         {"address": "VW0", "value": 1}),

@@ -20,10 +20,10 @@ plcrt.blocks.call.protected_call).
 
 from __future__ import annotations
 
-import weakref
 from typing import Any, Optional
 
 from ...blocks import register_block, register_protected
+from ...engine.pulse import FAST_OUTPUTS, MIN_CYCLE_US
 from .plan import change_trains, continuous_trains, profile_trains, stop_trains
 
 #: Error output codes (plcrt's own: the wizard's numbers are not public)
@@ -50,9 +50,6 @@ COUNTER_OF = {0: 0, 1: 3}
 KINDS = ("CTRL", "RUN", "MAN", "LDPOS", "ADV")
 NAMES = tuple(f"PTO{n}_{k}" for n in (0, 1) for k in KINDS) + ("PWM0_RUN", "PWM1_RUN")
 
-#: plc -> {output: WizardAxis}, used only while the program compiles (the
-#: blocks keep their axis; a fork copies blocks and axis together)
-_AXES: "weakref.WeakKeyDictionary[Any, dict[int, WizardAxis]]" = weakref.WeakKeyDictionary()
 
 
 def _plant(plc: Any, key: str) -> dict:
@@ -172,7 +169,9 @@ class WizardAxis:
 
 
 def _axis(plc: Any, output: int) -> WizardAxis:
-    axes = _AXES.setdefault(plc, {})
+    """The axis of ``output`` the PTOx_* blocks of ``plc`` share, made with
+    the first of them (a fork copies blocks and axis together)."""
+    axes = plc.family_states.setdefault(_axis, {})
     if output not in axes:
         axes[output] = WizardAxis(plc, output)
     return axes[output]
@@ -205,9 +204,11 @@ class _Block:
         return self.motion != 0 and not (ax.motion == self.motion and ax.busy())
 
     @classmethod
-    def at_load(cls, g: Any, itf: Any, plc: Any) -> None:
+    def at_load(cls, g: Any, itf: Any) -> None:
         """Load-time warnings (once per output): where the configuration
-        comes from and that plcrt's choices stand for the wizard's code."""
+        comes from and that plcrt's choices stand for the wizard's code
+        (compile-time facts: the plant the program is compiled for and the
+        CPU model)."""
         output = int(itf.name[3])
         once = g.unit.hooks.setdefault("ptowizard-once", set())
         family = itf.name[:3]
@@ -215,7 +216,7 @@ class _Block:
             return
         once.add((family, output))
         table = "pto" if family == "PTO" else "pwm"
-        cfg = _plant(plc, table).get(output)
+        cfg = (getattr(g.unit.plant, table, None) or {}).get(output)
         wizard = "Position Control" if family == "PTO" else "PWM"
         if cfg is None:
             g.warn(f"{itf.name}: the {wizard} wizard's configuration is not in the export; it "
@@ -227,7 +228,7 @@ class _Block:
                f"from the plant's [{table}.{output}]; the wizard's ramp algorithm, error "
                f"numbers and V-memory table are not public: plcrt's choices are in "
                f"docs/pto-wizard.md", f"ptowizard-{table}{output}")
-        limit = 1_000_000 // plc.pulse[output].min_cycle
+        limit = 1_000_000 // FAST_OUTPUTS.get(g.unit.model.name, MIN_CYCLE_US)
         if family == "PTO" and cfg.max_speed > limit:
             g.warn(f"{itf.name}: max_speed {cfg.max_speed} pulses/s of [pto.{output}] is above "
                    f"the {limit} pulses/s of this CPU's Q0.{output}: PTO{output}_RUN and "

@@ -69,6 +69,7 @@ from .esm import EsmState
 from .od import SdoAbort
 from .plant import DrivePlant
 from .sdo_server import SdoServer
+from .sync import can_cycle_problem
 
 __all__ = ["CanopenDrive", "Clock", "can_view", "pdo_slots"]
 
@@ -83,8 +84,6 @@ CLOCKS = ("wall", "manual", "step", "sync")
 #: inputs without outputs (SAFE-OP), so the drive leaves OPERATION ENABLED.
 _NMT_TO_ESM = {127: (EsmState.PREOP,), 5: (EsmState.SAFEOP, EsmState.OP),
                4: (EsmState.SAFEOP,)}
-#: HCFA §7.4.3 / §6.2: the sync cycle the drive takes (µs); Kinco: not given.
-SYNC_CYCLE_US = {"hcfa-am0520b": (200, 10_000)}
 
 
 class _Nmt(NmtSlave):
@@ -375,10 +374,9 @@ class CanopenDrive:
         self._subscribe()
 
     def _check_cycle(self, us: int) -> None:
-        lo, hi = SYNC_CYCLE_US.get(self.drive.model, (0, 0xFFFFFFFF))
-        if us and not lo <= us <= hi:
-            raise SdoAbort(0x06090030, f"1006h := {us} µs: the drive takes a sync cycle of "
-                           f"{lo} µs to {hi} µs (HCFA §7.4.3; on EtherCAT AL 0x0035)")
+        why = can_cycle_problem(self.drive.model, us)
+        if why is not None:
+            raise SdoAbort(0x06090030, why)
 
     def sync_period_us(self) -> int:
         """The bus cycle a SYNC stands for: 1006h, or the drive's bus period."""

@@ -31,6 +31,7 @@ What it is not: no bus.  The canopen port and the PLC coupler call
 from __future__ import annotations
 
 import copy
+from functools import partial
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -44,6 +45,7 @@ from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, Profi
                     MODE_NAMES)
 from .od import ObjectDictionary, SdoAbort
 from .pdo import ASSIGN, MapLayout, PdoConfig
+from .sync import drive_cycle_problem
 from .plant import DrivePlant
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
@@ -99,7 +101,7 @@ class Drive(ProcessData, Timeline):
         self.controlword = int(self.store.get(0x6040))
         self.pdo = PdoConfig(self._lookup, lambda: self.esm.state, self._default_maps(),
                              self._map_layout())
-        self.esm = Esm(self.pdo.activate)
+        self.esm = Esm(self.pdo.activate, check_sync=partial(drive_cycle_problem, self))
         mode = int(self.store.get(0x6060))
         self.sm = Drive402(model, t=t_us / 1e6, mode=mode or None)
         self._sm_seen = 0

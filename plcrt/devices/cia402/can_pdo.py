@@ -216,9 +216,9 @@ class CanPdos:
     def _codec(self, ch: Channel) -> tuple:
         """(struct or None, keys, entries, size) for the current map (perf:
         built once per mapping)."""
+        if ch.codec[1] is not None:
+            return ch.codec[1]          # perf: built once per mapping (write() clears it)
         entries = self.entries(ch)
-        if ch.codec[0] == entries:
-            return ch.codec[1]
         signed = self.drive._signed
         fmt, keys, ok = "<", [], True
         for e in entries:

@@ -172,6 +172,7 @@ class CanopenDrive:
         self.network = network
         self._noted: set[str] = set()
         self._emcy_code = 0                         # 603Fh as last sent in an EMCY
+        self._cycle_us = 0                          # 1006h
         self.sdo = SdoServer(self._sdo_read, self._sdo_write,
                              lambda e: log.info("node %d: %s", node_id, e))
         network.create_node(self.node)
@@ -364,6 +365,8 @@ class CanopenDrive:
         elif index == 0x1006:
             self._check_cycle(value)
         self.node.set_data(index, sub, data, check_writable=True)
+        if index == 0x1006:
+            self._cycle_us = value              # perf: read at every SYNC
 
     def _write_sync_id(self, value: int) -> None:
         if value & (1 << 30) or value & (1 << 29) or (value & 0x7FF) in (0, 0x600 + self.drive.node_id):
@@ -380,7 +383,7 @@ class CanopenDrive:
 
     def sync_period_us(self) -> int:
         """The bus cycle a SYNC stands for: 1006h, or the drive's bus period."""
-        return int.from_bytes(self.node.get_data(0x1006, 0), "little") or self.period_us
+        return self._cycle_us or self.period_us
 
     # ---------------------------------------------------------------- PDOs, SYNC
     def _on_sync(self, can_id: int, data: bytes, timestamp: float) -> None:

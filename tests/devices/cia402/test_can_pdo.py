@@ -476,3 +476,35 @@ def test_attaching_a_drive_and_its_master_as_documented_prints_nothing(bus, caps
     assert not caplog.records
     out = capsys.readouterr()
     assert out.out == out.err == ""
+
+
+def test_an_event_driven_tpdo_waits_out_its_inhibit_time(bus):
+    """Type 254 with an inhibit time of 3 ms (30 x 100 µs) and no event
+    timer: the position changes at every 1 ms SYNC, the TPDO leaves every
+    third one."""
+    dev, mst = bus
+    sim = cia402.attach(dev, 17, clock="sync")
+    try:
+        n = master(mst, 17, "hcfa-am0520b")
+        tpdo, rpdo = remap_sync(n, sim, tx=(0x6064,), trans=1)
+        tpdo.trans_type, tpdo.inhibit_time, tpdo.event_timer = 254, 30, 0
+        tpdo.save()
+        sent = []
+        tpdo.add_callback(lambda m: sent.append(m[0x6064].raw))
+        operational(n, sim)
+        for cw in (0x06, 0x07, 0x0F):
+            rpdo[0x6040].raw, rpdo[0x607A].raw = cw, 0
+            rpdo.transmit()
+            mst.sync.transmit()
+        for k in range(1, 13):                      # 100 counts per 1 ms bus cycle
+            rpdo[0x6040].raw, rpdo[0x607A].raw = 0x0F, 100 * k
+            rpdo.transmit()
+            mst.sync.transmit()
+        assert wait_for(lambda: sim.drive.now == 15_000)
+        assert wait_for(lambda: len(sent) >= 5)
+        time.sleep(0.05)
+        moving = [pos for pos in sent if pos]
+        # one TPDO per 3 ms: the positions it carries are 300 counts apart
+        assert len(moving) == 4 and all(b - a == 300 for a, b in zip(moving, moving[1:]))
+    finally:
+        sim.close()

@@ -508,3 +508,35 @@ def test_an_event_driven_tpdo_waits_out_its_inhibit_time(bus):
         assert len(moving) == 4 and all(b - a == 300 for a, b in zip(moving, moving[1:]))
     finally:
         sim.close()
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_pp_move_from_synchronous_pdos(bus, model):
+    """PP from the process image: the set-point and the new-set-point bit
+    in a synchronous RPDO, the statusword's target-reached bit and the
+    position in the synchronous TPDO, at a 2 ms SYNC (1006h)."""
+    dev, mst = bus
+    sim = cia402.attach(dev, 18, model, clock="sync")
+    try:
+        n = master(mst, 18, model)
+        n.sdo[0x1006].raw = 2000
+        for index, value in ((0x6060, 1), (0x6081, 100_000), (0x6083, 1_000_000),
+                             (0x6084, 1_000_000)):
+            n.sdo[index].raw = value
+        tpdo, rpdo = remap_sync(n, sim, tx=(0x6041, 0x6064))
+        got = []
+        tpdo.add_callback(lambda m: got.append((m[0x6041].raw, m[0x6064].raw)))
+        operational(n, sim)
+        words = [0x06, 0x07, 0x0F, 0x0F, 0x1F] + [0x0F] * 150     # the move takes 224 ms
+        for cw in words:
+            rpdo[0x6040].raw, rpdo[0x607A].raw = cw, 12_345
+            rpdo.transmit()
+            mst.sync.transmit()
+        assert wait_for(lambda: len(got) == len(words))
+        sw, pos = got[-1]
+        assert sw & 0x0400 and pos == 12_345
+        assert sim.drive.now == 2000 * len(words)
+        first = next(k for k, (s, p) in enumerate(got) if p)
+        assert got[first - 1][1] == 0 and 0 < got[first][1] < 12_345    # it ramps, SYNC by SYNC
+    finally:
+        sim.close()

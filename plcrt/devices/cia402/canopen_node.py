@@ -304,7 +304,7 @@ class CanopenDrive:
             except Exception:
                 log.exception("node %d: SDO request failed", node)
                 answer = self.sdo.abort(0x08000000)
-            if answer is None:
+            if answer is None and len(data) != 8:
                 self._once("sdo-dlc", "CiA 301 §7.2.4.3",
                            f"SDO request of {len(data)} bytes not answered: SDO frames "
                            "have 8 data bytes")
@@ -369,7 +369,7 @@ class CanopenDrive:
             self._cycle_us = value              # perf: read at every SYNC
 
     def _write_sync_id(self, value: int) -> None:
-        if value & (1 << 30) or value & (1 << 29) or (value & 0x7FF) in (0, 0x600 + self.drive.node_id):
+        if value & (1 << 30) or value & (1 << 29) or value & 0x7FF == 0:
             raise SdoAbort(0x06090030, f"1005h := 0x{value:08X}: the drive is a SYNC consumer "
                            "with an 11-bit COB-ID (CiA 301 §7.5.2.5: bit 30 = producer, "
                            "bit 29 = 29-bit)")

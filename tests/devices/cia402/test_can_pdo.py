@@ -101,7 +101,7 @@ def remap_sync(n, sim, rx=(0x6040, 0x607A), tx=(0x6064, 0x6041), trans=1):
 
 @pytest.mark.parametrize("model", MODELS)
 def test_a_remapped_tpdo_and_rpdo_are_what_the_drive_sends_and_reads(bus, model):
-    """TPDO remapped to 6064h + 6041h (the issue's Kinco 1A04h case) and
+    """TPDO remapped to 6064h + 6041h (on the Kinco drive: 1A04h) and
     RPDO to 607Ah + 6040h, saved: the frames on the bus have the new layout."""
     dev, mst = bus
     sim = cia402.attach(dev, 7, model, clock="sync")
@@ -538,5 +538,22 @@ def test_a_pp_move_from_synchronous_pdos(bus, model):
         assert sim.drive.now == 2000 * len(words)
         first = next(k for k, (s, p) in enumerate(got) if p)
         assert got[first - 1][1] == 0 and 0 < got[first][1] < 12_345    # it ramps, SYNC by SYNC
+    finally:
+        sim.close()
+
+
+def test_the_sync_cob_id_is_the_one_in_1005h(bus):
+    dev, mst = bus
+    sim = cia402.attach(dev, 19, clock="sync")
+    try:
+        n = master(mst, 19, "hcfa-am0520b")
+        with pytest.raises(canopen.SdoAbortedError) as e:
+            n.sdo[0x1005].raw = 0x40000080           # bit 30: the drive would produce SYNC
+        assert e.value.code == 0x06090030
+        n.sdo[0x1005].raw = 0x10
+        mst.sync.transmit()                           # 080h: no longer the drive's SYNC
+        mst.send_message(0x10, b"")
+        assert wait_for(lambda: sim.drive.now == 1000)
+        assert not wait_for(lambda: sim.drive.now > 1000, timeout=0.05)
     finally:
         sim.close()

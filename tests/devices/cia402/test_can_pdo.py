@@ -557,3 +557,23 @@ def test_the_sync_cob_id_is_the_one_in_1005h(bus):
         assert not wait_for(lambda: sim.drive.now > 1000, timeout=0.05)
     finally:
         sim.close()
+
+
+def test_a_masters_periodic_sync_drives_synchronous_tpdos_on_the_wall_clock(bus):
+    """canopen's ``network.sync.start(period)`` with the default wall clock:
+    a TPDO of type 1 follows every SYNC."""
+    dev, mst = bus
+    sim = cia402.attach(dev, 21)
+    try:
+        n = master(mst, 21, "hcfa-am0520b")
+        tpdo, _ = remap_sync(n, sim, tx=(0x6041, 0x6064), trans=1)
+        frames = Frames(mst, tpdo.cob_id)
+        operational(n, sim)
+        mst.sync.start(0.005)
+        try:
+            assert len(frames.wait(tpdo.cob_id, 10)) >= 10
+        finally:
+            mst.sync.stop()
+        assert struct.unpack("<H", frames.got[tpdo.cob_id][-1][:2])[0] == sim.drive.statusword
+    finally:
+        sim.close()

@@ -296,6 +296,10 @@ class CanopenDrive:
     # ---------------------------------------------------------------- SDO server
     def _on_sdo(self, can_id: int, data: bytes, timestamp: float) -> None:
         node = self.drive.node_id
+        if self.node.nmt.state == "STOPPED":     # CiA 301 §7.3.2.2 Table 36: no SDO
+            self._once("sdo-stopped", "CiA 301 §7.3.2.2", "SDO request not answered in NMT "
+                       "STOPPED")
+            return
         with self._lock:
             if self.clock == "wall":
                 self._catch_up()

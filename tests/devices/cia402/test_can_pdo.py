@@ -259,6 +259,10 @@ def test_pdos_and_sync_act_in_operational_only(bus):
         mst.sync.transmit()
         mst.sync.transmit()
         assert not wait_for(lambda: len(frames.got[tpdo.cob_id]) > 1, timeout=0.1)
+        n.sdo.RESPONSE_TIMEOUT = 0.1
+        with pytest.raises(canopen.SdoCommunicationError):      # no SDO in STOPPED
+            n.sdo[0x6041].raw
+        assert any("not answered in NMT STOPPED" in e.text for e in sim.drive.log)
     finally:
         sim.close()
 

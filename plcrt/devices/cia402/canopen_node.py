@@ -385,7 +385,7 @@ class CanopenDrive:
         if why is not None:
             raise SdoAbort(0x06090030, why)
 
-    def sync_period_us(self) -> int:
+    def _sync_period_us(self) -> int:
         """The bus cycle a SYNC stands for: 1006h, or the drive's bus period."""
         return self._cycle_us or self.period_us
 
@@ -401,7 +401,7 @@ class CanopenDrive:
             with self._lock:
                 drive = self.drive
                 if self.clock == "sync":
-                    t = drive.now + self.sync_period_us()
+                    t = drive.now + self._sync_period_us()
                     drive.advance(t)
                 elif self.clock == "wall":
                     self._catch_up()

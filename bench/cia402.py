@@ -17,7 +17,15 @@ Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
    ratio stays near 1 although the speed differs a hundredfold;
 4. measures SDO round trips per second over python-can's ``virtual`` bus:
    a canopen master uploads 6064h from a drive put on the bus with
-   ``plcrt.cia402.attach`` (manual clock, so only the SDO path is timed).
+   ``plcrt.cia402.attach`` (manual clock, so only the SDO path is timed);
+5. runs eight drives in CSP over python-can's ``virtual`` bus in one run,
+   two ways, and gives the ratio: the process-data path (each drive
+   attached with ``clock="sync"``, its CAN-view PDOs remapped by a canopen
+   master to RPDO 6040h + 607Ah and TPDO 6041h + 6064h, transmission type 1;
+   per 1 ms cycle the master sends eight RPDOs and a SYNC and waits for the
+   eight TPDOs) and the SDO-only loop (per cycle the master downloads 607Ah
+   and uploads 6064h of each drive by SDO, then every drive advances 1 ms on
+   its manual clock).
 
 Each figure is the best of ``--repeat`` runs (fresh drives, set-up not
 timed).  The CSP figures come twice: per wall second, and per CPU second
@@ -165,6 +173,106 @@ def sdo_round_trips(n: int = 2000) -> float:
         dev.disconnect()
 
 
+class _Tpdos:
+    """Counts the TPDOs the master receives (its Notifier thread)."""
+
+    def __init__(self) -> None:
+        import threading
+        self.count = 0
+        self.cond = threading.Condition()
+
+    def __call__(self, can_id: int, data: bytes, timestamp: float) -> None:
+        with self.cond:
+            self.count += 1
+            self.cond.notify_all()
+
+    def wait(self, count: int) -> None:
+        with self.cond:
+            if not self.cond.wait_for(lambda: self.count >= count, 5.0):
+                raise RuntimeError(f"{count - self.count} TPDOs missing")
+
+
+def can_csp(n: int, cycles: int) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Eight (*n*) drives in CSP over the virtual bus: (PDO path, SDO-only
+    loop), each as (drive-seconds per wall second, per CPU second of the
+    process: its threads, the bus's included)."""
+    import struct
+
+    import canopen
+
+    from plcrt import cia402
+
+    channel = f"plcrt-bench-can-{time.monotonic_ns()}"
+    dev, mst = canopen.Network(), canopen.Network()
+    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
+    dev.connect(interface="virtual", channel=channel)
+    mst.connect(interface="virtual", channel=channel)
+    ids = range(1, n + 1)
+    sims = [cia402.attach(dev, i, clock="sync") for i in ids]
+    tpdos = _Tpdos()
+    rx_ids = []
+    try:
+        nodes = []
+        for i, sim in zip(ids, sims):
+            node = canopen.RemoteNode(i, cia402.object_dictionary(node_id=i))
+            mst.add_node(node)
+            nodes.append(node)
+            node.nmt.state = "PRE-OPERATIONAL"
+            node.tpdo.read()
+            node.rpdo.read()
+            node.sdo[0x1006].raw = CYCLE_US
+            tpdo, rpdo = node.tpdo[sim.tpdo_no], node.rpdo[sim.rpdo_no]
+            for pdo, objects in ((tpdo, (0x6041, 0x6064)), (rpdo, (0x6040, 0x607A))):
+                pdo.clear()
+                for index in objects:
+                    pdo.add_variable(index)
+                pdo.trans_type = 1
+                pdo.enabled = True
+                pdo.save()
+            rx_ids.append(rpdo.cob_id)
+            mst.subscribe(tpdo.cob_id, tpdos)
+            node.nmt.state = "OPERATIONAL"
+        for sim in sims:
+            while sim.drive.esm.state is not EsmState.OP:
+                time.sleep(0.001)
+        sent = 0
+
+        def cycle(cw: int, target: int) -> None:
+            nonlocal sent
+            data = struct.pack("<Hi", cw, target)
+            for can_id in rx_ids:
+                mst.send_message(can_id, data)
+            mst.sync.transmit()
+            sent += n
+            tpdos.wait(sent)
+
+        for cw in (0x06, 0x07, 0x0F, 0x0F):
+            cycle(cw, 0)
+        gc.collect()
+        start, cpu = time.perf_counter(), time.process_time()
+        for k in range(cycles):
+            cycle(0x0F, 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100))
+        pdo_x = ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
+        assert all(s.drive.sm.state.name == "OPERATION_ENABLED" for s in sims)
+        for sim in sims:                      # today's loop: SDO only, manual time
+            sim.clock = "manual"
+        start, cpu = time.perf_counter(), time.process_time()
+        for k in range(cycles):
+            target = 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)
+            for node in nodes:
+                node.sdo.download(0x607A, 0, struct.pack("<i", target))
+                node.sdo.upload(0x6064, 0)
+            for sim in sims:
+                sim.advance(CYCLE_US / 1e6)
+        sdo_x = ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
+        return pdo_x, sdo_x
+    finally:
+        for sim in sims:
+            sim.close()
+        mst.disconnect()
+        dev.disconnect()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per run")
@@ -182,6 +290,9 @@ def main(argv: list[str] | None = None) -> int:
     slow = min(time_pp(10_000, args.seconds) for _ in range(args.repeat))
     fast = min(time_pp(1_000_000, args.seconds) for _ in range(args.repeat))
     sdo = max(sdo_round_trips() for _ in range(args.repeat))
+    can_runs = [can_csp(8, int(args.seconds * 250)) for _ in range(args.repeat)]
+    can_pdo, can_pdo_cpu = best([r[0] for r in can_runs])
+    can_sdo, can_sdo_cpu = best([r[1] for r in can_runs])
     cal = calibration()
     out = {"machine": f"{platform.python_implementation()} {platform.python_version()} "
                       f"on {platform.machine()}",
@@ -196,7 +307,12 @@ def main(argv: list[str] | None = None) -> int:
            "load_average_1min": round(os.getloadavg()[0], 2),
            "pp_10kHz_wall_s": round(slow, 4), "pp_1MHz_wall_s": round(fast, 4),
            "pp_cost_ratio_fast_over_slow": round(fast / slow, 2),
-           "sdo_round_trips_per_s": round(sdo)}
+           "sdo_round_trips_per_s": round(sdo),
+           "can_csp_8_drives_pdo_sync_x_real_time": round(can_pdo, 2),
+           "can_csp_8_drives_sdo_only_x_real_time": round(can_sdo, 2),
+           "can_pdo_over_sdo": round(can_pdo / can_sdo, 1),
+           "can_per_cpu_second": {"pdo_sync": round(can_pdo_cpu, 2),
+                                  "sdo_only": round(can_sdo_cpu, 2)}}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -212,6 +328,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  PP move at 10 kP/s: {slow * 1e3:.1f} ms wall, at 1 MP/s: {fast * 1e3:.1f} ms wall "
           f"(ratio {fast / slow:.2f}) for {args.seconds:g} s simulated")
     print(f"  SDO round trips over the virtual bus (canopen master, attach): {sdo:8.0f} /s")
+    print(f"  CSP over the virtual bus, 8 drives at a 1 ms SYNC: PDOs {can_pdo:6.2f} x real time, "
+          f"({can_pdo_cpu:.2f}), SDO-only loop {can_sdo:6.2f} x ({can_sdo_cpu:.2f}); ratio "
+          f"{can_pdo / can_sdo:.1f}")
     return 0
 
 

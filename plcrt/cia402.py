@@ -5,7 +5,7 @@
 * :func:`eds_text` gives the same dictionary as an EDS file;
 * :func:`models` lists the drive models;
 * :func:`attach` puts a simulated drive on a connected ``canopen.Network``
-  as a ``canopen.LocalNode`` (see :mod:`plcrt.devices.cia402.canopen_node`).
+  (see :mod:`plcrt.devices.cia402.canopen_node`).
 
 All three read the model's data file, ``library/cia402/<model>.toml`` (see
 :mod:`plcrt.devices.cia402.od`).  ``canopen`` is imported only when a
@@ -63,8 +63,9 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
            plant: "DrivePlant | dict | str | None" = None, *,
            clock: "Clock" = "wall") -> "CanopenDrive":
     """Put a simulated drive of *model* on the connected ``canopen.Network``
-    *network* as node *node_id*; a master drives it with SDOs, NMT and
-    heartbeat (``BaseNode402(node_id, object_dictionary(model))``).
+    *network* as node *node_id*; a master drives it with SDOs, PDOs, SYNC,
+    NMT, heartbeat and EMCY (``BaseNode402(node_id, object_dictionary(model,
+    node_id))`` with ``setup_402_state_machine(read_pdos=True)``).
 
     *plant*: the machine around the drive: a dict of
     ``plcrt.devices.cia402.plant.PLANT_KEYS`` (limit switches, mechanical
@@ -73,11 +74,13 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
 
     *clock*: ``"wall"`` (the drive's time follows the wall clock, one bus
     cycle per bus period in a background thread), ``"manual"`` (time moves
-    only by ``.advance(seconds)``) or ``"step"`` (each SDO read of 6041h
-    runs one bus cycle first; ``.advance`` works too).
+    only by ``.advance(seconds)``), ``"step"`` (each SDO read of 6041h
+    runs one bus cycle first; ``.advance`` works too) or ``"sync"`` (each
+    SYNC received is one bus cycle of 1006h µs).
 
     Returns an object with ``.drive`` (:class:`~.devices.cia402.drive.Drive`),
-    ``.node`` (the ``canopen.LocalNode``), ``.advance(seconds)`` and
+    ``.node`` (the ``canopen.LocalNode``: NMT and heartbeat), ``.pdos`` (the
+    CAN PDOs), ``.tpdo_no`` / ``.rpdo_no``, ``.advance(seconds)`` and
     ``.close()``.
 
     Raises:

@@ -32,6 +32,7 @@
     pos_stop = 60000
     probe = [2000, 2100]        # touch probe input 1 active in this closed range (probe2: DI5)
     params = { "6099:01" = 20000, "6099:02" = 2000 }   # written by SDO at start-up
+    layout = "fixed"            # or "mapping": the image is the drive's PDO mapping
 
     [pto.0]                     # the Position Control wizard of Q0.0 (docs/pto-wizard.md)
     max_speed = 20000
@@ -69,6 +70,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import PlcConfigError, PlcError
+from ..safetext import shown_value
 from ..lang.limits import file_limit, read_capped
 from .cia402.coupler import IMAGE_BYTES
 from .keys import checked_table
@@ -82,7 +84,9 @@ _AXIS_KEYS = {"start", "rps", "limit_neg", "limit_pos", "z_period", "z_offset", 
 _MODULE_KEYS = {"EM253": {"kind", "axis"},
                 "FIELDBUS": {"kind", "v", "cycle_ms", "drive"}}
 _DRIVE_KEYS = {"model", "image", "neg_limit", "pos_limit", "home_switch", "index_period",
-               "index_phase", "neg_stop", "pos_stop", "probe", "probe2", "params"}
+               "index_phase", "neg_stop", "pos_stop", "probe", "probe2", "params", "layout"}
+#: FIELDBUS image layouts: the module's fixed object set, or the drive's PDO mapping
+LAYOUTS = ("fixed", "mapping")
 _PARAM_RE = re.compile(r"(?:0x)?([0-9A-Fa-f]{4})(?::(?:0x)?([0-9A-Fa-f]{1,2}))?h?")
 
 
@@ -96,6 +100,7 @@ class DriveConfig:
     plant: dict[str, Any] = field(default_factory=dict)   #: DrivePlant keywords
     params: list[tuple[int, int, int, str]] = field(default_factory=list)
     where: str = field(default="", compare=False)   #: file and key, for messages
+    layout: str = "fixed"                        #: "fixed" objects or the drive's "mapping"
 
 
 @dataclass
@@ -479,4 +484,8 @@ def _drive(node: int, d: dict, where: str, default_image: int) -> DriveConfig:
                                  f"(write INDEX:SUB in hex, e.g. \"6099:01\")")
         params.append((int(m.group(1), 16), int(m.group(2) or "0", 16),
                        _int(value, f"{where}.params.{name}"), f"{where}.params.{name}"))
-    return DriveConfig(node, model, image, plant, params, where)
+    layout = d.get("layout", "fixed")
+    if layout not in LAYOUTS:
+        raise PlcConfigError(f"{where}.layout must be one of {', '.join(map(repr, LAYOUTS))}, "
+                             f"got {shown_value(layout)}")
+    return DriveConfig(node, model, image, plant, params, where, layout)

@@ -61,9 +61,21 @@ SAFE-OP → OP; NMT start for a CANopen model) and writes the plant file's
 drive refuses or reports (refused controlwords, faults, SDO aborts, homing
 failures) reaches :attr:`plcrt.Plc.diagnostics` with its explanation.
 
+With ``layout = "mapping"`` on a drive, its image follows the drive's PDO
+mapping instead (the one in force, 1C12h/1C13h-assigned on the HCFA drive,
+every map with entries on the Kinco drive, as the plant's ``params`` left it
+at start-up): offsets 0..31 hold the RxPDO image, 32..63 the TxPDO image,
+each object in mapping order and in the S7-200's byte order; offset 64 is the
+module status byte, 66 the bus cycle counter (WORD); there is no SDO mailbox.
+A mapping whose image is over 32 bytes, or with an object that is not a whole
+number of bytes, is a start-up error.  The drive runs its own images
+(:meth:`~.drive.Drive.cycle`); a mapping changed later is followed at the next
+bus cycle.
+
 What it is not: no bus timing below the bus cycle, no PDO mapping of its
-own (the module exchanges objects, see :meth:`~.drive.Drive.exchange`; the
-set above fits the PDOs of both models), no second SDO in flight per drive.
+own in the fixed layout (the module exchanges objects, see
+:meth:`~.drive.Drive.exchange`; the set above fits the PDOs of both models),
+no second SDO in flight per drive.
 """
 
 from __future__ import annotations
@@ -76,6 +88,7 @@ from ...errors import PlcConfigError, PlcError
 from .drive import Drive
 from .esm import EsmState
 from .od import DTYPES, SdoAbort
+from .pdo import pack
 from .plant import DrivePlant
 
 __all__ = ["FieldbusModule", "IMAGE_BYTES", "OUT_LAYOUT", "IN_LAYOUT", "SDO_CYCLES"]
@@ -119,8 +132,11 @@ _MAILBOX_TYPES = frozenset({"I8", "U8", "I16", "U16", "I32", "U32"})
 class _Port:
     """One drive on the module: its image address and mailbox state."""
 
-    def __init__(self, node: int, drive: Drive, image: int) -> None:
+    def __init__(self, node: int, drive: Drive, image: int, layout: str = "fixed") -> None:
         self.node = node
+        self.mapped = layout == "mapping"
+        self.codec: tuple = ()                #: mapping layout: (rx, tx, (be, le) x 2)
+        self.tx_image = b""                   #: mapping layout: the last TxPDO image
         self.drive = drive
         self.image = image
         self.req = False                      #: REQ as the module last saw it
@@ -152,8 +168,13 @@ class FieldbusModule:
                 raise PlcConfigError(
                     f"{dc.where}.image: VB{dc.image}..VB{dc.image + IMAGE_BYTES - 1} is beyond "
                     f"the {model.name}'s V memory (VB0..VB{model.v_bytes - 1})")
-            self.ports[node] = port = _Port(node, self._drive(dc), dc.image)
+            self.ports[node] = port = _Port(node, self._drive(dc), dc.image, dc.layout)
             port.seen = len(port.drive.log)      # the start-up itself is no news
+            if port.mapped:
+                _follow(port, dc.where)
+                d = port.drive
+                port.tx_image = pack(d.pdo.active_tx, {(e.index, e.sub): int(
+                    d.store.get(e.index, e.sub)) for e in d.pdo.active_tx if e.index})
         self._write_inputs()
 
     def _drive(self, dc: Any) -> Drive:
@@ -169,7 +190,7 @@ class FieldbusModule:
             raise PlcConfigError(f"{dc.where}.model: {e.message}") from None
         drive.request_esm(EsmState.PREOP)
         for index, sub, value, where in dc.params:
-            if sub == 0 and index in _RX_OBJECTS:
+            if dc.layout == "fixed" and sub == 0 and index in _RX_OBJECTS:
                 off = next(o for o, i, _ in OUT_LAYOUT if i == index)
                 raise PlcConfigError(f"{where}: {index:04X}h is in the module's process image "
                                      f"(VB{dc.image + off}, offset {off}): the program sets it "
@@ -197,6 +218,9 @@ class FieldbusModule:
         period = self.cycle_us
         first = (t_from // period + 1) * period
         for port in self.ports.values():
+            if port.mapped:
+                self._step_mapped(port, v, first, t_to)
+                continue
             out = _OUT.unpack_from(v, port.image)
             values = self._rx(port, out)
             self._mailbox(port, out, t_from)
@@ -210,6 +234,15 @@ class FieldbusModule:
             self._report(port)
         self.cycles = (self.cycles + len(range(first, t_to + 1, period))) & 0xFFFF
         self._write_inputs()
+
+    def _step_mapped(self, port: _Port, v: bytearray, first: int, t_to: int) -> None:
+        """The bus cycles of a drive whose image is its PDO mapping."""
+        drive = port.drive
+        for t in range(first, t_to + 1, self.cycle_us):
+            _follow(port, f"fieldbus slot {self.slot} node {port.node}")
+            rx_be, rx_le = port.codec[2]
+            port.tx_image = drive.cycle(t, rx_le.pack(*rx_be.unpack_from(v, port.image)))
+        self._report(port)
 
     @staticmethod
     def _rx(port: _Port, out: tuple) -> dict[tuple[int, int], int]:
@@ -281,6 +314,13 @@ class FieldbusModule:
     def _write_inputs(self) -> None:
         v = self.plc.mem.areas["V"]
         for port in self.ports.values():
+            if port.mapped:
+                tx_be, tx_le = port.codec[3]
+                if len(port.tx_image) == tx_le.size:
+                    tx_be.pack_into(v, port.image + 32, *tx_le.unpack(port.tx_image))
+                v[port.image + 64] = ONLINE if port.drive.esm.state is EsmState.OP else 0
+                struct.pack_into(">H", v, port.image + 66, self.cycles)
+                continue
             get = port.drive.store.get
             vals = [int(get(i, 0)) if present else 0 for i, present in port.tx]
             status = port.flags | (ONLINE if port.drive.esm.state is EsmState.OP else 0)
@@ -313,3 +353,34 @@ class FieldbusModule:
     def drive(self, node: int) -> Drive:
         """The simulated drive at bus address *node*."""
         return self.ports[node].drive
+
+
+#: struct codes of a mapped object by (bits, signed)
+_CODES = {(8, False): "B", (8, True): "b", (16, False): "H", (16, True): "h",
+          (32, False): "I", (32, True): "i", (64, False): "Q", (64, True): "q"}
+
+
+def _follow(port: _Port, where: str) -> None:
+    """Build the port's image codecs for the drive's mapping in force (again
+    only when it changed): each image as S7 (big-endian per object) and CoE
+    (little-endian) structs of the same objects."""
+    pdo = port.drive.pdo
+    if port.codec and port.codec[0] is pdo.active_rx and port.codec[1] is pdo.active_tx:
+        return          # perf: the same mapping as the last cycle
+    signed = port.drive._signed
+    pairs = []
+    for entries, what in ((pdo.active_rx, "RxPDO"), (pdo.active_tx, "TxPDO")):
+        codes = ""
+        for e in entries:
+            code = f"{e.bits // 8}x" if e.index == 0 and e.bits % 8 == 0 else \
+                _CODES.get((e.bits, (e.index, e.sub) in signed), "") if e.index else ""
+            if not code:
+                raise PlcConfigError(f"{where}: layout = \"mapping\": {what} entry {e} is not "
+                                     "a whole number of bytes the image can hold")
+            codes += code
+        be, le = struct.Struct(">" + codes), struct.Struct("<" + codes)
+        if be.size > 32:
+            raise PlcConfigError(f"{where}: layout = \"mapping\": the {what} image is "
+                                 f"{be.size} bytes; the image holds 32")
+        pairs.append((be, le))
+    port.codec = (pdo.active_rx, pdo.active_tx, *pairs)

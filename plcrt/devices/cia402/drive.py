@@ -33,6 +33,7 @@ What it is not: no bus.  The canopen port and the PLC coupler call
 from __future__ import annotations
 
 import copy
+from functools import partial
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -49,6 +50,7 @@ from .modes import (CyclicPosition, Homing, Mode, NoMode, ProfilePosition, Profi
 from .od import ObjectDictionary, SdoAbort
 from .pdo import ASSIGN, MapLayout, PdoConfig
 from .plant import DrivePlant, plant_of
+from .sync import drive_cycle_problem
 from .statemachine import Command, Drive402, Result, State
 from .states import IDLE_STATUSWORD, STATUSWORD
 from .stops import HardStops
@@ -133,7 +135,7 @@ class Drive(Service, ProcessData, Timeline):
         fault, modes idle, the mechanical ends watched afresh): at
         construction and at :meth:`~.drive_service.Service.power_cycle`."""
         self.controlword = int(self.store.get(0x6040))
-        self.esm = Esm(self.pdo.activate)
+        self.esm = Esm(self.pdo.activate, check_sync=partial(drive_cycle_problem, self))
         mode = int(self.store.get(0x6060))
         self.sm = Drive402(self.model, t=t_us / 1e6, mode=mode or None)
         self._sm_seen = 0

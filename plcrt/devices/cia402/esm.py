@@ -64,6 +64,9 @@ class MappingProblem:
 Validator = Callable[[], "MappingProblem | None"]
 #: Checks at SAFE-OP -> OP: None, or why the outputs are not valid (AL 0x0019).
 OutputsCheck = Callable[[], "str | None"]
+#: Checks at PRE-OP -> SAFE-OP: None, or (AL code, why) for a sync cycle the
+#: drive cannot take (0x0035 / 0x0036, HCFA §7.4.3; see sync.py).
+SyncCheck = Callable[[], "tuple[int, str] | None"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,9 +106,11 @@ class Esm:
     *check_outputs* (optional) at SAFE-OP -> OP."""
 
     def __init__(self, validate_mapping: Validator,
-                 check_outputs: OutputsCheck | None = None) -> None:
+                 check_outputs: OutputsCheck | None = None,
+                 check_sync: SyncCheck | None = None) -> None:
         self.validate_mapping = validate_mapping
         self.check_outputs = check_outputs
+        self.check_sync = check_sync
         self.state = EsmState.INIT
         self.error = False
         self.al_code = 0
@@ -169,6 +174,10 @@ class Esm:
             return self._refuse(value, t, 0x0011, f"{name} skips a state: upward transitions go "
                                 f"one at a time, {steps} (HCFA §6.5 rule 1)")
         if before is EsmState.PREOP and target is EsmState.SAFEOP:
+            bad_sync = self.check_sync() if self.check_sync else None
+            if bad_sync is not None:
+                code, why = bad_sync
+                return self._refuse(value, t, code, f"{name} refused: {AL_CODES[code]}: {why}")
             problem = self.validate_mapping()
             if problem is not None:
                 code = 0x001D if problem.side == "outputs" else 0x001E

@@ -36,6 +36,7 @@ MAX_ENTRIES = 8                              # HCFA §6.7.2
 MAX_BYTES = 32                               # HCFA §6.7.2
 
 ABORT_TEXT = {
+    0x06010000: "unsupported access to an object",
     0x06010003: "subindex 0 must be 0 to write (SOES)",
     0x06020000: "object does not exist in the object dictionary",
     0x06040041: "object cannot be mapped to the PDO",
@@ -107,6 +108,10 @@ class MapLayout:
     max_entries: int = MAX_ENTRIES
     max_bytes: int = MAX_BYTES
     source: str = "HCFA §6.7.2"
+    #: the abort of an entry written while sub 0 is not 0: CoE's (SOES) by
+    #: default; a CAN port's maps use CiA 301's 0x06010000 (unsupported access)
+    entry_abort: int = 0x06010003
+    entry_rule: str = "HCFA §6.7.4 step C"
 
 
 @dataclass(frozen=True, slots=True)
@@ -251,8 +256,8 @@ class PdoConfig:
             step = "step E" if value else "step C: the map is invalid while changed"
             return WriteResult(0, f"{where}: {index:04X}h maps {value} entries ({step})")
         if self.count[index] != 0:
-            return self._abort(0x06010003, where, f"{index:04X}:00 = {self.count[index]}; "
-                               f"set it to 0 before writing entries (HCFA §6.7.4 step C)")
+            return self._abort(L.entry_abort, where, f"{index:04X}:00 = {self.count[index]}; "
+                               f"set it to 0 before writing entries ({L.entry_rule})")
         if value == 0:
             self.entries[index][sub - 1] = 0
             return WriteResult(0, f"{where}: entry cleared")

@@ -310,7 +310,9 @@ def test_a_fault_and_its_reset_reach_the_master_as_emcy_messages(pair):
 
 
 def test_a_homing_timeout_is_an_emcy_with_the_hcfa_code(bus):
-    """HCFA §4.7 alarm 63 (homing timeout, P03.07) reaches the master as EMCY 63."""
+    """HCFA §4.7 alarm 63 (homing timeout, P03.07) reaches the master as EMCY
+    FF3Fh (manufacturer-specific: 003Fh would read as an error reset) with
+    603Fh = 63 in the manufacturer-specific bytes."""
     dev, mst = bus
     # NLS far away: the search for it outlasts the homing time limit
     sim = cia402.attach(dev, 5, clock="manual", plant=DrivePlant(neg_limit=-10**9))
@@ -323,6 +325,7 @@ def test_a_homing_timeout_is_an_emcy_with_the_hcfa_code(bus):
         n.controlword = 0x1F
         sim.advance(2.0)
         assert wait_for(lambda: n.emcy.log, timeout=2)
-        assert [e.code for e in n.emcy.log] == [63]
+        assert [e.code for e in n.emcy.log] == [0xFF3F]
+        assert n.emcy.active and n.emcy.log[0].data[:2] == (63).to_bytes(2, "little")
     finally:
         sim.close()

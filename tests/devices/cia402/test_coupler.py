@@ -388,3 +388,74 @@ def test_errors_in_a_plant_file_name_the_file(tmp_path):
     with pytest.raises(PlcConfigError) as e:
         plcrt.load(IDLE, plant=str(path))
     assert e.value.message.startswith(f"{path}: module.0.drive.1.model: unknown CiA 402")
+
+
+# ---------------------------------------------------------------- layout = "mapping"
+def _mapped_enable(plc) -> None:
+    for cw, state in ((0x06, "READY TO SWITCH ON"), (0x07, "SWITCHED ON"),
+                      (0x0F, "OPERATION ENABLED")):
+        plc.write(f"VW{IMG}", cw)
+        for _ in range(100):
+            plc.scan()
+            if plc.drive(1).state == state:
+                break
+    assert plc.drive(1).state == "OPERATION ENABLED"
+
+
+def test_a_mapping_layout_image_is_the_drives_default_pdo_images():
+    """HCFA 1600h (6040h, 607Ah, 60B8h) at offsets 0..7 and 1A00h (6041h,
+    603Fh, 6064h, 606Ch, 6061h, 60B9h, 60BAh) from 32, S7 byte order; CSP
+    from the image."""
+    plc = load(layout='"mapping"')
+    _mapped_enable(plc)
+    plc.write(f"VD{IMG + 2}", 5000)
+    for _ in range(3):
+        plc.scan()
+    d = drive(plc)
+    sw, err, pos, vel, mode = struct.unpack(">HHiib", vbytes(plc, 32, 13))
+    assert (sw, err, pos, vel, mode) == (d.statusword, 0, d.position, d.read(0x606C), 8)
+    assert pos == 5000
+    assert plc.read(f"VB{IMG + 64}") & 0x01                    # online
+    assert plc.read(f"VW{IMG + 66}") == plc.module(0).cycles
+
+
+def test_a_mapping_layout_image_follows_a_remap_of_the_plant_params():
+    """The plant's start-up list moves the TxPDO to 1A01h = 6064h, 6041h
+    (CoE steps B, D, E, F, G): the input half is now 6064h then 6041h."""
+    params = {"1C13": 0, "1A01:01": 0x60640020, "1A01:02": 0x60410010, "1A01:00": 2,
+              "1C13:01": 0x1A01, "1C13:00": 1}
+    plc = load(layout='"mapping"', params=params)
+    _mapped_enable(plc)
+    plc.write(f"VD{IMG + 2}", -1234)
+    for _ in range(3):
+        plc.scan()
+    pos, sw = struct.unpack(">iH", vbytes(plc, 32, 6))
+    assert (pos, sw) == (-1234, drive(plc).statusword)
+    assert vbytes(plc, 38, 4) == bytes(4)                     # nothing beyond the 6 bytes
+
+
+def test_a_kinco_mapping_layout_with_one_rxpdo():
+    """A CANopen model: every map with entries is in force; the start-up list
+    leaves RxPDO 1 = 6040h + 607Ah and TxPDO 1 = 6041h + 6064h only."""
+    params = {"1601:00": 0, "1602:00": 0, "1603:00": 0, "1600:00": 0, "1600:01": 0x60400010,
+              "1600:02": 0x607A0020, "1600:0": 2, "1A01:00": 0, "1A02:00": 0, "1A03:00": 0,
+              "1A00:00": 0, "1A00:01": 0x60410010, "1A00:02": 0x60640020, "1A00:0": 2,
+              "6060": 8}
+    plc = load("kinco-servo", layout='"mapping"', params=params)
+    _mapped_enable(plc)
+    plc.write(f"VD{IMG + 2}", 777)
+    for _ in range(3):
+        plc.scan()
+    sw, pos = struct.unpack(">Hi", vbytes(plc, 32, 6))
+    assert (sw, pos) == (drive(plc).statusword, 777)
+
+
+@pytest.mark.parametrize("layout, params, words", [
+    ('"other"', {}, "layout must be one of"),
+    ('"mapping"', {"1C13": 0, "1A01:01": 0x60640020, "1A01:02": 0x60640020, "1A01:03": 0x606C0020,
+                   "1A01:04": 0x60F40020, "1A01:00": 4, "1C13:01": 0x1A00, "1C13:02": 0x1A01,
+                   "1C13:00": 2}, "image is 35 bytes"),
+])
+def test_a_mapping_layout_the_image_cannot_hold_is_refused(layout, params, words):
+    with pytest.raises(PlcConfigError, match=words):
+        load(layout=layout, params=params)

@@ -169,3 +169,24 @@ def test_any_request_sequence_keeps_the_rules(requests):
             assert {ev.before, ev.after} == {E.INIT, E.BOOT}
         else:
             assert UP.index(ev.after) <= UP.index(ev.before) + 1
+
+
+@pytest.mark.parametrize("mode, cycle_ns, code", [
+    (2, 199_000, 0x0036), (2, 10_000_001, 0x0036), (1, 100_000, 0x0035),
+    (2, 200_000, 0), (2, 10_000_000, 0), (1, 250_000, 0), (0, 50_000, 0)])
+def test_a_sync_cycle_outside_the_manual_is_refused_at_safeop(mode, cycle_ns, code):
+    """HCFA §7.4.3: 200 µs to 10 ms.  SM-synchronous (1C32h:01 = 1) and DC
+    SYNC0 (= 2) cycles outside it stay in PRE-OP with AL 0x0035 / 0x0036;
+    free run (0) takes any cycle."""
+    from plcrt.devices.cia402.drive import Drive
+
+    d = Drive("hcfa-am0520b")
+    d.request_esm(EsmState.PREOP)
+    d.write(0x1C32, 1, mode)
+    d.write(0x1C32, 2, cycle_ns)
+    res = d.request_esm(EsmState.SAFEOP)
+    assert res.accepted == (code == 0)
+    assert d.esm.al_code == code
+    assert d.esm.state is (EsmState.SAFEOP if code == 0 else EsmState.PREOP)
+    if code:
+        assert "HCFA §7.4.3" in res.explanation

@@ -144,3 +144,48 @@ def cpu_mode(client: Any) -> int:
     szl = client.read_szl(0x0424, 0)
     data = bytes(b & 0xFF for b in szl.Data[:szl.Header.LengthDR])
     return data[7]
+
+
+# -- raw sockets (the fault tests) ------------------------------------------------
+def tpkt(body: bytes) -> bytes:
+    return struct.pack(">BBH", 3, 0, len(body) + 4) + body
+
+
+def cr_frame(called: int = 0x0301) -> bytes:
+    """A COTP connection request to a two-byte TSAP (default: basic, rack 0
+    slot 1), TPDU size 1024."""
+    params = bytes([0xC1, 2, 0x01, 0x00, 0xC2, 2, called >> 8, called & 0xFF, 0xC0, 1, 0x0A])
+    return tpkt(bytes([6 + len(params), 0xE0, 0, 0, 0, 1, 0]) + params)
+
+
+def dt_frame(pdu: bytes) -> bytes:
+    return tpkt(b"\x02\xf0\x80" + pdu)
+
+
+SETUP = job(struct.pack(">BBHHH", 0xF0, 0, 1, 1, 240))
+
+
+def recv_frames(sock: Any, timeout: float = 5.0) -> tuple[list[bytes], bool]:
+    """Every TPKT the server sends until it closes (or ``timeout``), and
+    whether it closed; asserts each frame is a well-formed TPKT."""
+    sock.settimeout(timeout)
+    buf, closed = b"", False
+    try:
+        while True:
+            chunk = sock.recv(65536)
+            if not chunk:
+                closed = True
+                break
+            buf += chunk
+    except ConnectionResetError:
+        closed = True
+    except (TimeoutError, OSError):
+        pass
+    frames = []
+    while buf:
+        assert buf[0] == 3 and len(buf) >= 4, buf[:8].hex()
+        n = buf[2] << 8 | buf[3]
+        assert 7 <= n <= len(buf), buf[:8].hex()
+        frames.append(buf[:n])
+        buf = buf[n:]
+    return frames, closed

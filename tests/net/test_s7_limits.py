@@ -251,3 +251,11 @@ def test_a_refused_connection_gets_a_cotp_disconnect() -> None:
             s.sendall(bytes.fromhex("0300001611e00000000100c1020100c2020101c0010a"))
             answer = s.recv(64)
             assert answer[5] == 0x80             # COTP DR
+
+
+def test_a_read_without_items_is_answered_with_a_frame_error(client) -> None:
+    # the placeholder python-snap7 3.3's get_cpu_state() sends (function
+    # 0x04 alone): not a request a CPU can serve
+    ans = exchange(client, job(b"\x04"))
+    assert header_error(ans) == 0x8500
+    assert cpu_mode(client) == 0x08             # the connection goes on

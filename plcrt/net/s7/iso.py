@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 from ...errors import PlcError
 
-__all__ = ["CONN_BASIC", "CONN_OP", "CONN_PG", "ConnectRequest", "FrameError", "MAX_TPKT",
+__all__ = ["CONN_BASIC", "CONN_OP", "CONN_PG", "CR", "DR", "DT", "ConnectRequest", "FrameError",
+           "MAX_TPKT", "Tpdu",
            "build_cc", "build_dr", "build_dt", "connection_type", "parse_cotp",
            "parse_tpkt_header"]
 
@@ -68,9 +69,19 @@ def parse_tpkt_header(head: bytes) -> int:
     return length - 4
 
 
-def parse_cotp(payload: bytes) -> tuple[int, object]:
-    """``(code, content)`` of a COTP TPDU: CR -> :class:`ConnectRequest`,
-    DT -> ``(eot, data)``, DR -> None.
+@dataclass(frozen=True)
+class Tpdu:
+    """A parsed COTP TPDU: its code (:data:`CR`, :data:`DT` or :data:`DR`),
+    the request of a CR, the EOT flag and data of a DT."""
+
+    code: int
+    request: ConnectRequest | None = None
+    eot: bool = False
+    data: bytes = b""
+
+
+def parse_cotp(payload: bytes) -> Tpdu:
+    """A COTP TPDU: CR, DT or DR (DC counts as DR).
 
     Raises:
         FrameError: a length indicator that does not fit, an unknown TPDU,
@@ -84,14 +95,14 @@ def parse_cotp(payload: bytes) -> tuple[int, object]:
     if code == DT:
         if li != 2:
             raise FrameError("COTP DT header must be 2 bytes")
-        return DT, (bool(payload[2] & 0x80), bytes(payload[3:]))
+        return Tpdu(DT, eot=bool(payload[2] & 0x80), data=bytes(payload[3:]))
     if code == CR:
         if li < 6 or li + 1 != len(payload):
             raise FrameError("malformed COTP CR")
         src_ref = payload[4] << 8 | payload[5]
-        return CR, _connect_params(src_ref, payload[7:li + 1])
+        return Tpdu(CR, request=_connect_params(src_ref, payload[7:li + 1]))
     if code in (DR, DC):
-        return DR, None
+        return Tpdu(DR)
     raise FrameError(f"COTP TPDU 0x{payload[1]:02X} not supported")
 
 

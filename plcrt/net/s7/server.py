@@ -34,7 +34,7 @@ from ..door import DoorBusy, DoorClosed, ScanDoor
 from ..options import ServerOptions
 from ..tcp import ClosedByPeer, TcpService
 from .areas import RC, Loc, check_write, locate, read_job, reply_item, write_job
-from .iso import CR, DR, FrameError, build_cc, build_dr, build_dt, connection_type, \
+from .iso import DR, DT, FrameError, build_cc, build_dr, build_dt, connection_type, \
     parse_cotp, parse_tpkt_header
 from .pdu import ERR, FN, USERDATA, Header, ack, parse_header, parse_items, \
     parse_write_data, userdata_answer
@@ -101,19 +101,19 @@ class S7Server(TcpService):
     # -- the connection --------------------------------------------------
     async def session(self, reader: asyncio.StreamReader,
                       writer: asyncio.StreamWriter) -> None:
-        code, req = parse_cotp(await self._frame(reader, True))
-        if code != CR or req is None:
+        req = parse_cotp(await self._frame(reader, True)).request
+        if req is None:
             raise FrameError("a connection starts with a COTP connection request")
         self._refs = self._refs % 0xFFFF + 1
-        ctype = connection_type(req.called)       # type: ignore[attr-defined]
+        ctype = connection_type(req.called)
         if self.by_type[ctype] >= self.identity.connections[ctype]:
             self.stats[f"refused_{ctype}"] += 1
-            writer.write(build_dr(req, self._refs, REFUSED))   # type: ignore[arg-type]
+            writer.write(build_dr(req, self._refs, REFUSED))
             await self._drain(writer)
             return
         self.by_type[ctype] += 1
         try:
-            writer.write(build_cc(req, self._refs))             # type: ignore[arg-type]
+            writer.write(build_cc(req, self._refs))
             await self._drain(writer)
             conn = _Conn(self.identity.pdu_size)
             while True:
@@ -140,16 +140,15 @@ class S7Server(TcpService):
         """One S7 PDU from one or more COTP DTs; None on a COTP DR."""
         parts = b""
         while True:
-            code, content = parse_cotp(await self._frame(reader, not parts))
-            if code == DR:
+            tpdu = parse_cotp(await self._frame(reader, not parts))
+            if tpdu.code == DR:
                 return None
-            if code != 0xF0:
+            if tpdu.code != DT:
                 raise FrameError("a second COTP connection request")
-            eot, data = content                   # type: ignore[misc]
-            parts += data
+            parts += tpdu.data
             if len(parts) > MAX_PDU:
                 raise FrameError(f"an S7 PDU longer than {MAX_PDU} bytes")
-            if eot:
+            if tpdu.eot:
                 return parts
 
     async def _answer(self, conn: _Conn, pdu: bytes) -> bytes:
@@ -165,14 +164,13 @@ class S7Server(TcpService):
             return await handler(self, conn, h)
         except FrameError:
             self.stats["refused_requests"] += 1
-            return ack(h.ref, h.params[:1] + b"\x00" if h.params else b"", error=ERR["frame"])
+            return _error(h, ERR["frame"])
         except _Refuse as r:
             self.stats["refused_requests"] += 1
-            return ack(h.ref, h.params[:1] + b"\x00" if h.params else b"", error=r.error)
+            return _error(h, r.error)
         except DoorBusy:
             self.stats["busy"] += 1
-            return ack(h.ref, h.params[:1] + b"\x00" if h.params else b"",
-                       error=ERR["resources"])
+            return _error(h, ERR["resources"])
         except DoorClosed:
             raise ClosedByPeer() from None
 
@@ -279,6 +277,16 @@ class S7Server(TcpService):
         part, conn.pending = conn.pending[:room], conn.pending[room:]
         data = struct.pack(">BBH", 0xFF, 0x09, len(part)) + part
         return userdata_answer(h.ref, 4, 1, data, seq=conn.seq, more=bool(conn.pending))
+
+
+def _error(h: Header, error: int) -> bytes:
+    """A request answered with an error word: a job's answer names the
+    function, a user-data answer the group and subfunction asked."""
+    p = h.params
+    if h.rosctr == USERDATA:
+        group, sub = (p[5] & 0x0F, p[6]) if len(p) >= 7 else (0, 0)
+        return userdata_answer(h.ref, group, sub, b"\x0a\x00\x00\x00", error=error)
+    return ack(h.ref, p[:1] + b"\x00" if p else b"", error=error)
 
 
 def _switch(plc: Any, mode: str) -> bool:

@@ -151,10 +151,10 @@ def tpkt(body: bytes) -> bytes:
     return struct.pack(">BBH", 3, 0, len(body) + 4) + body
 
 
-def cr_frame(called: int = 0x0301) -> bytes:
+def cr_frame(called: int = 0x0301, tpdu: int = 0x0A) -> bytes:
     """A COTP connection request to a two-byte TSAP (default: basic, rack 0
-    slot 1), TPDU size 1024."""
-    params = bytes([0xC1, 2, 0x01, 0x00, 0xC2, 2, called >> 8, called & 0xFF, 0xC0, 1, 0x0A])
+    slot 1), TPDU size 2**tpdu (default 1024)."""
+    params = bytes([0xC1, 2, 0x01, 0x00, 0xC2, 2, called >> 8, called & 0xFF, 0xC0, 1, tpdu])
     return tpkt(bytes([6 + len(params), 0xE0, 0, 0, 0, 1, 0]) + params)
 
 

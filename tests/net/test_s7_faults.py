@@ -73,7 +73,8 @@ def _mutate(rng: random.Random, data: bytes) -> bytes:
             b += bytes(rng.randrange(256) for _ in range(rng.randint(1, 30)))
         elif b:
             i = rng.randrange(len(b))
-            b[i:i + 2] = struct.pack(">H", rng.choice([0, 1, 0xFF, 0xFFFF, len(b), rng.randrange(65536)]))
+            b[i:i + 2] = struct.pack(">H", rng.choice([0, 1, 0xFF, 0xFFFF, len(b),
+                                                      rng.randrange(65536)]))
     return bytes(b)
 
 

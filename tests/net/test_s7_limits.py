@@ -15,8 +15,8 @@ import plcrt
 from plcrt.net.options import Listen
 from plcrt.net.s7 import S7Identity, S7Options
 
-from .s7_support import connect, cpu_mode, exchange, header_error, item, job, load, \
-    read_items, snap7, wait_for, write_items
+from .s7_support import connect, cpu_mode, cr_frame, dt_frame, exchange, header_error, item, \
+    job, load, read_items, recv_frames, snap7, wait_for, write_items
 
 Area = snap7.type.Area
 WordLen = snap7.type.WordLen
@@ -113,6 +113,20 @@ def test_pdu_size_is_the_smaller_of_asked_and_ours(ours, asked, got) -> None:
         c = connect(srv.port("s7"), pdu=asked)
         assert c.pdu_length == got
         c.disconnect()
+
+
+def test_the_tpdu_size_bounds_the_pdu_size() -> None:
+    opts = S7Options(identity=S7Identity(pdu_size=960))
+    with plcrt.serve(load(), s7=opts) as srv:
+        with socket.create_connection(("127.0.0.1", srv.port("s7")), timeout=5) as s:
+            # TPDU 512 asked: the CC says 512 (code 9), and an S7 PDU of
+            # 960 would not fit one TPDU: setup answers 509
+            setup = job(struct.pack(">BBHHH", 0xF0, 0, 1, 1, 960))
+            s.sendall(cr_frame(tpdu=0x09) + dt_frame(setup))
+            s.shutdown(socket.SHUT_WR)
+            (cc, answer), _ = recv_frames(s)
+        assert cc[5] == 0xD0 and b"\xc0\x01\x09" in cc
+        assert struct.unpack(">H", answer[-2:])[0] == 509
 
 
 def test_a_read_larger_than_the_pdu_is_refused_and_python_snap7_splits(served, client) -> None:
@@ -240,6 +254,13 @@ def test_an_unknown_szl_id_is_an_error_the_client_sees(client) -> None:
     n = struct.unpack(">H", ids[2:4])[0]
     served_ids = {struct.unpack(">H", ids[4 + 2 * i:6 + 2 * i])[0] for i in range(n)}
     assert {0x0011, 0x001C, 0x0424} <= served_ids
+    # one record by its index: 0x001C index 5, the serial number
+    szl = client.read_szl(0x001C, 5)
+    one = bytes(b & 0xFF for b in szl.Data[:szl.Header.LengthDR])
+    assert struct.unpack(">HH", one[:4]) == (34, 1) and one[4:6] == b"\x00\x05"
+    assert one[6:20] == b"PLCRT-00000001"
+    with pytest.raises(Exception):
+        client.read_szl(0x001C, 6)                 # no record 6
     assert cpu_mode(client) == 0x08             # the connection goes on
 
 

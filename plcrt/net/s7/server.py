@@ -34,8 +34,8 @@ from ..door import DoorBusy, DoorClosed, ScanDoor
 from ..options import ServerOptions
 from ..tcp import ClosedByPeer, TcpService
 from .areas import RC, Loc, check_write, locate, read_job, reply_item, write_job
-from .iso import DR, DT, FrameError, build_cc, build_dr, build_dt, connection_type, \
-    parse_cotp, parse_tpkt_header
+from .iso import DR, DT, MAX_TPDU_CODE, FrameError, build_cc, build_dr, build_dt, \
+    connection_type, parse_cotp, parse_tpkt_header
 from .pdu import ERR, FN, USERDATA, Header, ack, parse_header, parse_items, \
     parse_write_data, userdata_answer
 from .szl import S7Identity, szl_answer
@@ -71,6 +71,7 @@ class _Refuse(Exception):
 @dataclass
 class _Conn:
     pdu: int
+    tpdu: int = 0x7FFF       # the S7 PDU size the TPDU size allows
     pending: bytes = b""      # the rest of an SZL answer longer than a PDU
     seq: int = 0
 
@@ -115,7 +116,10 @@ class S7Server(TcpService):
         try:
             writer.write(build_cc(req, self._refs))
             await self._drain(writer)
-            conn = _Conn(self.identity.pdu_size)
+            # an S7 PDU travels in one TPDU: the negotiated TPDU size (its 3
+            # header bytes off) bounds the PDU size setup may answer
+            tpdu = 1 << min(max(req.tpdu_code, 7), MAX_TPDU_CODE)
+            conn = _Conn(min(self.identity.pdu_size, tpdu - 3), tpdu - 3)
             while True:
                 pdu = await self._pdu(reader)
                 if pdu is None:
@@ -179,7 +183,7 @@ class S7Server(TcpService):
         if len(h.params) != 8:
             raise FrameError("setup communication parameters are 8 bytes")
         _, _, amq1, amq2, asked = struct.unpack(">BBHHH", h.params)
-        conn.pdu = max(min(asked, self.identity.pdu_size), MIN_PDU)
+        conn.pdu = max(min(asked, self.identity.pdu_size, conn.tpdu), MIN_PDU)
         return ack(h.ref, struct.pack(">BBHHH", FN["setup"], 0, min(amq1, 1) or 1,
                                       min(amq2, 1) or 1, conn.pdu))
 

@@ -8,9 +8,10 @@ CPUs send them and snap7, python-snap7 and Wireshark read them):
 - 0x0011: module identification, 28-byte records: index 1 the order
   number (MLFB), 6 the hardware, 7 the firmware (``V`` and three digits);
 - 0x001C: component identification, 34-byte records: 1 station name,
-  2 module name, 3 plant id, 4 copyright, 5 serial number, 7 module type;
+  2 module name, 3 plant id, 4 copyright, 5 serial number, 7 module type
+  (for both, an index other than 0 asks for that record alone);
 - 0x0131 index 1: communication capabilities (max PDU, connections);
-- 0x0232 index 4: protection level and the mode switch;
+- 0x0132 and 0x0232 index 4: protection level and the mode switch;
 - 0x0424: the CPU's mode, byte 3 of the record 0x08 RUN or 0x04 STOP (the
   byte snap7's ``Cli_GetPlcStatus`` reads).
 
@@ -58,7 +59,8 @@ class S7Identity:
 
     def __post_init__(self) -> None:
         if self.pdu_size not in (240, 480, 960):
-            raise PlcConfigError(f"S7 PDU size is 240, 480 or 960, not {shown_value(self.pdu_size)}")
+            raise PlcConfigError(f"S7 PDU size is 240, 480 or 960, not "
+                                 f"{shown_value(self.pdu_size)}")
         for key in ("PG", "OP", "basic"):
             n = self.connections.get(key)
             if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 64:
@@ -81,7 +83,7 @@ def _module(ident: S7Identity, index: int, mode: str) -> tuple[int, list[bytes]]
     v1, v2, v3 = ident.firmware
     mlfb = _text(ident.order_number, 20)
     return 28, [struct.pack(">H", 1) + mlfb + b"\x00\xc0\x00\x00\x00\x00",
-                struct.pack(">H", 6) + mlfb + struct.pack(">HH", 0x00C0, ident.hardware) + b"\x00\x00",
+                struct.pack(">H", 6) + mlfb + struct.pack(">HHH", 0x00C0, ident.hardware, 0),
                 struct.pack(">H", 7) + b"\x20" * 20 + b"\x00\xc0" + bytes([0x56, v1, v2, v3])]
 
 
@@ -115,9 +117,14 @@ SZL: dict[int, Callable[[S7Identity, int, str], tuple[int, list[bytes]]]] = {
     0x0011: _module,
     0x001C: _component,
     0x0131: _comm,
+    0x0132: _protection,      # the same record: S7-300 CPUs and H CPUs ask either
     0x0232: _protection,
     0x0424: _mode,
 }
+
+
+#: SZL ids whose records begin with their index (the index asks one)
+_INDEXED = frozenset({0x0011, 0x001C})
 
 
 def szl_answer(ident: S7Identity, szl_id: int, index: int, mode: str) -> bytes | None:
@@ -127,4 +134,9 @@ def szl_answer(ident: S7Identity, szl_id: int, index: int, mode: str) -> bytes |
     if make is None:
         return None
     size, recs = make(ident, index, mode)
+    if szl_id in _INDEXED and index:
+        # one record asked by its index
+        recs = [r for r in recs if r[:2] == struct.pack(">H", index)]
+        if not recs:
+            return None
     return struct.pack(">HHHH", szl_id, index, size, len(recs)) + b"".join(recs)

@@ -178,10 +178,10 @@ def test_half_open_sockets_are_closed_after_the_idle_timeout(served) -> None:
     c = connect(served.port("s7"))                 # others are served meanwhile
     assert c.db_read(1, 0, 1) == bytearray(1)
     for s in (silent, half):
-        _, closed = recv_frames(s, timeout=6.0)
+        _, closed = recv_frames(s, timeout=10.0)
         assert closed
         s.close()
-    assert 1.5 < time.monotonic() - t0 < 6.0        # idle_timeout=2 s
+    assert 1.5 < time.monotonic() - t0 < 10.0       # idle_timeout=2 s (a loaded machine)
     assert served.services["s7"].stats["idle_or_closed"] >= 2
     c.disconnect()
     _healthy(served)

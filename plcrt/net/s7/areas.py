@@ -31,8 +31,8 @@ from typing import Any
 from ..options import WriteGuard
 from .pdu import Item
 
-__all__ = ["AREAS", "AreaSpec", "Loc", "RC", "TSIZES", "check_write", "locate", "read_job", "reply_item",
-           "write_job"]
+__all__ = ["AREAS", "AreaSpec", "Loc", "RC", "TSIZES", "check_write", "locate", "read_job",
+           "reply_item", "write_job"]
 
 #: item return codes
 RC = {"ok": 0xFF, "na": 0x03, "denied": 0x03, "range": 0x05, "type": 0x06, "size": 0x07}

@@ -64,12 +64,12 @@ def test_a_written_input_holds_and_starts_a_timer(served, client) -> None:
 def test_counter_counts_client_pulses_and_is_read_by_both_codes(served, client) -> None:
     _, srv = served
     for _ in range(3):
-        before = srv.call(lambda p: p.scans)
-        client.write_area(Area.PE, 0, 1, bytearray(b"\x01"), WordLen.Bit)   # I0.1 on
-        wait_for(lambda: srv.call(lambda p: p.scans) > before + 1)
-        before = srv.call(lambda p: p.scans)
-        client.write_area(Area.PE, 0, 1, bytearray(b"\x00"), WordLen.Bit)   # I0.1 off
-        wait_for(lambda: srv.call(lambda p: p.scans) > before + 1)
+        for level in (b"\x01", b"\x00"):                    # I0.1 on, then off
+            client.write_area(Area.PE, 0, 1, bytearray(level), WordLen.Bit)
+            # the write has landed (its answer came); a scan after this
+            # boundary sees it
+            before = srv.call(lambda p: p.scans)
+            wait_for(lambda: srv.call(lambda p: p.scans) > before)
     assert srv.call(lambda p: p.read("C5")) == 3
     (rc, v), = read_items(client, [item(0x1E, 5, 1, tsize=0x1E)])
     assert (rc, v) == (0xFF, b"\x00\x03")

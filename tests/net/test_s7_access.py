@@ -160,3 +160,16 @@ def test_reads_see_a_scan_boundary_never_half_a_scan(served, client) -> None:
         assert mb10 == mb11
         seen.add(mb10)
     assert len(seen) > 1          # the PLC ran meanwhile
+
+
+def test_in_lockstep_a_write_waits_for_the_next_scan() -> None:
+    # the PLC does not run by itself: what a client writes is in the image
+    # at once (at this boundary) and reaches the program at the next scan
+    with plcrt.serve(load(), s7=0, speed="lockstep") as srv:
+        c = connect(srv.port("s7"))
+        c.db_write(1, 0, bytearray(b"\x07\x00"))
+        assert srv.call(lambda p: (p.scans, p.read("VW0"), p.read("QW0"))) == (0, 0x700, 0)
+        assert c.read_area(Area.PA, 0, 0, 2) == bytearray(2)
+        srv.call(lambda p: p.scan(1))
+        assert c.read_area(Area.PA, 0, 0, 2) == bytearray(b"\x07\x00")
+        c.disconnect()

@@ -280,3 +280,12 @@ def test_a_read_without_items_is_answered_with_a_frame_error(client) -> None:
     ans = exchange(client, job(b"\x04"))
     assert header_error(ans) == 0x8500
     assert cpu_mode(client) == 0x08             # the connection goes on
+
+
+@pytest.mark.parametrize("kw", [{"pdu_size": 1000}, {"firmware": (2, 300, 0)},
+                                {"firmware": "V2.7"}, {"hardware": -1},
+                                {"connections": {"PG": 1, "OP": 100, "basic": 1}},
+                                {"module_name": "x" * 33}, {"serial": "Ünicode"}])
+def test_a_bad_identity_is_a_config_error(kw) -> None:
+    with pytest.raises(plcrt.PlcConfigError):
+        S7Identity(**kw)

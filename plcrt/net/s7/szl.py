@@ -65,6 +65,14 @@ class S7Identity:
             n = self.connections.get(key)
             if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 64:
                 raise PlcConfigError(f"S7 connections of type {key}: 0..64, not {shown_value(n)}")
+        fw = self.firmware
+        if not (isinstance(fw, tuple) and len(fw) == 3
+                and all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 255
+                        for v in fw)):
+            raise PlcConfigError(f"S7 firmware is three numbers 0..255, not {shown_value(fw)}")
+        hw = self.hardware
+        if isinstance(hw, bool) or not isinstance(hw, int) or not 0 <= hw <= 0xFFFF:
+            raise PlcConfigError(f"S7 hardware version is 0..65535, not {shown_value(hw)}")
         texts = (self.order_number, self.station, self.module_name, self.plant_id,
                  self.copyright, self.serial, self.module_type)
         if not all(isinstance(t, str) and t.isascii() and len(t) <= 32 for t in texts):

@@ -19,10 +19,12 @@ from .door import ScanDoor
 from .host import SERVICES, Serving
 from .lockstep import LockstepServer
 from .options import ServerOptions, WriteGuard, parse_listen, parse_ranges
+from .s7 import make_s7
 
 __all__ = ["serve"]
 
 SERVICES["lockstep"] = LockstepServer
+SERVICES["s7"] = make_s7
 
 
 def _options(name: str, spec: Any, *, max_connections: int, idle_timeout: float,

@@ -168,15 +168,15 @@ def _read(source: str | Path) -> tuple[dict[str, Any], str]:
     try:
         text = read_capped(path, MAX_MAP_BYTES).decode("utf-8")
     except PlcError as e:
-        raise PlcConfigError(f"{excerpt(str(path))}: cannot read the Modbus map: "
+        raise PlcConfigError(f"{excerpt(str(path), 300)}: cannot read the Modbus map: "
                              f"{e.message}") from None
     except UnicodeDecodeError:
-        raise PlcConfigError(f"{excerpt(str(path))}: the Modbus map is not UTF-8 text "
+        raise PlcConfigError(f"{excerpt(str(path), 300)}: the Modbus map is not UTF-8 text "
                              f"(TOML)") from None
     try:
         return tomllib.loads(text), str(path)
     except tomllib.TOMLDecodeError as e:
-        raise PlcConfigError(f"{excerpt(str(path))}: {e}") from None
+        raise PlcConfigError(f"{excerpt(str(path), 300)}: {e}") from None
 
 
 def load_map(source: Any, areas: Mapping[str, Any] | None = None) -> AddressMap:
@@ -199,7 +199,7 @@ def load_map(source: Any, areas: Mapping[str, Any] | None = None) -> AddressMap:
         raise PlcConfigError(f"a Modbus map is a TOML file or a dict, not {shown_value(source)}")
     unknown = set(data) - set(TABLES)
     if unknown:
-        raise PlcConfigError(f"{excerpt(name)}: unknown key(s) "
+        raise PlcConfigError(f"{excerpt(name, 300)}: unknown key(s) "
                              f"{excerpt(', '.join(sorted(map(str, unknown))))} (a Modbus map "
                              f"has {', '.join(TABLES)})")
     regions: dict[str, tuple[Region, ...]] = {}
@@ -207,13 +207,13 @@ def load_map(source: Any, areas: Mapping[str, Any] | None = None) -> AddressMap:
     for key, (kind, bits, _) in TABLES.items():
         rows = data.get(key, [])
         if not isinstance(rows, list):
-            raise PlcConfigError(f"{excerpt(name)}: {key} is a list of tables ([[{key}]])")
+            raise PlcConfigError(f"{excerpt(name, 300)}: {key} is a list of tables ([[{key}]])")
         total += len(rows)
         if total > MAX_REGIONS:
-            raise PlcConfigError(f"{excerpt(name)}: at most {MAX_REGIONS} ranges")
+            raise PlcConfigError(f"{excerpt(name, 300)}: at most {MAX_REGIONS} ranges")
         out = []
         for i, row in enumerate(rows):
-            where = f"{excerpt(name)}: {key}[{i}]"
+            where = f"{excerpt(name, 300)}: {key}[{i}]"
             if not isinstance(row, dict) or set(row) - {"start", "count", "to"} \
                     or not {"start", "count", "to"} <= set(row):
                 raise PlcConfigError(f"{where}: a range has start, count and to")
@@ -231,7 +231,7 @@ def load_map(source: Any, areas: Mapping[str, Any] | None = None) -> AddressMap:
         out.sort(key=lambda r: r.first)
         for a, b in zip(out, out[1:]):
             if b.first < a.end:
-                raise PlcConfigError(f"{excerpt(name)}: {key}: the ranges from {a.first} and "
-                                     f"{b.first} overlap")
+                raise PlcConfigError(f"{excerpt(name, 300)}: {key}: the ranges from "
+                                     f"{a.first} and {b.first} overlap")
         regions[kind] = tuple(out)
     return AddressMap(regions, name)

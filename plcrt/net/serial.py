@@ -16,11 +16,13 @@ slave side's path is ``serving.addresses["serial0"][0]`` (and
 - what the far end writes is read by the servers' loop and handed to the
   port at the next scan boundary (a door job): the characters arrive one
   after the other from that instant (never overlapping the previous ones)
-  in the framing the far end set on the pseudo-terminal (its baud rate,
-  data bits and parity, as pyserial and mbpoll set them with ``termios``),
-  so a master at another rate or parity than the port's SMB30 / SMB130 is
-  received with errors as on a real line, and so is a request sent before
-  the program's MBUS_INIT put the port in freeport;
+  at the baud rate and character size the far end set on the
+  pseudo-terminal (as pyserial and mbpoll set them with ``termios``), so a
+  master at another rate than the port's SMB30 / SMB130 is received with
+  errors as on a real line, and so is a request sent before the program's
+  MBUS_INIT put the port in freeport.  A Linux pseudo-terminal keeps no
+  parity (pyserial cannot even set it there), so the characters carry the
+  port's own parity: set the master to parity none;
 - the scan never waits: a far end that does not read loses what its
   buffer cannot take (``stats["dropped_out"]``), a flood of input beyond
   the door's bound is dropped (``stats["dropped_in"]``).
@@ -55,21 +57,20 @@ READ_CHUNK = 4096
 _SPEEDS = {getattr(termios, f"B{b}"): b for b in BAUDS if hasattr(termios, f"B{b}")}
 
 
-def line_framing(fd: int, fallback: Framing) -> Framing:
-    """The framing the far end set on the terminal ``fd`` (its output
-    speed, character size and parity); ``fallback`` for a rate no port
-    can run at."""
+def line_framing(fd: int, port: Framing) -> Framing:
+    """The framing of the characters the far end writes on the terminal
+    ``fd``: its output speed and character size, the ``port``'s parity (a
+    pseudo-terminal keeps none); ``port`` itself for a rate no port can
+    run at."""
     try:
         _, _, cflag, _, _, ospeed, _ = termios.tcgetattr(fd)
     except (termios.error, OSError):
-        return fallback
+        return port
     baud = _SPEEDS.get(ospeed)
     if baud is None:
-        return fallback
-    parity = "none" if not cflag & termios.PARENB else \
-        "odd" if cflag & termios.PARODD else "even"
+        return port
     bits = 7 if cflag & termios.CSIZE == termios.CS7 else 8
-    return Framing(baud, bits, parity, "freeport")
+    return Framing(baud, bits, port.parity, "freeport")
 
 
 class _PtyPeer:

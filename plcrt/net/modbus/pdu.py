@@ -130,8 +130,8 @@ def execute(areas: dict[str, bytearray], amap: AddressMap, req: Request,
         data = pack_bits(vals) if req.bits else b"".join(v.to_bytes(2, "big") for v in vals)
         return bytes((req.fn, len(data))) + data
     if req.fn == 15 and library:
-        # the library: "the starting output point must begin on a byte
-        # boundary and the number of outputs written must be a multiple of 8"
+        # the library's rule: the first output on a byte boundary of Q, a
+        # multiple of 8 outputs (System Manual, Modbus slave functions)
         if req.start & 7:
             raise ModbusException(2)
         if req.count & 7:

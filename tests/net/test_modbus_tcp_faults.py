@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import socket
 import struct
+import threading
 import time
 import tracemalloc
 
@@ -122,8 +123,9 @@ def test_fuzz_left_the_server_healthy(served):
 
 
 def test_a_flood_of_clients_is_bounded_and_the_plc_scans_on(served):
-    """3 200 requests from 8 clients at once (loopback), one more
-    client's requests answered meanwhile, memory flat."""
+    """3 200 requests from 8 clients at once (loopback; a warm-up of 800,
+    then 2 400 measured): another client is answered meanwhile, the PLC
+    scans on, memory stays flat."""
     port = served.port("modbus")
 
     async def client(n: int) -> int:
@@ -140,26 +142,42 @@ def test_a_flood_of_clients_is_bounded_and_the_plc_scans_on(served):
     async def flood(per: int) -> list[int]:
         return list(await asyncio.gather(*(client(per) for _ in range(8))))
 
+    other: list[float] = []                           # another client's answer times
+    stop = threading.Event()
+
+    def bystander() -> None:
+        with ModbusTcpClient("127.0.0.1", port=port, timeout=10) as c:
+            while not stop.is_set():
+                t = time.monotonic()
+                assert not c.read_coils(0, count=16).isError()
+                other.append(time.monotonic() - t)
+
     scans0 = served.call(lambda p: p.scans)
     asyncio.run(flood(100))                            # warm up: every path allocated
     tracemalloc.start()
+    side = threading.Thread(target=bystander)
     try:
         before = tracemalloc.get_traced_memory()[0]
         t0 = time.monotonic()
-        done = asyncio.run(flood(400))
+        side.start()
+        done = asyncio.run(flood(300))
         wall = time.monotonic() - t0
+        stop.set()
+        side.join(10)
         healthy(served)
         after = tracemalloc.get_traced_memory()[0]
     finally:
+        stop.set()
         tracemalloc.stop()
-    assert done == [400] * 8
+    assert done == [300] * 8
+    assert len(other) >= 10 and max(other) < 5.0, (len(other), max(other, default=0))
     assert after - before < 2_000_000, after - before
     svc = served.services["modbus"]
     assert served.door.waiting == 0 and svc.stats["server_errors"] == 0
     # real time: the PLC ran scans all along (10 ms scans: about wall / 10 ms)
     scans = served.call(lambda p: p.scans) - scans0
     scan_s = served.call(lambda p: p.scan_us) / 1e6
-    assert scans >= 0.5 * wall / scan_s, (scans, wall)
+    assert scans >= 0.25 * wall / scan_s, (scans, wall)
 
 
 def test_a_pipelined_burst_is_answered_in_order(served):

@@ -200,3 +200,14 @@ def test_serve_refuses_a_map_without_a_modbus_server():
     plc = plcrt.load(REACT)
     with pytest.raises(PlcConfigError, match="modbus_map needs"):
         plcrt.serve(plc, lockstep=0, modbus_map={}, start=False)
+
+
+def test_the_library_map_is_bounded_by_the_cpus_image():
+    # a CPU 221 has no analog inputs: no input register at all
+    plc = plcrt.load("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     SM0.0\n"
+                     "=      Q0.0\nEND_ORGANIZATION_BLOCK\n", cpu="CPU221")
+    with plcrt.serve(plc, modbus=0) as s, \
+            ModbusTcpClient("127.0.0.1", port=s.port("modbus"), timeout=5) as c:
+        r = c.read_input_registers(0, count=1)
+        assert r.isError() and r.exception_code == 2
+        assert len(ok(c.read_holding_registers(999, count=1)).registers) == 1

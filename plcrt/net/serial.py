@@ -148,10 +148,12 @@ class PtyBridge:
             self.door.post(self._detach)
         except DoorClosed:
             self._detach(self.plc)             # the runner has stopped
-        for fd in (self._master, self._slave):
+        # forgotten before closed: a write racing the close never reaches a
+        # file that reuses the descriptor's number
+        fds, self._master, self._slave = (self._master, self._slave), -1, -1
+        for fd in fds:
             if fd >= 0:
                 os.close(fd)
-        self._master = self._slave = -1
 
     # -- the PLC's thread ---------------------------------------------------
     def _attach(self, plc: Plc) -> None:
@@ -172,10 +174,11 @@ class PtyBridge:
 
     def write(self, data: bytes) -> None:
         """Characters for the far end (the PLC's thread; never blocks)."""
-        if self._master < 0:
+        fd = self._master
+        if fd < 0:
             return
         try:
-            os.write(self._master, data)
+            os.write(fd, data)
             self.stats["sent"] += len(data)
         except (BlockingIOError, OSError):
             self.stats["dropped_out"] += len(data)

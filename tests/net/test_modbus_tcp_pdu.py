@@ -72,7 +72,11 @@ def test_parse_refuses_with_the_library_codes(pdu, code):
 def test_a_refused_write_is_exception_2_and_writes_nothing():
     guard = WriteGuard(allow=parse_ranges("VB0-VB3"))
     req = parse(_request(16, 1, 2, b"\x04\x00\x01\x00\x02"))      # VB2 .. VB5
+    before = bytes(PLC.mem.areas["V"][:8])
     with pytest.raises(Refused) as e:
         execute(PLC.mem.areas, MAP, req, guard, True)
     assert e.value.code == 2 and "V bytes 2..5" in e.value.what
-    assert bytes(PLC.mem.areas["V"][2:6]) == bytes(4)
+    assert bytes(PLC.mem.areas["V"][:8]) == before
+    req = parse(_request(16, 0, 2, b"\x04\x00\x01\x00\x02"))      # VB0 .. VB3: allowed
+    execute(PLC.mem.areas, MAP, req, guard, True)
+    assert bytes(PLC.mem.areas["V"][:4]) == b"\x00\x01\x00\x02"

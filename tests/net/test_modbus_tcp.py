@@ -211,3 +211,16 @@ def test_the_library_map_is_bounded_by_the_cpus_image():
         r = c.read_input_registers(0, count=1)
         assert r.isError() and r.exception_code == 2
         assert len(ok(c.read_holding_registers(999, count=1)).registers) == 1
+
+
+def test_the_server_answers_in_stop_and_the_program_reacts_after_run(served):
+    s, c = served
+    s.call(lambda p: p.set_mode("STOP"))
+    scans = s.call(lambda p: p.scans)
+    ok(c.write_register(0, 9))                        # written while the CPU is stopped
+    assert ok(c.read_holding_registers(0, count=1)).registers == [9]
+    assert s.call(lambda p: (p.mode, p.scans)) == ("STOP", scans)
+    assert read(s, "VW2") == 1                        # the program has not run since
+    s.call(lambda p: p.set_mode("RUN"))
+    wait_for(lambda: ok(c.read_holding_registers(1, count=1)).registers == [10],
+             what="VW2 = VW0 + 1 after RUN")

@@ -215,6 +215,7 @@ def test_the_library_map_is_bounded_by_the_cpus_image():
 
 def test_the_server_answers_in_stop_and_the_program_reacts_after_run(served):
     s, c = served
+    wait_for(lambda: read(s, "VW2") == 1, what="a first scan")
     s.call(lambda p: p.set_mode("STOP"))
     scans = s.call(lambda p: p.scans)
     ok(c.write_register(0, 9))                        # written while the CPU is stopped

@@ -1,0 +1,80 @@
+"""Read a project file: the container, then its sections in order.
+
+:func:`read_project` opens the container (:mod:`.container`), finds the
+program block in the inflated stream and reads it (:mod:`.program`), then
+writes the blocks as STL export text (:mod:`.awl`) whose code page is
+detected as an export's is.  The result holds that text, the blocks and
+what the header says; :func:`plcrt.project.load_project` parses it.
+
+Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
+layout, which is not read: they are refused with a message saying so.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import PlcConfigError
+from ..lang.encoding import decode_bytes
+from .awl import blocks_text
+from .container import Container, open_container
+from .program import Block, read_program_block
+from .stream import Cursor, binary_error
+
+__all__ = ["Project", "read_project", "PROJECT_SUFFIXES"]
+
+#: file name endings read as project files
+PROJECT_SUFFIXES = (".mwp", ".smart")
+
+#: the start of the program block: version 2, a block count, then MAIN
+#: (block version 7 or 8, type 1000, number 0)
+_PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
+
+
+@dataclass
+class Project:
+    """A project file, read."""
+
+    file: str
+    format: str
+    version: str
+    blocks: list[Block]
+    #: the program as its STL export (the code page's characters)
+    awl: str
+    #: the code page the project's strings were decoded with
+    encoding: str
+    notes: list[str] = field(default_factory=list)
+
+
+def read_project(data: bytes, file: str) -> Project:
+    """The project in ``data`` (the bytes of a whole project file)."""
+    box = open_container(data, file)
+    if box.format == "Micro/WIN V3":
+        raise binary_error(file, "program block", 0, "Micro/WIN V3 projects (R03.xx) keep "
+                           "their program in a layout this reader does not read: open the "
+                           "project in Micro/WIN V4 and save it, or export it as STL (.awl)",
+                           PlcConfigError)
+    blocks = _program(box)
+    raw = blocks_text(blocks)
+    decoded = decode_bytes(raw.encode("latin-1"), file)
+    notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
+             "protected block, its interface without its code" for b in blocks if b.protected]
+    return Project(file, box.format, box.version, blocks, decoded.text, decoded.encoding,
+                   notes)
+
+
+def _program(box: Container) -> list[Block]:
+    match = _PROGRAM_BLOCK.search(box.stream)
+    if match is None:
+        raise binary_error(box.file, "program block", 0, "no program block found in the "
+                           "project (no block MAIN)")
+    cursor = Cursor(box.stream, box.file, "program block", match.start())
+    return read_program_block(cursor)
+
+
+def read_project_file(path: str | Path, limit: int) -> Project:
+    """Read the project file ``path`` (at most ``limit`` bytes)."""
+    from ..lang.limits import read_capped
+    return read_project(read_capped(path, limit), str(path))

@@ -22,6 +22,7 @@ from typing import Any
 from ..lang import ir
 from ..lang.sources import PROJECT_READERS
 from ..lang.stl import parse_program
+from ..lang.symbols import parse_symbols
 from .reader import PROJECT_SUFFIXES, Project, read_project, read_project_file
 
 __all__ = ["PROJECT_SUFFIXES", "Project", "load_project", "read_project",
@@ -34,7 +35,8 @@ def load_project(path: str, limit: int) -> tuple[ir.Program, Any, Any]:
     project = read_project_file(path, limit)
     program = parse_program(project.awl, path)
     program = ir.Program(program.pous, program.file, program.source, project.encoding)
-    return program, None, None
+    symbols = parse_symbols(project.symbols, path) if project.symbols else None
+    return program, symbols, None
 
 
 for _suffix in PROJECT_SUFFIXES:

@@ -22,6 +22,7 @@ from .awl import blocks_text
 from .container import Container, open_container
 from .program import Block, read_program_block
 from .stream import Cursor, binary_error
+from .tables import SymbolTables, read_symbol_tables
 
 __all__ = ["Project", "read_project", "PROJECT_SUFFIXES"]
 
@@ -45,6 +46,8 @@ class Project:
     awl: str
     #: the code page the project's strings were decoded with
     encoding: str
+    #: the user's symbol table as Micro/WIN exports it (tab-separated), or ""
+    symbols: str = ""
     notes: list[str] = field(default_factory=list)
 
 
@@ -56,22 +59,40 @@ def read_project(data: bytes, file: str) -> Project:
                            "their program in a layout this reader does not read: open the "
                            "project in Micro/WIN V4 and save it, or export it as STL (.awl)",
                            PlcConfigError)
-    blocks = _program(box)
-    raw = blocks_text(blocks)
-    decoded = decode_bytes(raw.encode("latin-1"), file)
+    cursor = _program_cursor(box)
+    blocks = read_program_block(cursor)
+    tables = read_symbol_tables(cursor)
+    for block in blocks:          # the block's title is its comment in the block-name table
+        block.comment = block.comment or tables.block_comments.get(block.name, "")
+    program, symbols = blocks_text(blocks), symbols_text(tables)
+    # one code page for the program and its symbols, detected as an export's
+    decoded = decode_bytes((program + symbols).encode("latin-1"), file)
+    codec = decoded.encoding
     notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
              "protected block, its interface without its code" for b in blocks if b.protected]
-    return Project(file, box.format, box.version, blocks, decoded.text, decoded.encoding,
-                   notes)
+    notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
+    return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
+                   _recode(symbols, codec), notes)
 
 
-def _program(box: Container) -> list[Block]:
+def _recode(text: str, codec: str) -> str:
+    return text.encode("latin-1").decode(codec, "replace")
+
+
+def symbols_text(tables: SymbolTables) -> str:
+    """The user's symbols as Micro/WIN's tab-separated export (CR LF)."""
+    rows = []
+    for name, address, comment in tables.symbols:
+        rows.append(f"{name}\t{address}\t{' '.join(comment.split())}".rstrip("\t"))
+    return "".join(row + "\r\n" for row in rows)
+
+
+def _program_cursor(box: Container) -> Cursor:
     match = _PROGRAM_BLOCK.search(box.stream)
     if match is None:
         raise binary_error(box.file, "program block", 0, "no program block found in the "
                            "project (no block MAIN)")
-    cursor = Cursor(box.stream, box.file, "program block", match.start())
-    return read_program_block(cursor)
+    return Cursor(box.stream, box.file, "program block", match.start())
 
 
 def read_project_file(path: str | Path, limit: int) -> Project:

@@ -21,6 +21,8 @@ from typing import Any
 
 from ..lang import ir
 from ..lang.sources import PROJECT_READERS
+from ..lang.codepage import string_codepage
+from ..lang.datablock import parse_datablock
 from ..lang.stl import parse_program
 from ..lang.symbols import parse_symbols
 from .reader import PROJECT_SUFFIXES, Project, read_project, read_project_file
@@ -36,7 +38,10 @@ def load_project(path: str, limit: int) -> tuple[ir.Program, Any, Any]:
     program = parse_program(project.awl, path)
     program = ir.Program(program.pous, program.file, program.source, project.encoding)
     symbols = parse_symbols(project.symbols, path) if project.symbols else None
-    return program, symbols, None
+    data = None
+    if project.data.strip():
+        data = parse_datablock(project.data, path, codepage=string_codepage(project.encoding))
+    return program, symbols, data
 
 
 for _suffix in PROJECT_SUFFIXES:

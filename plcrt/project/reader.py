@@ -20,6 +20,7 @@ from ..errors import PlcConfigError
 from ..lang.encoding import decode_bytes
 from .awl import blocks_text
 from .container import Container, open_container
+from .datapage import read_data_block
 from .program import Block, read_program_block
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
@@ -28,6 +29,12 @@ __all__ = ["Project", "read_project", "PROJECT_SUFFIXES"]
 
 #: file name endings read as project files
 PROJECT_SUFFIXES = (".mwp", ".smart")
+
+#: the start of the data block: version 2, a page count, a page (version
+#: 7 or 8, type 5000)
+_DATA_BLOCK = re.compile(rb"\x02..[\x07\x08]\x88\x13", re.S)
+#: the CPU named in the project, after the data block: "CPU 224 REL 02.01"
+_CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
 
 #: the start of the program block: version 2, a block count, then MAIN
 #: (block version 7 or 8, type 1000, number 0)
@@ -48,6 +55,10 @@ class Project:
     encoding: str
     #: the user's symbol table as Micro/WIN exports it (tab-separated), or ""
     symbols: str = ""
+    #: the data block as Micro/WIN exports it, or ""
+    data: str = ""
+    #: the CPU the project is for, as Micro/WIN names it ("CPU 224 REL 02.01")
+    cpu: str = ""
     notes: list[str] = field(default_factory=list)
 
 
@@ -64,15 +75,33 @@ def read_project(data: bytes, file: str) -> Project:
     tables = read_symbol_tables(cursor)
     for block in blocks:          # the block's title is its comment in the block-name table
         block.comment = block.comment or tables.block_comments.get(block.name, "")
+    data, cpu = _data_block(box, cursor.pos)
     program, symbols = blocks_text(blocks), symbols_text(tables)
-    # one code page for the program and its symbols, detected as an export's
-    decoded = decode_bytes((program + symbols).encode("latin-1"), file)
+    # one code page for the program and its tables, detected as an export's
+    decoded = decode_bytes((program + symbols + data).encode("latin-1"), file)
     codec = decoded.encoding
     notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
              "protected block, its interface without its code" for b in blocks if b.protected]
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
-                   _recode(symbols, codec), notes)
+                   _recode(symbols, codec), _recode(data, codec), cpu, notes)
+
+
+def _data_block(box: Container, start: int) -> tuple[str, str]:
+    """(data block text, CPU name) of the sections after the symbol tables
+    (the status charts between them are stepped over by finding the data
+    block's header)."""
+    match = _DATA_BLOCK.search(box.stream, start)
+    if match is None:
+        raise binary_error(box.file, "data block", start, "no data block found after the "
+                           "symbol tables")
+    cursor = Cursor(box.stream, box.file, "data block", match.start())
+    text = read_data_block(cursor)
+    cpu = _CPU.match(box.stream, cursor.pos)
+    name = ""
+    if cpu is not None and cpu.group(1)[0] == len(cpu.group(2)):
+        name = cpu.group(2).decode("ascii")
+    return text, name
 
 
 def _recode(text: str, codec: str) -> str:

@@ -33,7 +33,7 @@ __all__ = ["Container", "open_container", "MAX_STREAM"]
 
 #: largest decompressed project accepted (real projects are 10 KB to a
 #: few MB; the largest S7-200 program is 24 KB of code)
-MAX_STREAM = 64 * 1024 * 1024
+MAX_STREAM = 16 * 1024 * 1024
 
 #: (signature, version prefix) -> (format, password field, length offset)
 _LAYOUTS = {

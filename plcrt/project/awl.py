@@ -14,10 +14,13 @@ It reads nothing; :mod:`.program` does.
 
 from __future__ import annotations
 
+import re
+
 from .program import Block, Net
 
 __all__ = ["blocks_text"]
 
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 _HEADS = {"OB": ("ORGANIZATION_BLOCK", "END_ORGANIZATION_BLOCK"),
           "SBR": ("SUBROUTINE_BLOCK", "END_SUBROUTINE_BLOCK"),
           "INT": ("INTERRUPT_BLOCK", "END_INTERRUPT_BLOCK")}
@@ -26,18 +29,20 @@ _SECTIONS = (("IN", "VAR_INPUT"), ("IN_OUT", "VAR_IN_OUT"), ("OUT", "VAR_OUTPUT"
 
 
 def _one_line(text: str) -> str:
-    return " ".join(text.split())
+    """``text`` on one line: a name or title read from a project file
+    cannot start a line of its own (no statement is injected through it)."""
+    return _CONTROL.sub(" ", text).strip()
 
 
 def _comment_lines(text: str) -> list[str]:
-    return ["// " + line.rstrip() if line.strip() else "//"
-            for line in text.replace("\r\n", "\n").replace("\r", "\n").split("\n")]
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    return ["// " + _one_line(line) if _one_line(line) else "//" for line in lines]
 
 
 def _statement(mnemonic: str, operands: tuple[str, ...]) -> str:
     if not operands:
         return mnemonic
-    return f"{mnemonic:<6} {', '.join(operands)}"
+    return f"{mnemonic:<6} {', '.join(_one_line(o) for o in operands)}"
 
 
 def kept_networks(block: Block) -> list[Net]:
@@ -60,7 +65,7 @@ def block_text(block: Block) -> list[str]:
             lines.append(keyword)
             for _, vname, vtype, comment in rows:
                 note = f"\t// {_one_line(comment)}" if comment.strip() else ""
-                lines.append(f"{vname}:{vtype};{note}")
+                lines.append(f"{_one_line(vname)}:{vtype};{note}")
             lines.append("END_VAR")
     lines.append("BEGIN")
     # a block with a password is exported as Micro/WIN exports it: its

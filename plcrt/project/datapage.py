@@ -11,6 +11,7 @@ It reads nothing else; :mod:`.reader` finds the section.
 
 from __future__ import annotations
 
+import re
 import struct
 
 from .codes import WIDTH_LETTER
@@ -18,6 +19,7 @@ from .stream import Cursor
 
 __all__ = ["read_data_block"]
 
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 MAX_PAGES = 256
 MAX_ROWS = 65535
 MAX_TOKENS = 4096
@@ -103,7 +105,8 @@ def _token(c: Cursor) -> tuple[str, bool]:
     if kind in (0x0601, 0x0801):               # 'text' and "text"
         c.skip(4)
         quote = "'" if kind == 0x0601 else '"'
-        return quote + c.text(1) + quote, False
+        # on one line: a value cannot start a data line of its own
+        return quote + _CONTROL.sub(" ", c.text(1)) + quote, False
     value = c.u4()
     c.skip(1)
     if kind == 0x0101:

@@ -30,6 +30,7 @@ __all__ = ["Project", "read_project", "PROJECT_SUFFIXES"]
 #: file name endings read as project files
 PROJECT_SUFFIXES = (".mwp", ".smart")
 
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 #: the start of the data block: version 2, a page count, a page (version
 #: 7 or 8, type 5000)
 _DATA_BLOCK = re.compile(rb"\x02..[\x07\x08]\x88\x13", re.S)
@@ -112,7 +113,8 @@ def symbols_text(tables: SymbolTables) -> str:
     """The user's symbols as Micro/WIN's tab-separated export (CR LF)."""
     rows = []
     for name, address, comment in tables.symbols:
-        rows.append(f"{name}\t{address}\t{' '.join(comment.split())}".rstrip("\t"))
+        cells = (" ".join(_CONTROL.sub(" ", x).split()) for x in (name, address, comment))
+        rows.append("\t".join(cells).rstrip("\t"))
     return "".join(row + "\r\n" for row in rows)
 
 

@@ -36,7 +36,10 @@ def _runs() -> dict[int, str]:
 OPCODES: dict[int, str] = {
     **_runs(),
     0x20A: "NOT", 0x20B: "EU", 0x20D: "ED",
-    0x210: "ALD", 0x211: "LPS", 0x213: "LPP",
+    # 0x210 is OLD: the one use seen is an SR box's code, LD S1, LD R,
+    # NOT, A OUT, 0x210, = OUT, which is S1 OR (NOT R AND OUT).  ALD's
+    # code has not been seen (docs/project-files.md)
+    0x210: "OLD", 0x211: "LPS", 0x212: "LRD", 0x213: "LPP",
     0x214: "=", 0x215: "=I", 0x216: "S", 0x217: "SI", 0x218: "R", 0x219: "RI",
     0x230: "XMT", 0x231: "RCV", 0x234: "GPA", 0x235: "SPA", 0x236: "GIP", 0x237: "SIP",
     0x238: "GET", 0x239: "PUT",

@@ -38,10 +38,12 @@ O      M0.0
 LDN    I0.2
 AN     V10.1
 ON     SM0.5
-ALD
+OLD
 LPS
 AI     I0.3
 =      Q0.0
+LRD
+=      Q0.4
 LPP
 ANI    I0.4
 =I     Q0.1

@@ -109,9 +109,12 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
 def _project_reader(items: list[Any]) -> Callable[[str, int], Any] | None:
     """The project-file reader for a single file argument whose name ends
     in a registered ending, else None."""
-    if len(items) != 1 or not is_file_arg(items[0]):
-        return None
-    return PROJECT_READERS.get(Path(str(items[0])).suffix.lower())
+    readers = [PROJECT_READERS.get(Path(str(x)).suffix.lower()) if is_file_arg(x) else None
+               for x in items]
+    if len(items) > 1 and any(readers):
+        raise PlcConfigError("a project file (.mwp, .smart) holds a whole program: load it "
+                             "alone, not together with other program files")
+    return readers[0]
 
 
 def _merge(programs: list[ir.Program], encoding: str) -> ir.Program:

@@ -227,3 +227,17 @@ def test_errors_are_plc_errors(tmp_path: Path) -> None:
     bad.write_bytes(b"GJK\0R04.00" + bytes(60))
     with pytest.raises(PlcError):
         plcrt.load(bad)
+
+
+def test_a_project_is_loaded_alone(tmp_path: Path) -> None:
+    path = _write(tmp_path, EVERY_CODE, False)
+    with pytest.raises(PlcConfigError, match="load it alone"):
+        plcrt.load([path, ROOT / "programs" / "seal_in.awl"])
+
+
+def test_show_draws_a_project(tmp_path: Path, capsys) -> None:
+    """plcrt show (which parses without loading) reads a project too."""
+    path = _write(tmp_path, EVERY_CODE, False)
+    assert main(["show", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "OB1 (MAIN)" in out and "TON" in out and "T37" in out

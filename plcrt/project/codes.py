@@ -2,11 +2,13 @@
 operand widths, variable types.
 
 Data only.  Each instruction code below was seen in a project file next to
-the instruction Micro/WIN shows for it, or follows from a run of codes seen
-on both sides of it (the comparisons come in runs of three, LD/A/O, for
-``=``, ``<>``, ``>=``, ``<=``, ``>``, ``<``; the bit instructions in runs of
-three as well).  A code that is not in :data:`OPCODES` is refused with its
-byte offset rather than guessed (docs/project-files.md, "Instruction codes").
+the instruction Micro/WIN shows for it (its ladder cell, its symbol, the
+network's title), is listed by the public description of the format
+(wpyoga/s7-200-smart-project-file), or lies in a run of codes seen on both
+sides of it (the comparisons come in runs of three, LD/A/O, for ``=``,
+``<>``, ``>=``, ``<=``, ``>``, ``<``; the bit instructions in runs of three
+as well).  A code that is not in :data:`OPCODES` is refused with its byte
+offset rather than guessed (docs/project-files.md, "Instruction codes").
 """
 
 from __future__ import annotations

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ..errors import PlcConfigError
 from ..lang.encoding import decode_bytes
+from ..lang.limits import read_capped
 from .awl import blocks_text
 from .container import Container, open_container
 from .datapage import read_data_block
@@ -25,7 +26,7 @@ from .program import Block, read_program_block
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
 
-__all__ = ["Project", "read_project", "PROJECT_SUFFIXES"]
+__all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
 
 #: file name endings read as project files
 PROJECT_SUFFIXES = (".mwp", ".smart")
@@ -128,5 +129,4 @@ def _program_cursor(box: Container) -> Cursor:
 
 def read_project_file(path: str | Path, limit: int) -> Project:
     """Read the project file ``path`` (at most ``limit`` bytes)."""
-    from ..lang.limits import read_capped
     return read_project(read_capped(path, limit), str(path))

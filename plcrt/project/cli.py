@@ -22,6 +22,7 @@ from typing import Any
 
 from ..errors import PlcConfigError, SourceLoc
 from ..paths import check_path
+from ..safetext import printable
 
 __all__ = ["register", "cmd_export"]
 
@@ -57,8 +58,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     for path, text in outputs:
         if path:
             _write(path, text, codec)
-    for note in project.notes:
-        print(f"{args.project}: note: {note}", file=sys.stderr)
+    for note in project.notes:        # names read from the file: escaped
+        print(printable(f"{args.project}: note: {note}"), file=sys.stderr)
     return 0
 
 

@@ -8,6 +8,7 @@ must be the same IR network by network and run to the same memory image.
 
 from __future__ import annotations
 
+import dataclasses
 import random
 import zlib
 import sys
@@ -241,3 +242,16 @@ def test_show_draws_a_project(tmp_path: Path, capsys) -> None:
     assert main(["show", str(path)]) == 0
     out = capsys.readouterr().out
     assert "OB1 (MAIN)" in out and "TON" in out and "T37" in out
+
+
+def test_export_notes_escape_names_read_from_the_file(tmp_path: Path, capsys) -> None:
+    """A block name with a terminal escape is printed escaped."""
+    program = parse_program(EVERY_CODE, "x.awl")
+    sbr = program.pous[1]
+    evil = dataclasses.replace(sbr, name="S\x1b[31mX")
+    program = dataclasses.replace(program, pous=(program.pous[0], evil))
+    path = tmp_path / "e.mwp"
+    path.write_bytes(project_bytes(program, protected=("SBR0",)))
+    assert main(["export", str(path), "--awl", str(tmp_path / "e.awl")]) == 0
+    err = capsys.readouterr().err
+    assert "password" in err and "\x1b" not in err and "\\x1b" in err

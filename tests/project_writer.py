@@ -75,12 +75,17 @@ def statement(index: int, mnemonic: str, operands: tuple[str, ...]) -> bytes:
     return out
 
 
-def network(index: int, net: ir.Network) -> bytes:
+#: a ladder cell: a normally open contact with no operand
+CONTACT = (u1(0) + u1(0) + u1(0) + u2(0x103) + u2(0x14) + u1(0) + u1(3) + u1(0) + u2(0) + u1(0)
+           + u2(0x101) + u2(0))
+
+
+def network(index: int, net: ir.Network, drawn: bool = False) -> bytes:
     out = u2(index) + u2(0x102) + u2(4) + strl(net.title) + u1(0) + strl(net.comment)
     out += u1(1) + u2(0) + u1(0) + u2(0) + u1(2) + u4(0) + u2(0) + u2(len(net.insns))
     for i, insn in enumerate(net.insns):
         out += statement(i, insn.mnemonic, tuple(o.text for o in insn.operands))
-    return out + u1(1) + u2(0)
+    return out + u1(1) + (u2(1) + CONTACT if drawn else u2(0))
 
 
 def variable(v: ir.VarDecl) -> bytes:
@@ -89,7 +94,7 @@ def variable(v: ir.VarDecl) -> bytes:
             + bytes(7))
 
 
-def block(pou: ir.Pou, smart: bool, protected: bool = False) -> bytes:
+def block(pou: ir.Pou, smart: bool, protected: bool = False, drawn: tuple = ()) -> bytes:
     number = 0 if pou.kind == "OB" else pou.number
     out = u1(8 if smart else 7) + u2(_KIND[pou.kind]) + u2(0) + u2(number)
     out += u4(0x401 if protected else 1) + bytes(16) + (u4(0) if smart else b"")
@@ -97,7 +102,7 @@ def block(pou: ir.Pou, smart: bool, protected: bool = False) -> bytes:
     out += bytes(89) if smart else u1(0) + u4(0)
     out += bytes(32) + u1(0) + u2(len(pou.networks))
     for i, net in enumerate(pou.networks):
-        out += network(i, net)
+        out += network(i, net, (pou.ident, i + 1) in drawn)
     out += u1(0) + u2(len(pou.variables)) + b"".join(variable(v) for v in pou.variables)
     return out + u4(0) + u4(1) + u4(100)
 
@@ -132,11 +137,14 @@ def data_section(rows: list[tuple[str, list[int], str]]) -> bytes:
 
 def stream(program: ir.Program, *, smart: bool = False,
            symbols: list[tuple[str, str, str]] = (), data: list = (),
-           cpu: str = "CPU 224 REL 02.01", protected: tuple[str, ...] = ()) -> bytes:
-    """The decompressed project: filler, program block, symbols, data, CPU."""
+           cpu: str = "CPU 224 REL 02.01", protected: tuple[str, ...] = (),
+           drawn: tuple = ()) -> bytes:
+    """The decompressed project: filler, program block, symbols, data, CPU.
+    ``drawn`` lists (block, network) pairs given a ladder contact besides
+    their code."""
     body = b"\x10" + b"\x55" * 64                   # stands for preamble and system block
     body += u1(2) + u2(len(program.pous))
-    body += b"".join(block(p, smart, p.ident in protected) for p in program.pous)
+    body += b"".join(block(p, smart, p.ident in protected, drawn) for p in program.pous)
     body += symbol_section(list(symbols))
     body += b"\x03" + b"\x55" * 16                  # stands for the status charts
     body += data_section(list(data)) + u1(0) + strl(cpu) + bytes(16)

@@ -31,6 +31,8 @@ MAX_LABELS = 16
 
 _KINDS = {0x3E8: "OB", 0x3E9: "SBR", 0x3EA: "INT"}
 _NETWORK_KINDS = {0x101: "FBD", 0x102: "LAD", 0x106: "STL"}
+#: cell kinds that draw no instruction: an empty cell (or arrow), a wire
+_WIRES = frozenset((0x0, 0x1))
 #: a block's protection flags: 0x200/0x400 mark a block with a password
 _PROTECTED = 0x600
 
@@ -126,6 +128,7 @@ def _block(c: Cursor) -> Block:
 
 
 def _network(c: Cursor, block: Block, index: int) -> Net:
+    start = c.pos
     c.u2()
     at = c.pos
     editor = _NETWORK_KINDS.get(c.u2())
@@ -164,27 +167,37 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
                           f"0x{code:x} is not one this reader knows", code_at)
         net.statements.append((mnemonic, tuple(operands)))
     c.expect(1, 1, "network body")
+    drawn = 0                  # STL lines, or cells other than empty and wire
     if editor == "STL":
         for _ in range(c.count(2, 65535, "number of STL lines")):
             if c.u2() != 0xFFFF:
+                drawn += 1
                 c.skip(2 + 2 + 2 + 4)
                 c.expect(0x101, 2, "STL line")
                 _operands(c, compiled=False)
     else:
         for _ in range(c.count(2, 65535, "number of cells")):
-            _cell(c)
+            drawn += _cell(c) not in _WIRES
+    if drawn and not net.statements:
+        # the editor holds a program the CPU would not get: never run it as empty
+        raise c.error(f"network {index + 1} of {block.ident} has {editor} content but no "
+                      "compiled code (an incomplete network Micro/WIN did not compile): "
+                      "compile the project in Micro/WIN and save it", start)
     return net
 
 
-def _cell(c: Cursor) -> None:
-    """Step over one ladder or FBD cell (position, kind, labels, operands)."""
+def _cell(c: Cursor) -> int:
+    """Step over one ladder or FBD cell (position, kind, labels, operands);
+    returns its kind."""
     c.expect(0, 1, "cell")
     c.skip(2)
     c.expect(0x103, 2, "cell")
-    c.skip(2 + 1 + 1 + 1 + 2)
+    kind = c.u2()
+    c.skip(1 + 1 + 1 + 2)
     c.skip(53 * c.count(1, MAX_LABELS, "number of cell labels"))
     c.expect(0x101, 2, "cell")
     _operands(c, compiled=True)
+    return kind
 
 
 def _operands(c: Cursor, *, compiled: bool) -> list[str]:

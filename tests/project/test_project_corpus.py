@@ -53,8 +53,9 @@ REFUSED = {
     f"{ESDRAS}Proyecto Final__PT1_IIIB_SDL.mwp": (PlcConfigError, "Micro/WIN V3"),
     "YashviArya12__PLC_Ladder_Logic_Program_.Projects__PLC_PROJECTS__Analog to digital "
     "input__analog.mwp": (PlcConfigError, "Micro/WIN V3"),
-    # a SMART math code whose mnemonic is not known (docs/project-files.md)
-    "Kity23__test__项目 1.smart": (PlcSyntaxError, "network 1 of SBR1: instruction code 0x2db"),
+    # a drawn network Micro/WIN did not compile (docs/project-files.md)
+    "Kity23__test__项目 1.smart": (PlcSyntaxError, "network 4 of SBR0 has LAD content but no "
+                                                 "compiled code"),
 }
 #: project -> its export, as SOURCES.md pairs them ("export" quality)
 PAIRS = {f"{TARIQ}.mwp": f"{TARIQ}.awl"}

@@ -255,3 +255,15 @@ def test_export_notes_escape_names_read_from_the_file(tmp_path: Path, capsys) ->
     assert main(["export", str(path), "--awl", str(tmp_path / "e.awl")]) == 0
     err = capsys.readouterr().err
     assert "password" in err and "\x1b" not in err and "\\x1b" in err
+
+
+def test_a_drawn_network_without_code_is_refused() -> None:
+    """Ladder cells without compiled code (a network Micro/WIN did not
+    compile) are refused, not run as an empty network; a network with both
+    loads."""
+    text = EVERY_CODE.replace("Network 5 // a call\nLD     I1.4\nCALL   SBR0\n", "Network 5 // empty\n")
+    program = parse_program(text, "x.awl")
+    assert not program.pous[0].networks[4].insns
+    with pytest.raises(PlcSyntaxError, match="network 5 of OB1 has LAD content but no compiled"):
+        read_project(container(stream(program, drawn=(("OB1", 5),))), "p.mwp")
+    read_project(container(stream(program, drawn=(("OB1", 4),))), "p.mwp")

@@ -107,7 +107,7 @@ def _main(argv: list[str]) -> int:
 #: Subcommands defined beside the feature they present; each module has
 #: ``register(sub)`` adding its parser with ``func`` set.
 _COMMAND_MODULES = ("plcrt.view.cli", "plcrt.debug.cli", "plcrt.trace.cli",
-                    "plcrt.devices.cia402.cli", "plcrt.web.cli")
+                    "plcrt.devices.cia402.cli", "plcrt.web.cli", "plcrt.project.cli")
 
 
 def _build_parser() -> _Parser:

@@ -29,6 +29,7 @@ from .engine.runtime import Plc, parse_sources
 from .engine.values import check_load_options, source_items
 from .lang.limits import file_limit
 from .lang.sources import read_program
+from .project import frontend as _project  # noqa: F401  registers the .mwp/.smart reader
 from .memory import cpu_model
 
 __all__ = ["Plc", "build_devices", "attach_port_devices", "is_plant", "load", "parse_sources"]

@@ -25,7 +25,13 @@ from .limits import check_text_size, file_limit
 from .stl import parse_program
 from .symbols import parse_symbols
 
-__all__ = ["is_file_arg", "read_program"]
+__all__ = ["PROJECT_READERS", "is_file_arg", "read_program"]
+
+#: front ends for project files, by file name ending (``.mwp``): each takes
+#: the path and the size limit and returns (program, symbols or None, data
+#: block or None).  :mod:`plcrt.project` fills it when imported (it sits
+#: above this package and is imported by :mod:`plcrt.loader`)
+PROJECT_READERS: dict[str, Callable[[str, int], tuple[ir.Program, Any, Any]]] = {}
 
 
 def is_file_arg(x: Any) -> bool:
@@ -55,6 +61,15 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
     items = [source] if isinstance(source, (str, Path)) else list(source)
     if not items:
         raise PlcConfigError("no program given")
+    project = _project_reader(items)
+    if project is not None:       # a project file: program and its tables
+        program, own_symbols, own_data = project(str(items[0]), limit)
+        if symbols is None and data is None:
+            return program, own_symbols, own_data
+        _, symbols, data = read_program(program.source, symbols, data, encoding=encoding,
+                                        max_bytes=max_bytes, v_bytes=v_bytes)
+        return (program, own_symbols if symbols is None else symbols,
+                own_data if data is None else data)
     tables = [x if isinstance(x, (str, Path)) else None for x in (symbols, data)]
     files = [x for x in items + tables if x is not None and is_file_arg(x)]
     for x in items + tables:
@@ -89,6 +104,17 @@ def read_program(source: str | Path | Sequence[str | Path], symbols: Any = None,
         data = _parse(partial(parse_datablock, v_bytes=v_bytes, codepage=codepage),
                       tables[1], table)
     return program, symbols, data
+
+
+def _project_reader(items: list[Any]) -> Callable[[str, int], Any] | None:
+    """The project-file reader for a single file argument whose name ends
+    in a registered ending, else None."""
+    readers = [PROJECT_READERS.get(Path(str(x)).suffix.lower()) if is_file_arg(x) else None
+               for x in items]
+    if len(items) > 1 and any(readers):
+        raise PlcConfigError("a project file (.mwp, .smart) holds a whole program: load it "
+                             "alone, not together with other program files")
+    return readers[0]
 
 
 def _merge(programs: list[ir.Program], encoding: str) -> ir.Program:

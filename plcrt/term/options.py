@@ -39,7 +39,8 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
     """The program, symbol table, encoding, data, CPU and plant options
     commands share."""
     p.add_argument("programs", nargs="+", metavar="PROGRAM",
-                   help="STL export (.awl); several files are merged into one program")
+                   help="STL export (.awl), or a project (.mwp, .smart); several "
+                        ".awl files are merged into one program")
     p.add_argument("--symbols", metavar="F", help="symbol table (.sdf CSV or Micro/WIN tab list)")
     p.add_argument("--encoding", metavar="NAME",
                    help="text encoding of the program and table files, e.g. cp1252, gbk, "

@@ -127,6 +127,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 def _parse(args: argparse.Namespace) -> tuple[Any, Any]:
     """(program, symbol table or None) of the command line, parsed only."""
+    from ..project import frontend  # noqa: F401  registers the .mwp/.smart reader
     from ..lang.limits import file_limit
     from ..lang.sources import read_program
 

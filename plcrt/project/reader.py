@@ -1,0 +1,132 @@
+"""Read a project file: the container, then its sections in order.
+
+:func:`read_project` opens the container (:mod:`.container`), finds the
+program block in the inflated stream and reads it (:mod:`.program`), then
+writes the blocks as STL export text (:mod:`.awl`) whose code page is
+detected as an export's is.  The result holds that text, the blocks and
+what the header says; :func:`plcrt.project.load_project` parses it.
+
+Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
+layout, which is not read: they are refused with a message saying so.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import PlcConfigError
+from ..lang.encoding import decode_bytes
+from ..lang.limits import read_capped
+from .awl import blocks_text
+from .container import Container, open_container
+from .datapage import read_data_block
+from .program import Block, read_program_block
+from .stream import Cursor, binary_error
+from .tables import SymbolTables, read_symbol_tables
+
+__all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
+
+#: file name endings read as project files
+PROJECT_SUFFIXES = (".mwp", ".smart")
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+#: the start of the data block: version 2, a page count, a page (version
+#: 7 or 8, type 5000)
+_DATA_BLOCK = re.compile(rb"\x02..[\x07\x08]\x88\x13", re.S)
+#: the CPU named in the project, after the data block: "CPU 224 REL 02.01"
+_CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
+
+#: the start of the program block: version 2, a block count, then MAIN
+#: (block version 7 or 8, type 1000, number 0)
+_PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
+
+
+@dataclass
+class Project:
+    """A project file, read."""
+
+    file: str
+    format: str
+    version: str
+    blocks: list[Block]
+    #: the program as its STL export (the code page's characters)
+    awl: str
+    #: the code page the project's strings were decoded with
+    encoding: str
+    #: the user's symbol table as Micro/WIN exports it (tab-separated), or ""
+    symbols: str = ""
+    #: the data block as Micro/WIN exports it, or ""
+    data: str = ""
+    #: the CPU the project is for, as Micro/WIN names it ("CPU 224 REL 02.01")
+    cpu: str = ""
+    notes: list[str] = field(default_factory=list)
+
+
+def read_project(data: bytes, file: str) -> Project:
+    """The project in ``data`` (the bytes of a whole project file)."""
+    box = open_container(data, file)
+    if box.format == "Micro/WIN V3":
+        raise binary_error(file, "program block", 0, "Micro/WIN V3 projects (R03.xx) keep "
+                           "their program in a layout this reader does not read: open the "
+                           "project in Micro/WIN V4 and save it, or export it as STL (.awl)",
+                           PlcConfigError)
+    cursor = _program_cursor(box)
+    blocks = read_program_block(cursor)
+    tables = read_symbol_tables(cursor)
+    for block in blocks:          # the block's title is its comment in the block-name table
+        block.comment = block.comment or tables.block_comments.get(block.name, "")
+    data, cpu = _data_block(box, cursor.pos)
+    program, symbols = blocks_text(blocks), symbols_text(tables)
+    # one code page for the program and its tables, detected as an export's
+    decoded = decode_bytes((program + symbols + data).encode("latin-1"), file)
+    codec = decoded.encoding
+    notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
+             "protected block, its interface without its code" for b in blocks if b.protected]
+    notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
+    return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
+                   _recode(symbols, codec), _recode(data, codec), cpu, notes)
+
+
+def _data_block(box: Container, start: int) -> tuple[str, str]:
+    """(data block text, CPU name) of the sections after the symbol tables
+    (the status charts between them are stepped over by finding the data
+    block's header)."""
+    match = _DATA_BLOCK.search(box.stream, start)
+    if match is None:
+        raise binary_error(box.file, "data block", start, "no data block found after the "
+                           "symbol tables")
+    cursor = Cursor(box.stream, box.file, "data block", match.start())
+    text = read_data_block(cursor)
+    cpu = _CPU.match(box.stream, cursor.pos)
+    name = ""
+    if cpu is not None and cpu.group(1)[0] == len(cpu.group(2)):
+        name = cpu.group(2).decode("ascii")
+    return text, name
+
+
+def _recode(text: str, codec: str) -> str:
+    return text.encode("latin-1").decode(codec, "replace")
+
+
+def symbols_text(tables: SymbolTables) -> str:
+    """The user's symbols as Micro/WIN's tab-separated export (CR LF)."""
+    rows = []
+    for name, address, comment in tables.symbols:
+        cells = (" ".join(_CONTROL.sub(" ", x).split()) for x in (name, address, comment))
+        rows.append("\t".join(cells).rstrip("\t"))
+    return "".join(row + "\r\n" for row in rows)
+
+
+def _program_cursor(box: Container) -> Cursor:
+    match = _PROGRAM_BLOCK.search(box.stream)
+    if match is None:
+        raise binary_error(box.file, "program block", 0, "no program block found in the "
+                           "project (no block MAIN)")
+    return Cursor(box.stream, box.file, "program block", match.start())
+
+
+def read_project_file(path: str | Path, limit: int) -> Project:
+    """Read the project file ``path`` (at most ``limit`` bytes)."""
+    return read_project(read_capped(path, limit), str(path))

@@ -1,0 +1,138 @@
+"""The project reader against the corpus of real project files
+(shared/corpus/mwp, beside the checkout; ``PLCRT_CORPUS`` names another
+corpus folder).  Skipped where the corpus or a file is absent.
+
+* every Micro/WIN V4 and SMART V2 project of it loads, compiles, and its
+  ``plcrt export`` re-loads to the same IR and runs to the same memory image;
+* a project published with its own ``.awl`` export has the export's blocks,
+  block titles, networks, network titles and comments, and (where the two
+  files are the same revision) its code, network by network, and the same
+  memory image after 300 scans of the same stimuli;
+* what SOURCES.md and the strings of the files say (CPU, symbols) is read.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import sys
+from pathlib import Path
+
+import pytest
+
+import plcrt
+from plcrt.cli import main
+from plcrt.errors import PlcConfigError, PlcSyntaxError
+from plcrt.project import read_project
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_project_load import ir_of  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+_ENV = os.environ.get("PLCRT_CORPUS")
+CORPUS = (Path(_ENV) if _ENV else ROOT.parent / "shared" / "corpus") / "mwp"
+
+TARIQ = "tariqrm__Object-sorting-on-conveyor-belt-S7-200-PLC__EN21435522"
+HAMTECH = "hamtech221__Traffic-Light-System-PLC-Ladder-Logic-__Files__TRAFFIC"
+ESDRAS = "santiagoesdras__Practica_1_taller__"
+
+#: projects read: file -> the CPU SOURCES.md (or the file's strings) names
+READ = {
+    f"{TARIQ}.mwp": "CPU 222 REL 02.01",
+    f"{HAMTECH}_LIGHT.mwp": "CPU 224 REL 02.00",
+    "zcdlab__MCU-PLC-Some-Small-Project__抢答器.mwp": "CPU 221 REL 01.10",
+    "Electro-Industrial-Works__PLC-Practical-Projects__Bai_5_Mo_rong_Toggle_1_nut+Chong_doi"
+    "+Lockout+Counter__Vol1_Proj05Ex_LAD_05_toggle_debounce.mwp": "CPU 224 REL 02.01",
+    "ammardab3an__Step7-Micro-Win__Projects__S7-200 smart__scr.smart": "CPU ST40",
+}
+#: projects refused, and the words of the refusal
+REFUSED = {
+    "Belita-Lili__PracticasPLC_cecyt3__Proyecto1.mwp": (PlcConfigError, "Micro/WIN V3"),
+    f"{ESDRAS}Practica 1.mwp": (PlcConfigError, "Micro/WIN V3"),
+    f"{ESDRAS}Proyecto Esdras__Practica 1.mwp": (PlcConfigError, "Micro/WIN V3"),
+    f"{ESDRAS}Proyecto Final__PT1_IIIB_SDL.mwp": (PlcConfigError, "Micro/WIN V3"),
+    "YashviArya12__PLC_Ladder_Logic_Program_.Projects__PLC_PROJECTS__Analog to digital "
+    "input__analog.mwp": (PlcConfigError, "Micro/WIN V3"),
+    # a drawn network Micro/WIN did not compile (docs/project-files.md)
+    "Kity23__test__项目 1.smart": (PlcSyntaxError, "network 4 of SBR0 has LAD content but no "
+                                                 "compiled code"),
+}
+#: project -> its export, as SOURCES.md pairs them ("export" quality)
+PAIRS = {f"{TARIQ}.mwp": f"{TARIQ}.awl"}
+#: pairs whose files are different revisions of the project: why
+REVISIONS = {
+    f"{TARIQ}.mwp": "the project's ladder cells and compiled code agree with each other and "
+                    "not with the export (network 3 holds a TON T38 box and network 5 a TOF "
+                    "T39 box; the export has one TON T37): two revisions of the project",
+}
+
+
+def _file(name: str) -> Path:
+    path = CORPUS / name
+    if not path.is_file():
+        pytest.skip(f"corpus file not found: {path}")
+    return path
+
+
+@pytest.mark.parametrize("name", sorted(READ))
+def test_corpus_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -> None:
+    path = _file(name)
+    project = read_project(path.read_bytes(), str(path))
+    assert project.cpu == READ[name]
+    plc = plcrt.load(path)
+    out = [tmp_path / n for n in ("o.awl", "o.txt", "o.db")]
+    assert main(["export", str(path), "--awl", str(out[0]), "--symbols", str(out[1]),
+                 "--data", str(out[2])]) == 0
+    again = plcrt.load(out[0], symbols=out[1] if out[1].stat().st_size else None,
+                       data=out[2])
+    assert ir_of(again.program) == ir_of(plc.program)
+    _same_run(plc, again, 300)
+
+
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_corpus_projects_not_read_are_refused_by_name(name: str) -> None:
+    path = _file(name)
+    kind, words = REFUSED[name]
+    with pytest.raises(kind, match=words) as e:
+        plcrt.load(path)
+    assert e.value.loc.file == str(path) and "byte 0x" in e.value.message
+
+
+@pytest.mark.parametrize("name", sorted(PAIRS))
+def test_project_is_its_own_export(name: str) -> None:
+    """Blocks, titles, networks and comments equal the export's; the code
+    too where the two files are one revision."""
+    project, export = plcrt.load(_file(name)), plcrt.load(_file(PAIRS[name]))
+    shape = [[(p.ident, p.name, p.title)] + [(n.number, n.title, n.comment) for n in p.networks]
+             for p in project.program.pous]
+    assert shape == [[(p.ident, p.name, p.title)] + [(n.number, n.title, n.comment)
+                                                     for n in p.networks]
+                     for p in export.program.pous]
+    if name in REVISIONS:
+        assert ir_of(project.program) != ir_of(export.program)
+        pytest.skip(f"code not compared: {REVISIONS[name]}")
+    assert ir_of(project.program) == ir_of(export.program)
+    _same_run(project, export, 300)
+
+
+def test_symbols_of_a_project() -> None:
+    """The symbol table's names, addresses and comments (the names and
+    comments are strings of the file; the Chinese ones in GBK)."""
+    tariq = read_project(_file(f"{TARIQ}.mwp").read_bytes(), "t.mwp")
+    assert tariq.symbols.startswith("START\tI0.0\tstart button\r\nSTOP_\tI0.1\tstop button\r\n")
+    zcd = plcrt.load(_file("zcdlab__MCU-PLC-Some-Small-Project__抢答器.mwp"))
+    assert zcd.program.encoding == "gbk"
+    assert zcd.program.pous[0].name == "主程序"
+    assert zcd.symbols is not None and zcd.symbols.lookup("复位按键").address == "I0.3"
+
+
+def _same_run(a, b, scans: int) -> None:
+    rng = random.Random(28)
+    for _ in range(scans):
+        for bit in range(16):
+            value = rng.random() < 0.3
+            a.write(f"I{bit // 8}.{bit % 8}", value)
+            b.write(f"I{bit // 8}.{bit % 8}", value)
+        a.scan()
+        b.scan()
+    assert a.mem.snapshot().areas == b.mem.snapshot().areas

@@ -1,0 +1,155 @@
+"""A fuzz of the project-file reader: truncated, bit-flipped and
+length-forged files, and zlib bombs, end in a PlcError (or load) within a
+time and memory bound; never another exception, never a hang.
+
+Mutants are drawn from a seeded generator, so a failure names the one
+mutant to look at.  ``PLCRT_FUZZ_PROJECTS`` (default 25) says how many
+mutants of each kind are tried per seed file, ``PLCRT_FUZZ_SEED`` draws
+other ones: ``PLCRT_FUZZ_PROJECTS=20000 pytest tests/project/test_project_fuzz.py``
+is the long run.  The seeds are the tests' own project files and, where
+the shared corpus is present, one ``.mwp`` and one ``.smart`` of it (every
+project file of it when ``PLCRT_FUZZ_PROJECTS`` is set).  Memory is traced
+for every tenth mutant and for the bombs (tracing costs time).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import random
+import struct
+import sys
+import time
+import tracemalloc
+import zlib
+from pathlib import Path
+
+import pytest
+
+from plcrt.errors import PlcError
+from plcrt.lang.stl import parse_program
+from plcrt.project import read_project
+from plcrt.project.container import MAX_STREAM
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from project_writer import container, project_bytes  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
+MUTANTS = int(os.environ.get("PLCRT_FUZZ_PROJECTS", "25"))
+LONG = "PLCRT_FUZZ_PROJECTS" in os.environ
+SEED = int(os.environ.get("PLCRT_FUZZ_SEED", "28"))
+#: per mutant: wall-clock seconds and traced peak memory
+TIME_BOUND = 5.0
+MEMORY_BOUND = 3 * MAX_STREAM + (16 << 20)
+
+
+def _seeds() -> dict[str, bytes]:
+    from test_project_load import EVERY_CODE
+    program = parse_program(EVERY_CODE, "x.awl")
+    seeds = {"own.mwp": project_bytes(program, symbols=[("A", "I0.0", "a")],
+                                      data=[("VW0", [1, 2], "c")]),
+             "own.smart": project_bytes(program, smart=True)}
+    env = os.environ.get("PLCRT_CORPUS")
+    folder = Path(env) / "mwp" if env else CORPUS
+    if folder.is_dir():
+        for f in sorted(folder.iterdir()):
+            data = f.read_bytes() if f.suffix in (".mwp", ".smart") else b""
+            if data[:8] in (b"GJK\0R04.", b"SH3\0R02.") and (
+                    LONG or not any(n.endswith(f.suffix) for n in seeds if "~" in n)):
+                seeds[f"corpus~{f.name}"] = data
+    return seeds
+
+
+SEEDS = _seeds()
+
+
+def _split(data: bytes) -> tuple[bytes, bytes]:
+    """(header up to the length field, decompressed stream)."""
+    at = {b"GJK\0R04.": 0x34, b"GJK\0R03.": 0x10, b"SH3\0R02.": 0x6C}[data[:8]]
+    return data[:at], zlib.decompress(data[at + 4:])
+
+
+def _check(data: bytes, name: str, traced: bool = True) -> None:
+    """Reading ``data`` loads or raises a PlcError naming the file, within
+    the bounds (memory only when ``traced``)."""
+    if traced:
+        tracemalloc.start()
+    start = time.perf_counter()
+    try:
+        project = read_project(data, name)
+        parse_program(project.awl, name)
+    except PlcError as e:
+        assert e.loc is None or e.loc.file == name
+    finally:
+        peak = tracemalloc.get_traced_memory()[1] if traced else 0
+        tracemalloc.stop()
+    elapsed = time.perf_counter() - start
+    assert elapsed < TIME_BOUND, f"{name}: {elapsed:.1f} s"
+    assert peak < MEMORY_BOUND, f"{name}: {peak >> 20} MiB"
+
+
+def _mutants(kind: str, seed_name: str, rng: random.Random) -> list[tuple[str, bytes]]:
+    data = SEEDS[seed_name]
+    head, body = _split(data)
+    out = []
+    for k in range(MUTANTS):
+        if kind == "truncated":           # the file or its stream cut anywhere
+            if k % 2:
+                mutant = data[:rng.randrange(len(data))]
+            else:
+                cut = body[:rng.randrange(len(body))]
+                mutant = head + struct.pack("<I", len(cut)) + zlib.compress(cut)
+        elif kind == "flipped":           # bits of the stream (the sections)
+            raw = bytearray(body)
+            for _ in range(rng.randint(1, 8)):
+                raw[rng.randrange(len(raw))] ^= 1 << rng.randrange(8)
+            mutant = head + struct.pack("<I", len(raw)) + zlib.compress(bytes(raw))
+        elif kind == "forged":            # counts and lengths set to extremes
+            raw = bytearray(body)
+            for _ in range(rng.randint(1, 4)):
+                at = rng.randrange(len(raw) - 4)
+                width = rng.choice((1, 2, 4))
+                raw[at:at + width] = rng.choice((b"\xff", b"\x00", b"\x7f")) * width
+            mutant = head + struct.pack("<I", len(raw)) + zlib.compress(bytes(raw))
+        else:                             # the header's length field forged
+            forged = rng.choice((0, 1, len(body) - 1, len(body) + 1, MAX_STREAM,
+                                 MAX_STREAM + 1, 0xFFFFFFFF, rng.randrange(1 << 32)))
+            mutant = head + struct.pack("<I", forged) + data[len(head) + 4:]
+        out.append((f"{seed_name}~{kind}{k}", mutant))
+    return out
+
+
+@pytest.mark.parametrize("seed_name", sorted(SEEDS))
+@pytest.mark.parametrize("kind", ["truncated", "flipped", "forged", "length"])
+def test_mutants_end_in_plc_errors(kind: str, seed_name: str) -> None:
+    rng = random.Random(f"{SEED}/{kind}/{seed_name}")
+    for k, (name, mutant) in enumerate(_mutants(kind, seed_name, rng)):
+        _check(mutant, name, traced=k % 10 == 0)
+
+
+@functools.cache
+def _bomb() -> bytes:
+    """256 MiB of zeros, compressed (about 256 KB)."""
+    bomb = zlib.compressobj(9)
+    return b"".join(bomb.compress(bytes(1 << 20)) for _ in range(256)) + bomb.flush()
+
+
+@pytest.mark.parametrize("declared", [MAX_STREAM + 1, 64, MAX_STREAM])
+def test_zlib_bombs_are_bounded(declared: int) -> None:
+    """A stream of 256 MiB of zeros is never inflated past what the header
+    declares, nor past MAX_STREAM."""
+    packed = _bomb()
+    head = b"GJK\0R04.00" + bytes(26) + b"\xaa\xaa\0\0" * 4
+    _check(head + struct.pack("<I", declared) + packed, "bomb.mwp")
+    smart_head = b"SH3\0R02.04.00.00" + bytes(26 + 66)
+    _check(smart_head + struct.pack("<I", declared) + packed, "bomb.smart")
+
+
+def test_a_stream_longer_than_declared_is_refused() -> None:
+    program = parse_program("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\n"
+                            "= Q0.0\nEND_ORGANIZATION_BLOCK\n", "x.awl")
+    data = project_bytes(program)
+    head, body = _split(data)
+    with pytest.raises(PlcError, match="not the 10 its header declares"):
+        read_project(container(body, declared=10), "x.mwp")

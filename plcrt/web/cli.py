@@ -57,6 +57,13 @@ def register(sub: Any) -> None:
     net.add_argument("--lockstep", metavar="[HOST:]PORT",
                      help="lockstep server: a client advances the PLC step by step "
                           "(JSON lines; plcrt.net.client.LockstepClient)")
+    net.add_argument("--modbus-map", metavar="FILE",
+                     help="a custom Modbus address map (TOML; docs/network.md) instead of "
+                          "the slave library's")
+    net.add_argument("--serial", type=int, action="append", default=[], metavar="PORT",
+                     help="put CPU port PORT (0 or 1) on a pseudo-terminal, so a serial "
+                          "program (a Modbus RTU master, a terminal) talks to the program's "
+                          "freeport or MBUS_SLAVE through /dev/pts/N (repeatable)")
     net.add_argument("--no-panel", action="store_true",
                      help="no browser panel: only the network servers")
     net.add_argument("--speed", default="realtime", metavar="SPEED",
@@ -149,22 +156,22 @@ def cmd_serve(args: argparse.Namespace) -> int:
             raise PlcConfigError(f"--port must be between 0 and 65535, got {args.port}")
         servers = _server_options(args)
         if args.no_panel:
-            if not servers:
-                raise PlcConfigError("--no-panel: name a server to run (--s7, --modbus or "
-                                     "--lockstep)")
+            if not servers and not args.serial:
+                raise PlcConfigError("--no-panel: name a server to run (--s7, --modbus, "
+                                     "--lockstep or --serial)")
             return _serve_headless(args, servers, EXIT_OK)
         try:
             import aiohttp  # noqa: F401
         except ImportError:
             raise PlcConfigError("plcrt serve needs aiohttp: pip install aiohttp") from None
         from ..net.door import ScanDoor
-        from ..net.host import Serving
         from ..net.runner import parse_speed
         speed = parse_speed(args.speed)
         door = ScanDoor()
         panel = build_panel(args, door)
-        if servers:
-            serving = Serving(panel.session.plc, servers, runner=False, door=door).start()
+        if servers or args.serial:
+            serving = _serving(panel.session.plc, servers, args, runner=False,
+                               door=door).start()
             _say_servers(serving)
             if speed == "lockstep":   # lockstep clients step it on the panel's thread
                 door.speed = "lockstep"
@@ -186,6 +193,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
 def _server_options(args: argparse.Namespace) -> dict[str, Any]:
     """The network servers the command line names, with their options."""
+    from ..errors import PlcConfigError
     from ..net.options import Listen, ServerOptions, WriteGuard, exposed, parse_listen, \
         parse_ranges
     guard = WriteGuard(read_only=args.read_only,
@@ -203,11 +211,31 @@ def _server_options(args: argparse.Namespace) -> dict[str, Any]:
                   f"who can reach this address can read and write the PLC", file=sys.stderr)
         out[name] = ServerOptions(listen=listen, max_connections=args.max_connections,
                                   idle_timeout=args.idle_timeout, guard=guard)
+    if args.modbus_map is not None:
+        from ..net.modbus import with_map
+        if "modbus" not in out:
+            raise PlcConfigError("--modbus-map needs a Modbus server (--modbus)")
+        out["modbus"] = with_map(out["modbus"], args.modbus_map)
     return out
+
+
+def _serving(plc: Any, servers: dict[str, Any], args: argparse.Namespace,
+             **kw: Any) -> Any:
+    """The servers (and ``--serial`` ports) of the command line, not started."""
+    from ..net.host import Serving
+    from ..net.serial import pty_services
+    serving = Serving(plc, servers, **kw)
+    if args.serial:
+        serving.services.update(pty_services(serving.door, plc,
+                                             {n: "pty" for n in args.serial}))
+    return serving
 
 
 def _say_servers(serving: Any) -> None:
     for name, (host, port) in serving.addresses.items():
+        if name.startswith("serial"):      # a port on a pseudo-terminal: its path
+            print(f"plcrt port {name[6:]}: {host}", flush=True)
+            continue
         shown = f"[{host}]" if ":" in host else host
         print(f"plcrt {name} server: {shown}:{port}", flush=True)
 
@@ -224,7 +252,6 @@ def _serve_headless(args: argparse.Namespace, servers: dict[str, Any], ok: int) 
     import signal
     import threading
 
-    from ..net.host import Serving
     from ..term.options import load_from_args
     from ..term.report import print_diagnostics
 
@@ -233,7 +260,7 @@ def _serve_headless(args: argparse.Namespace, servers: dict[str, Any], ok: int) 
     done = threading.Event()
     previous = signal.signal(signal.SIGTERM, lambda *_: done.set())
     try:
-        with Serving(plc, servers, speed=args.speed) as serving:
+        with _serving(plc, servers, args, speed=args.speed) as serving:
             _say_servers(serving)
             print("(Ctrl-C stops)", flush=True)
             try:

@@ -23,7 +23,7 @@ from plcrt.devices.modbus.slavelib import slave_of  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 from plcrt.net.serial import pty_path  # noqa: E402
 
-from modbus_net_helpers import SLAVE, wait_for  # noqa: E402
+from .modbus_net_helpers import SLAVE, wait_for  # noqa: E402
 
 #: freeport 9600 8N1 (SMB30 = 2#0000_1001); each received character is
 #: echoed from the receive-character routine (event 8) and counted in VW200

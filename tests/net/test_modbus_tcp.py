@@ -17,7 +17,7 @@ from plcrt.devices.modbus.slavelib import slave_of  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 from plcrt.net import ScanDoor  # noqa: E402
 
-from modbus_net_helpers import REACT, SLAVE, mbap, recv_frame, wait_for  # noqa: E402
+from .modbus_net_helpers import REACT, SLAVE, mbap, recv_frame, wait_for  # noqa: E402
 
 
 @pytest.fixture

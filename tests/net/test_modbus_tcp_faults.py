@@ -21,7 +21,7 @@ from pymodbus.client import AsyncModbusTcpClient, ModbusTcpClient  # noqa: E402
 
 import plcrt  # noqa: E402
 
-from modbus_net_helpers import REACT, closed, mbap, recv_frame, wait_for  # noqa: E402
+from .modbus_net_helpers import REACT, closed, mbap, recv_frame, wait_for  # noqa: E402
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ import plcrt  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 from plcrt.net.modbus import load_map  # noqa: E402
 
-from modbus_net_helpers import REACT, wait_for  # noqa: E402
+from .modbus_net_helpers import REACT, wait_for  # noqa: E402
 
 #: sensors: coils -> I, analog sensors: holding registers -> AIW;
 #: actuators: discrete inputs <- Q, input registers <- VW

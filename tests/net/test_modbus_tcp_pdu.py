@@ -14,7 +14,7 @@ from plcrt.net.modbus.addrmap import DEFAULTS, library_map
 from plcrt.net.modbus.pdu import FUNCTIONS, Refused, execute, parse
 from plcrt.net.options import WriteGuard, parse_ranges
 
-from modbus_net_helpers import REACT
+from .modbus_net_helpers import REACT
 
 PLC = plcrt.load(REACT)
 MAP = library_map(PLC.mem.areas, DEFAULTS)

@@ -92,3 +92,52 @@ def test_bad_options_are_errors(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert main(["serve", str(prog), *args]) == 1
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
+
+
+def test_a_cpu_port_on_a_pseudo_terminal_from_the_command_line(tmp_path: Path) -> None:
+    serial = pytest.importorskip("serial")
+    prog = tmp_path / "echo.awl"
+    # freeport 9600 8N1; every character received is sent back
+    prog.write_text("""ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1
+LD     SM0.1
+MOVB   9, SMB30
+ATCH   INT_0, 8
+ENI
+END_ORGANIZATION_BLOCK
+INTERRUPT_BLOCK INT_0:INT0
+BEGIN
+Network 1
+LD     SM0.0
+MOVB   SMB2, VB101
+MOVB   1, VB100
+XMT    VB100, 0
+END_INTERRUPT_BLOCK
+""")
+    p = subprocess.Popen([sys.executable, "-m", "plcrt", "serve", str(prog), "--no-panel",
+                          "--serial", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+    try:
+        assert p.stdout is not None
+        line = p.stdout.readline()
+        m = re.match(r"plcrt port 0: (/dev/\S+)$", line.strip())
+        assert m, line + (p.stderr.read() if p.poll() is not None and p.stderr else "")
+        with serial.Serial(m.group(1), 9600, timeout=3) as tty:
+            time.sleep(0.2)                      # the program's first scan set freeport
+            echoed = b""
+            for ch in (b"p", b"l", b"c"):      # one at a time: an XMT still sending
+                tty.write(ch)                  # would not take the next echo
+                echoed += tty.read(1)
+            assert echoed == b"plc"
+    finally:
+        assert _stop(p) == 0
+
+
+def test_a_modbus_map_needs_a_modbus_server(tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    prog = tmp_path / "count.awl"
+    prog.write_text(COUNT)
+    assert main(["serve", str(prog), "--no-panel", "--lockstep", "0",
+                 "--modbus-map", "x.toml"]) == 1
+    assert "--modbus-map needs a Modbus server" in capsys.readouterr().err

@@ -92,7 +92,8 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     j = unit.probes.add_contact(k, m, insn.operands[0].text if insn.operands else "", loc)
     cc = gen.bind(unit.probes.closed, "CC")
     load_spec.emit(gen, *ops)
-    gen.line(f"{cc}[{j}] |= {gen.top} + 1")  # perf: a stack value is 0 or 1
+    # perf: a stack value is 0 or 1: one store, no read (engine/coverage.py)
+    gen.line(f"{cc}[{2 * j} + ({gen.top})] = 1")
     steps: list[tuple[str, list[Any], int]] = [(load, ops, -1), ("@CON", [j], -1)]
     if shp.op != "load":
         combine = lookup(_COMBINE[shp.op])

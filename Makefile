@@ -9,9 +9,10 @@ BIN     = $(VENV)/bin
 .PHONY: demo test bench panel setup clean
 
 # Two stamp files, one per install, each redone when pyproject.toml changes:
-#   .installed       plcrt and what running needs (`pip install -e .`): demo, panel
+#   .installed       plcrt and what running needs (`pip install -e .`, llvmlite
+#                    included): demo, panel
 #   .installed-test  the test extra on top (pytest, hypothesis, matplotlib,
-#                    llvmlite, playwright): test, bench, setup
+#                    playwright): test, bench, setup
 # so `make demo` stays small and `make test` after it adds only the test tools.
 # pip -qq: only errors, so that `make demo` starts with the demo
 $(BIN)/.installed: pyproject.toml

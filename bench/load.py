@@ -29,6 +29,10 @@ Run ``python bench/load.py`` (``--json`` for one JSON document).  It
    environments (``--cache``, as for ``bench/peers.py``); without them
    this part is skipped with a message.
 
+``--backends python,native`` measures instead, per backend, the first load
+(a fresh process and an empty disk cache) and the cached load (a fresh
+process, the machine code on disk) with the RSS growth of each.
+
 ``--plcrt DIR`` measures the plcrt package found in DIR instead (another
 checkout: the figures before a change, side by side in the same run with
 ``--compare DIR``).  This is a measuring tool, not a test: it asserts
@@ -84,7 +88,14 @@ def child(path: str, mode: str) -> dict[str, Any]:
     import plcrt
     from plcrt.engine import runtime
     from plcrt.engine.runtime import Plc, parse_sources
-    plcrt.load(TINY).scan(1)          # imports and first-use costs out of the way
+    # "plain@native": a backend named (the backend rows); without one the
+    # plcrt's default, and a tiny load first takes imports and first-use
+    # costs out of the way.  With one, the tiny load is Python's, so the
+    # native row's first load includes loading llvmlite and LLVM: what a
+    # user's first load of a session costs
+    mode, _, backend = mode.partition("@")
+    kw: dict[str, Any] = {"backend": backend} if backend else {}
+    plcrt.load(TINY, backend="python" if backend else None).scan(1)
     out: dict[str, Any] = {"mode": mode, "plcrt": str(Path(plcrt.__file__).parent)}
     if mode == "gc-on":
         if not hasattr(runtime, "gc_paused"):
@@ -105,7 +116,7 @@ def child(path: str, mode: str) -> dict[str, Any]:
     with (contextlib.nullcontext() if mode == "gc-on" else pause()):
         program = parse_sources(text)
     t1 = time.perf_counter()
-    plc = Plc(program, scan_ms=1)
+    plc = Plc(program, scan_ms=1, **kw)
     t2 = time.perf_counter()
     if mode == "trace":
         now, peak = tracemalloc.get_traced_memory()
@@ -116,6 +127,9 @@ def child(path: str, mode: str) -> dict[str, Any]:
     t3 = time.perf_counter()
     plc.fork()
     t4 = time.perf_counter()
+    if backend:
+        out["backend"] = plc.backend["name"]
+        out["native_cached"] = bool(plc.backend.get("cached"))
     out.update(insns=program.instruction_count(), parse_s=t1 - t0, compile_s=t2 - t1,
                load_s=t2 - t0, fork_s=t4 - t3,
                rss_growth_mib=(after["VmRSS"] - before["VmRSS"]) / 1024,
@@ -170,8 +184,11 @@ def child_peer_load(path: str, repeats: int = 3) -> dict[str, Any]:
             "best_s": min(times[1:]), "all_s": times}
 
 
-def _run_child(path: Path, mode: str, plcrt_dir: str | None) -> dict[str, Any]:
+def _run_child(path: Path, mode: str, plcrt_dir: str | None,
+               cache_dir: Path | None = None) -> dict[str, Any]:
     env = dict(os.environ)
+    if cache_dir is not None:          # the native backend's disk cache
+        env["PLCRT_CACHE_DIR"] = str(cache_dir)
     if plcrt_dir:
         env["PYTHONPATH"] = plcrt_dir + os.pathsep + env.get("PYTHONPATH", "")
     r = subprocess.run([sys.executable, __file__, "--child", str(path), mode],
@@ -329,8 +346,36 @@ def _peer_line(res: dict[str, Any]) -> str:
 # Driver
 # ---------------------------------------------------------------------------
 
+def backend_loads(path: Path, backends: list[str], plcrt_dir: str | None,
+                  workdir: Path) -> dict[str, Any]:
+    """Per backend: the first load (a fresh process, an empty disk cache)
+    and the cached load (a fresh process whose disk cache holds the
+    machine code the first one made: a second ``plcrt run`` or pytest
+    session; the Python backend keeps nothing on disk, so it is a first
+    load again)."""
+    out: dict[str, Any] = {}
+    for backend in backends:
+        cache = Path(tempfile.mkdtemp(prefix=f"cache-{backend}-", dir=workdir))
+        out[backend] = {"first": _run_child(path, f"plain@{backend}", plcrt_dir, cache),
+                        "cached": _run_child(path, f"plain@{backend}", plcrt_dir, cache)}
+    return out
+
+
+def _backend_line(row: dict[str, Any]) -> str:
+    parts = []
+    for backend, r in row["backends"].items():
+        f, c = r["first"], r["cached"]
+        if "error" in f or "error" in c:
+            parts.append(f"{backend}: error {f.get('error') or c.get('error')}")
+            continue
+        parts.append(f"{backend}: first {f['load_s']:.2f} s RSS +{f['rss_growth_mib']:.0f} MiB, "
+                     f"cached {c['load_s']:.2f} s RSS +{c['rss_growth_mib']:.0f} MiB")
+    return f"{row['shape']:5} {row['size']:>6} seed {row['seed']}: " + "; ".join(parts)
+
+
 def measure(plcrt_dir: str | None, sizes: list[int], seeds: list[int], shapes: list[str],
-            fixture_tests: int, workdir: Path) -> dict[str, Any]:
+            fixture_tests: int, workdir: Path, backends: list[str] | None = None
+            ) -> dict[str, Any]:
     rows = []
     for size in sizes:
         for shape in shapes:
@@ -339,6 +384,11 @@ def measure(plcrt_dir: str | None, sizes: list[int], seeds: list[int], shapes: l
                 if not path.exists():
                     path.write_text(_generators()[shape](size, seed))
                 row: dict[str, Any] = {"size": size, "shape": shape, "seed": seed}
+                if backends:
+                    row["backends"] = backend_loads(path, backends, plcrt_dir, workdir)
+                    rows.append(row)
+                    print(_backend_line(row), file=sys.stderr)
+                    continue
                 for mode in ("plain", "gc-on", "trace"):
                     row[mode] = _run_child(path, mode, plcrt_dir)
                 rows.append(row)
@@ -385,6 +435,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--peer-size", type=int, default=20000)
     ap.add_argument("--peer-rounds", type=int, default=3)
     ap.add_argument("--peer-repeats", type=int, default=3)
+    ap.add_argument("--backends", default=None, metavar="LIST",
+                    help="instead of the load breakdown: the first and the cached load "
+                         "(RSS growth too) on each of these backends, e.g. python,native")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -414,7 +467,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"== {label}: {where or 'this checkout'}", file=sys.stderr)
             if not args.awlsim_only:
                 result[label] = measure(where, sizes, seeds, shapes, args.fixture_tests,
-                                        Path(d))
+                                        Path(d), args.backends.split(",") if args.backends
+                                        else None)
             if args.awlsim or args.awlsim_only:
                 peer = versus_awlsim(Path(args.peers), _peer_cache(args.cache),
                                      args.peer_size, args.peer_rounds, args.peer_repeats,

@@ -3,8 +3,8 @@
 Run ``python bench/panel.py`` (``--json`` for one JSON object).  It loads
 the generated boolean program of ``bench/run.py`` (about 1000
 instructions) at 1 ms scans as ``plcrt serve`` loads it (no network
-probes until a breakpoint is set; the native backend where llvmlite is
-installed), serves it with ``plcrt serve``'s application on a free
+probes until a breakpoint is set; the default backend, native where
+llvmlite works), serves it with ``plcrt serve``'s application on a free
 loopback port, connects 5 websocket clients that each read every frame
 they are sent (each viewing networks 1-10 of OB1, a screenful, as a page
 does), , puts the PLC in "as fast as possible" mode and measures
@@ -65,9 +65,8 @@ async def _client(url: str, counts: list[int], i: int, stop: asyncio.Event) -> N
 
 
 def default_backend() -> str:
-    """The backend ``plcrt serve`` chooses (plcrt.web.cli)."""
-    from plcrt.compiler.native.jit import available
-    return "native" if available() else "python"
+    """The backend ``plcrt serve`` chooses: the default, ``auto``."""
+    return "auto"
 
 
 def alone(plc: plcrt.Plc, seconds: float) -> float:
@@ -133,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scan-ms", type=float, default=1.0)
     ap.add_argument("--probes", action="store_true",
                     help="run in the build with network probes (as while a breakpoint is set)")
-    ap.add_argument("--backend", choices=("python", "native"), default=None)
+    ap.add_argument("--backend", choices=("auto", "python", "native"), default=None)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--check", action="store_true", help=f"exit 1 below {TARGET_X:g} x")
     args = ap.parse_args(argv)

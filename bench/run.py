@@ -16,7 +16,9 @@ Run ``python bench/run.py`` (or ``make bench``).  It
    present): a real export that uses every instruction family.
 
 ``--native`` also times the native backend (docs/native.md) on the same
-programs and prints its speed-up over the Python backend; ``--seeds 5,6``
+programs, with and without probes (``+native+probes``: coverage and
+breakpoints as machine code, what ``--plc-coverage`` and ``plcrt debug``
+run), and prints its speed-ups; ``--seeds 5,6``
 adds a boolean and a mixed program per seed.
 
 This is a measuring tool, not a test: it asserts nothing and never fails on
@@ -345,6 +347,11 @@ def main(argv: list[str] | None = None) -> int:
             r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
                               backend="native")
             scans[f"{name}+native"] = dataclasses.replace(r, name=f"{name}+native")
+            # the instrumented build on the native backend (probes as machine
+            # code): what --plc-coverage, plcrt debug and a panel breakpoint run
+            r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
+                              backend="native", instrument=True)
+            scans[f"{name}+native+probes"] = dataclasses.replace(r, name=f"{name}+native+probes")
     corpus = measure_corpus(max(3, args.repeats // 2))
 
     if args.json:
@@ -359,7 +366,7 @@ def main(argv: list[str] | None = None) -> int:
             target = TARGETS.get(r.name)
             verdict = "" if target is None else \
                 f" - {'meets' if r.insns_per_s >= target else 'BELOW'} target {target / 1e6:g} M/s"
-            print(f"{r.name:<12} {r.instructions:>5} instructions, {r.networks:>4} networks: "
+            print(f"{r.name:<19} {r.instructions:>5} instructions, {r.networks:>4} networks: "
                   f"{r.insns_per_s / 1e6:6.2f} M instructions/s "
                   f"({1e6 / r.scans_per_s:7.1f} us/scan, best of {r.repeats} x "
                   f"{r.scans_per_repeat} scans; load {r.load_s * 1e3:.0f} ms){verdict}")
@@ -367,6 +374,11 @@ def main(argv: list[str] | None = None) -> int:
             nat = scans.get(f"{name}+native")
             if nat is not None:
                 print(f"{name:<12} native / python: {nat.insns_per_s / scans[name].insns_per_s:.1f}x")
+            probed = scans.get(f"{name}+native+probes")
+            if nat is not None and probed is not None:
+                print(f"{name:<12} native with probes / native: "
+                      f"{probed.insns_per_s / nat.insns_per_s:.2f}x, / python with probes: "
+                      f"{probed.insns_per_s / scans[name + '+probes'].insns_per_s:.1f}x")
         if corpus is None:
             print(f"corpus: {CORPUS_FILE} not found, skipped")
         else:

@@ -142,6 +142,8 @@ def _build_parser() -> _Parser:
     p.add_argument("--quiet", action="store_true",
                    help="print only errors: no summary, value table, axes, warnings or "
                         "progress bar (--json still prints its object)")
+    p.add_argument("--verbose", action="store_true",
+                   help="also say on stderr which backend ran the program")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",

@@ -94,6 +94,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     # report bad parameters only when they execute) go to stderr as well.
     report(plc.diagnostics[loaded:])
     values = {spec: plc.read(addr, kind) for spec, addr, kind in watches}
+    if getattr(args, "verbose", False):
+        print(backend_line(plc), file=sys.stderr)
     if args.json:
         _emit_json(args, plc, values, str(fault or stopped) if fault or stopped else None)
     elif not quiet:
@@ -152,6 +154,7 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         "values": {k: json_number(v) for k, v in values.items()},
     }
     if plc is not None:
+        obj["backend"] = plc.backend["name"]
         # the CPU's own state the program sets: real-time clock and DLED
         obj["clock"] = plc.clock.now(plc.now_us).isoformat()
         obj["dled"] = plc.station.led
@@ -170,6 +173,15 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
     if error is not None:
         obj["error"] = error
     sys.stdout.write(json.dumps(obj, ensure_ascii=False, allow_nan=False) + "\n")
+
+
+def backend_line(plc: Plc) -> str:
+    """One line saying which code generator ran the program (``--verbose``)."""
+    info = plc.backend
+    if info["name"] != "native":
+        return "backend: python"
+    return (f"backend: native ({info['pieces']} pieces as machine code, "
+            f"{len(info['python'])} in Python)")
 
 
 def _fmt(value: int | float) -> str:

@@ -38,8 +38,8 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
         library: accept a program without OB1 (a subroutine library, for
             checking only); otherwise that is an error.
         native: also plan the native backend's segments
-            (:mod:`plcrt.compiler.native`; ``unit.native`` holds the plan).
-            An instrumented program (``probes``) stays Python.
+            (:mod:`plcrt.compiler.native`; ``unit.native`` holds the plan),
+            probes included.
 
     Raises:
         PlcCompileError: with every error found (warnings ride along).
@@ -48,7 +48,7 @@ def compile_program(program: ir.Program, model: CpuModel, *, symbols: Any = None
     diag = DiagnosticSink()
     unit = build_unit(program, model, symbols, system_symbols or {}, diag, library=library)
     unit.probes = probes
-    if native and probes is None:
+    if native:
         from .native import NativePlan
         unit.native = NativePlan()
     unit.plant = plant

@@ -43,6 +43,8 @@ def network_probe(unit: Unit, gen: Gen, piece: Piece) -> None:
         hit = gen.bind(PROBES["call_hit"], "HIT")
         with gen.block(f"if {bp}[{k}]:"):
             gen.line(f"{hit}({k})")
+    if piece.resolved is not None:     # the native backend's probes: same tables
+        piece.resolved.append(("@NET", [k, not piece.suffix], -1))
 
 
 def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: SourceLoc,
@@ -62,6 +64,8 @@ def _output_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, loc: Source
     oc = gen.bind(PROBES["power"], "OC")
     # the first power input (EN; CU of a counter) is the deepest of them
     gen.line(f"{oc}[{j}] |= {gen.level(shp.inputs - 1)} + 1")  # perf: 0/1 -> bit 0/1
+    if piece.resolved is not None:
+        piece.resolved.append(("@OUT", [j, shp.inputs - 1], -1))
 
 
 #: A and O contacts are emitted as their load form plus ALD / OLD when
@@ -95,11 +99,16 @@ def _contact_probe(unit: Unit, gen: Gen, piece: Piece, insn: ir.Insn, ops: list[
     j = unit.probes.add_contact(k, m, insn.operands[0].text if insn.operands else "", loc)
     cc = gen.bind(PROBES["closed"], "CC")
     load_spec.emit(gen, *ops)
-    gen.line(f"{cc}[{j}] |= {gen.top} + 1")  # perf: a stack value is 0 or 1
+    # perf: a stack value is 0 or 1: one store, no read (engine/coverage.py)
+    gen.line(f"{cc}[{2 * j} + ({gen.top})] = 1")
+    steps: list[tuple[str, list[Any], int]] = [(load, ops, -1), ("@CON", [j], -1)]
     if shp.op != "load":
         combine = lookup(_COMBINE[shp.op])
         assert combine is not None
         combine.emit(gen)
+        steps.append((_COMBINE[shp.op], [], -1))
+    if piece.resolved is not None:     # the native backend lowers the same steps
+        piece.resolved.extend(steps)
     return True
 
 
@@ -142,14 +151,15 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         # perf: emitters only append lines, so the length is what to restore
         saved = (len(gen.lines), gen.depth, gen.indent, gen.pending)
         try:
-            if unit.probes is not None and not broken and \
-                    _contact_probe(unit, gen, piece, insn, ops, loc):
+            probed = unit.probes is not None and not broken and \
+                _contact_probe(unit, gen, piece, insn, ops, loc)
+            if probed:
                 pass
             elif spec.variadic:
                 spec.emit(gen, insn, resolver, *ops)
             else:
                 spec.emit(gen, *ops)
-            if piece.resolved is not None:
+            if piece.resolved is not None and not probed:
                 site = len(unit.hooks["edges"]) - 1 if insn.mnemonic in ("EU", "ED") else -1
                 piece.resolved.append((insn.mnemonic, ops, site))
             if unit.probes is not None:

@@ -117,6 +117,8 @@ class Binding:
         edges = self.unit.native.edges if self.unit.native is not None else None
         bufs.update(T_RUN=t.running, T_PRE=t.preset, T_D100=t.d100_buf, T_PREV=t.prev_in,
                     EDGES=self._bindings[edges] if edges else bytearray(1))
+        from ..compiler.native.jit import probe_buffers
+        bufs.update(probe_buffers(self.coverage))
         return bufs
 
     @property

@@ -11,9 +11,12 @@ two kinds of probes (and nothing else changes in what the program does):
   output was reached without power flow, bit 1 = with power flow.  An output
   that saw both has had each of its rung's outcomes exercised: the ladder
   equivalent of branch (decision) coverage;
-* at every contact ``_CC[j] |= 2 if <closed> else 1``: bit 0 = evaluated
-  open, bit 1 = closed.  A parallel branch whose contact was never closed
-  never conducted: the ladder form of condition coverage.
+* at every contact ``_CC[2 * j + <closed>] = 1``: byte ``2j`` = evaluated
+  open, byte ``2j + 1`` = closed (reported as bit 0 and bit 1, as the
+  outputs are).  A parallel branch whose contact was never closed never
+  conducted: the ladder form of condition coverage.  (perf: a store
+  without a read, the cheapest probe on both backends; contacts are most
+  of a boolean program's probes.)
 
 A contact on a bit that is constant in RUN (SM0.0) and an output whose
 power is constant because of such contacts get no probe: they are not
@@ -69,7 +72,8 @@ class CoverageMap:
         self.hits = bytearray()          #: per network: 1 = ran (since reset)
         self.power = bytearray()         #: per output: bit0 unpowered, bit1 powered
         self.contacts: list[OutputRef] = []
-        self.closed = bytearray()        #: per contact: bit0 seen open, bit1 closed
+        #: per contact two bytes: [2j] seen open, [2j + 1] seen closed
+        self.closed = bytearray()
         self.breakpoints = bytearray()   #: per network: 1 = break before it
         self.on_break: Callable[[NetworkRef], None] | None = None
         #: perf: one bound method for every probe to share
@@ -97,7 +101,7 @@ class CoverageMap:
     def add_contact(self, network: int, mnemonic: str, operand: str, loc: SourceLoc) -> int:
         j = len(self.contacts)
         self.contacts.append(OutputRef(j, network, mnemonic, operand, loc))
-        self.closed.append(0)
+        self.closed += b"\0\0"
         return j
 
     # -- run time ---------------------------------------------------------
@@ -122,8 +126,12 @@ class CoverageMap:
         return {
             "networks": {n.name: int(self.hits[n.index]) for n in self.networks},
             "outputs": {self.output_key(o): int(self.power[o.index]) for o in self.outputs},
-            "contacts": {self.output_key(c): int(self.closed[c.index]) for c in self.contacts},
+            "contacts": {self.output_key(c): self.contact_bits(c.index) for c in self.contacts},
         }
+
+    def contact_bits(self, j: int) -> int:
+        """Contact ``j``: bit 0 seen open, bit 1 seen closed."""
+        return (1 if self.closed[2 * j] else 0) | (2 if self.closed[2 * j + 1] else 0)
 
     def output_key(self, o: OutputRef) -> str:
         net = self.networks[o.network]

@@ -475,23 +475,29 @@ def _fits_float(x: Any) -> bool:
 LOAD_OPTIONS = ("plant", "pace", "watchdog_ms", "instrument", "system_symbols", "library",
                 "max_file_mb", "auto_symbols", "clock", "backend", "entry")
 
-#: the code generators a program can be loaded with (plcrt.compiler.native)
-BACKENDS = ("python", "native")
+#: the code generators a program can be loaded with (plcrt.compiler.native);
+#: "auto" is native where llvmlite works, else Python
+BACKENDS = ("auto", "python", "native")
 
 
 def check_backend(backend: Any) -> str:
-    """The code generator to load with: ``backend``, or when it is None the
-    environment's ``PLCRT_BACKEND`` (a test suite run on the native
-    backend: ``PLCRT_BACKEND=native pytest``), else ``"python"``."""
+    """The code generator to load with, ``"python"`` or ``"native"``:
+    ``backend``, or when it is None the environment's ``PLCRT_BACKEND`` (a
+    test suite pinned to one backend: ``PLCRT_BACKEND=python pytest``), else
+    ``"auto"``, which is native where llvmlite imports and works and Python
+    otherwise (:func:`plcrt.compiler.native.jit.auto_backend` says so once)."""
     if backend is None:
         import os
-        backend = os.environ.get("PLCRT_BACKEND") or "python"
+        backend = os.environ.get("PLCRT_BACKEND") or "auto"
         if backend not in BACKENDS:
             raise PlcConfigError(f"PLCRT_BACKEND must be one of "
                                  f"{', '.join(BACKENDS)}, got {shown_value(backend)}")
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise PlcConfigError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
                              f"got {shown_value(backend)}")
+    if backend == "auto":
+        from ..compiler.native.jit import auto_backend
+        return auto_backend()
     return backend
 
 _SOURCE_FORMS = "a file path (str or pathlib.Path), STL text (a str with a newline)"

@@ -58,9 +58,9 @@ def add_program_args(p: argparse.ArgumentParser, *, data: bool = True, cpu: bool
                         "address, reported as warnings (for exports published without "
                         "their symbol table)")
     p.add_argument("--backend", choices=BACKENDS, default=None,
-                   help="code generator: python (default; or $PLCRT_BACKEND) or native "
-                        "(machine code through llvmlite for the pieces it covers: "
-                        "the 'native' extra, docs/native.md)")
+                   help="code generator: auto (default, or $PLCRT_BACKEND: native where "
+                        "llvmlite works, else python), native (machine code through "
+                        "llvmlite for the pieces it covers, docs/native.md) or python")
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="refuse program, symbol and data files larger than this "
                         "(default 16 MB, far above any S7-200 program)")

@@ -114,8 +114,9 @@ class Harness(Stimuli, Motion):
         time (see :meth:`limit_time`).  ``encoding`` is the text encoding of
         the files (detected by default, as in :func:`plcrt.load`);
         ``clock`` the real-time clock's start (as in :func:`plcrt.load`);
-        ``backend`` the code generator (``"python"`` or ``"native"``, as in
-        :func:`plcrt.load`; default ``$PLCRT_BACKEND``, else Python).
+        ``backend`` the code generator (``"auto"``, ``"python"`` or
+        ``"native"``, as in :func:`plcrt.load`; default ``$PLCRT_BACKEND``,
+        else auto: native where llvmlite works).
         """
         from ..lang import ir
 

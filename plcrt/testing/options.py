@@ -24,6 +24,9 @@ import pytest
 
 from .markers import MARKER_HELP, _scan_us
 
+#: plcrt.engine.values.BACKENDS (kept here: importing the engine is not cheap)
+BACKENDS = ("auto", "python", "native")
+
 if TYPE_CHECKING:
     from ..engine.runtime import Plc
 
@@ -41,7 +44,7 @@ class _Session:
     max_time: float | None
     coverage: bool
     coverage_report: Path | None
-    #: the code generator of every PLC (None: $PLCRT_BACKEND, else Python)
+    #: the code generator of every PLC (None: $PLCRT_BACKEND, else auto)
     backend: str | None = None
     #: parsed programs with their tables: (((path, mtime_ns, size), ...),
     #: which tables, encoding) -> (ir.Program, symbols, data).  The IR is
@@ -77,11 +80,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--plc-max-time", dest="plc_max_time", metavar="DURATION", default=None,
                     help="fail a test whose PLC runs past this much simulated time, e.g. "
                          "60s or 10min (default: ini plc_max_time, else no limit)")
-    group.addoption("--plc-backend", dest="plc_backend", choices=("python", "native"),
+    group.addoption("--plc-backend", dest="plc_backend", choices=BACKENDS,
                     default=None,
-                    help="code generator of the PLCs: python or native (machine code through "
-                         "llvmlite; default: ini plc_backend, else $PLCRT_BACKEND, else python)")
-    parser.addini("plc_backend", "PLC code generator: python or native (plcrt)", default=None)
+                    help="code generator of the PLCs: auto, native (machine code through "
+                         "llvmlite) or python (default: ini plc_backend, else "
+                         "$PLCRT_BACKEND, else auto: native where llvmlite works)")
+    parser.addini("plc_backend", "PLC code generator: auto, native or python (plcrt)",
+                  default=None)
     parser.addini("plc_history", "scans kept for the PLC trace (plcrt)", default=None)
     parser.addini("plc_max_time", "simulated-time limit per PLC (plcrt)", default=None)
     parser.addini("plc_coverage", "report PLC network coverage (plcrt)", type="bool",
@@ -130,8 +135,9 @@ def _session_from_config(config: pytest.Config) -> _Session:
         report_path = Path(config.invocation_params.dir) / report_path
     coverage = bool(_setting(config, "plc_coverage")) or report_path is not None
     backend = _setting(config, "plc_backend")
-    if backend not in (None, "python", "native"):
-        raise pytest.UsageError(f"plc_backend must be python or native, got {backend!r:.40}")
+    if backend not in (None, *BACKENDS):
+        raise pytest.UsageError(f"plc_backend must be one of {', '.join(BACKENDS)}, "
+                                f"got {backend!r:.40}")
     return _Session(rootpath=Path(config.rootpath), scan_ms=scan_ms, history=history,
                     max_time=max_time, coverage=coverage, coverage_report=report_path,
                     backend=backend)

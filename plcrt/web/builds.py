@@ -3,7 +3,7 @@
 Breakpoints stop inside a scan, as the debugger's do: the program is
 loaded with network probes (``instrument=True``) and
 ``CoverageMap.on_break`` is called before a network with a breakpoint.
-Probes cost scan time (and the native backend does not compile them), so
+Probes cost scan time, so
 the session scans in the build it was loaded in (its *home* build) and
 moves to a build with probes, between two scans and in exactly the same
 state (:meth:`plcrt.Plc.recompiled`), while a breakpoint is set.  The
@@ -100,9 +100,8 @@ class Builds:
 
     def backend(self, probes: bool) -> str:
         """The backend of the build with (or without) probes: the loaded
-        one's for its own kind, Python for the other (the native backend
-        does not compile probes)."""
-        return self.home[1] if probes == self.home[0] else "python"
+        one's (both backends compile probes)."""
+        return self.home[1]
 
     def apply(self, plc: Plc, suspended: bool = False) -> None:
         """Write the breakpoints into ``plc``'s probes (none while

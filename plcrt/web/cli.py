@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import ipaddress
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -92,12 +91,6 @@ def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
     from . import course
     from .server import Panel
     from .session import PanelSession
-
-    if getattr(args, "backend", None) is None and not os.environ.get("PLCRT_BACKEND"):
-        # scans run without probes until a breakpoint is set: the native
-        # backend where llvmlite is installed (docs/panel.md, "Speed")
-        from ..compiler.native.jit import available
-        args.backend = "native" if available() else None
 
     def load_lesson(les: course.Lesson) -> PanelSession:
         ns = argparse.Namespace(**vars(args))

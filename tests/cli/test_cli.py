@@ -9,6 +9,7 @@ run-time fault), never in a traceback.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -158,9 +159,29 @@ def test_run_json(capsys: pytest.CaptureFixture[str]) -> None:
                            "--watch", "T37", "--watch", "Q0.0", "--json")
     assert code == 0
     obj = json.loads(out)
+    # the default backend: native, llvmlite being a dependency
     assert obj == {"program": TIMERS, "scans": 250, "time_s": 2.5, "mode": "RUN",
                    "values": {"T37": 24, "Q0.0": 1}, "clock": "2024-01-01T00:00:02",
-                   "dled": False}
+                   "dled": False, "backend": "native"}
+
+
+@pytest.mark.parametrize("backend", ["python", "native", "auto"])
+def test_run_says_which_backend_ran(backend: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """--json carries the backend that ran, --verbose says it on stderr
+    (auto is native where llvmlite works, as here)."""
+    ran = "python" if backend == "python" else "native"
+    code, out, _ = run_cli(capsys, "run", TIMERS, "--scans", "3", "--json", "--backend", backend)
+    assert code == 0 and json.loads(out)["backend"] == ran
+    code, out, err = run_cli(capsys, "run", TIMERS, "--scans", "3", "--verbose",
+                             "--backend", backend)
+    assert code == 0
+    line = next(x for x in err.splitlines() if x.startswith("backend: "))
+    if ran == "python":
+        assert line == "backend: python"
+    else:
+        assert re.fullmatch(r"backend: native \(\d+ pieces as machine code, \d+ in Python\)",
+                            line), line
+        assert line != "backend: native (0 pieces as machine code, 0 in Python)"
 
 
 def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -377,7 +398,8 @@ def test_parse_value_non_finite_reals(text: str, expected: str) -> None:
 # ---------------------------------------------------------------------------
 
 def test_dump_shows_networks_and_stl_lines(capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run_cli(capsys, "dump", SEAL_IN)
+    # the Python backend's module layout (native: the runner calls segments)
+    code, out, err = run_cli(capsys, "dump", SEAL_IN, "--backend", "python")
     assert code == 0
     assert err == ""
     lines = out.splitlines()

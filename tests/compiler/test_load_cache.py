@@ -203,7 +203,7 @@ def test_a_fault_in_a_late_chunk_is_located_at_its_instruction(
     monkeypatch.setattr(codegen, "GROUP_PIECES", 4)     # networks 1-4, 5-8, ...
     nets = "".join(f"Network {n}\nLD     SM0.0\nMOVW   +{n}, VW{2 * n}\n" for n in range(1, 40))
     text = f"ORGANIZATION_BLOCK OB1\nBEGIN\n{nets}END_ORGANIZATION_BLOCK\n"
-    plc = plcrt.load(text)
+    plc = plcrt.load(text, backend="python")    # the Python backend's functions
     assert len(plc.unit.chunks) > 3
     # the function of networks 33-36 with its memory buffers taken away
     # fails at network 33's MOVW: the traceback's generated line leads to

@@ -121,10 +121,13 @@ for _p in ("LD", "A", "O"):
 
 
 def test_every_lowering_is_an_instruction_with_a_row() -> None:
-    """The native table lowers registered instructions only, and each has a row."""
-    for mnemonic in LOWER:
+    """The native table lowers registered instructions only, and each has a
+    row; besides them only the probes of an instrumented program (``@``)."""
+    insns = [m for m in LOWER if not m.startswith("@")]
+    for mnemonic in insns:
         assert lookup(mnemonic) is not None, mnemonic
-    assert sorted(LOWER) == sorted(ROWS)
+    assert sorted(insns) == sorted(ROWS)
+    assert sorted(set(LOWER) - set(insns)) == ["@CON", "@NET", "@OUT"]
 
 
 @pytest.mark.parametrize("mnemonic", sorted(ROWS))
@@ -177,11 +180,54 @@ def test_blocks_with_jumps_and_loops_run_their_other_pieces_natively() -> None:
     assert nat.mem.areas["V"][3] == 24 and nat.mem.areas["V"][5] == 8   # I0.0 on in 4 scans
 
 
-def test_instrumented_program_runs_as_python() -> None:
-    """Coverage and breakpoints need the probes of the Python code."""
-    nat = plcrt.load(_ob1("LD I0.0\n= Q0.0"), backend="native", instrument=True)
-    assert nat.backend == {"name": "native"}
-    assert "_nseg" not in nat.source
+def test_instrumented_program_runs_natively_with_the_same_coverage_and_breaks() -> None:
+    """Coverage probes and breakpoints are machine code too: every piece is
+    lowered, the counts equal the Python build's after every scan, and a
+    breakpoint stops before the same network in the same scan, with the
+    memory the network is about to read."""
+    text = _ob1("LD I0.0\nA I0.1\nO M0.0\n= Q0.0", "LD I0.1\nAN I0.0\nINCW VW0\nLD SM0.0\n= Q0.1",
+                "LD I0.0\nLPS\nA I0.1\n= Q0.2\nLPP\nON I0.1\nTON T37, +2")
+    py, nat = _pair(text, instrument=True)
+    assert nat.backend["python"] == [] and nat.backend["pieces"] == 3
+    stops: dict[str, list] = {"python": [], "native": []}
+    for plc in (py, nat):
+        plc.coverage.breakpoints[1] = 1
+        plc.coverage.on_break = (lambda net, plc=plc: stops[plc.backend["name"]].append(
+            (net.name, plc.scans, bytes(plc.mem.areas["V"][:2]))))
+    for k, ib0 in enumerate((0, 2, 3, 1, 0, 2, 2, 2)):
+        for plc in (py, nat):
+            plc.mem.areas["PI"][0] = ib0
+            plc.scan()
+        _same(py, nat, f"scan {k + 1}")
+        assert nat.coverage.data() == py.coverage.data(), f"scan {k + 1}"
+    assert stops["native"] == stops["python"]
+    assert [s[:2] for s in stops["native"]] == [("OB1/2", k) for k in range(8)]
+    # VW0 counts in scans 2, 6, 7, 8 (I0.1 without I0.0), after the stop
+    assert [s[2][1] for s in stops["native"]] == [0, 0, 1, 1, 1, 1, 2, 3]
+    assert nat.mem.areas["V"][1] == 4
+    data = nat.coverage.data()
+    assert data["contacts"]["OB1/1:5:1:A"] == 3 and data["outputs"]["OB1/3:21:1:TON"] == 3
+
+
+def test_a_breakpoint_handler_writes_what_the_network_then_reads() -> None:
+    """What the debugger sets while paused (memory, other breakpoints) is
+    what the rest of the scan sees: nothing is kept in registers across
+    the call."""
+    text = _ob1("LD I0.0\n= Q0.0", "LD M0.0\n= Q0.1", "LD M0.1\n= Q0.2")
+    for backend in ("python", "native"):
+        plc = plcrt.load(text, backend=backend, instrument=True)
+        seen = []
+
+        def pause(net, plc=plc, seen=seen) -> None:
+            seen.append(net.name)
+            plc.mem.areas["M"][0] = 3            # as the debugger's `set M0.0 1`
+            plc.coverage.breakpoints[:] = bytes([0, 0, 1])   # `next` moves on
+
+        plc.coverage.breakpoints[1] = 1
+        plc.coverage.on_break = pause
+        plc.scan()
+        assert seen == ["OB1/2", "OB1/3"], backend
+        assert plc.mem.areas["Q"][0] == 0b110, backend
 
 
 def test_machine_code_is_cached_on_disk_and_a_bad_file_is_compiled_again(

@@ -66,19 +66,20 @@ def _stamp(venv: Path, name: str) -> None:
 
 
 def test_make_demo_installs_what_running_needs(tmp_path: Path) -> None:
-    """The demo installs plcrt and its dependencies, not the test extra
-    (pytest, hypothesis, matplotlib, llvmlite, playwright: hundreds of MB)."""
+    """The demo installs plcrt and its dependencies (llvmlite among them),
+    not the test extra (pytest, hypothesis, matplotlib, playwright: hundreds
+    of MB)."""
     installs = _make_n("demo", tmp_path / "venv")
     assert any(line.endswith("pip install -qq -e .") for line in installs)
     assert not any("[test]" in line or "[native]" in line for line in installs)
 
 
 def test_make_demo_runs_only_what_it_installed() -> None:
-    """The native backend is the optional 'native' extra: the demo has no
-    line that needs it."""
+    """The demo runs on the default backend (native where llvmlite works,
+    else Python): no line names a backend."""
     makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
     demo = makefile.split("\ndemo:", 1)[1].split("\n\n", 1)[0]
-    assert "plcrt run" in demo and "--backend native" not in demo
+    assert "plcrt run" in demo and "--backend" not in demo
 
 
 def test_make_test_from_a_fresh_clone_installs_the_test_extra(tmp_path: Path) -> None:

@@ -551,4 +551,4 @@ def test_timer(plc, run):
     _run(pytester, "--plc-backend", "native").assert_outcomes(passed=2)
     _write(pytester, "pytest.ini", "[pytest]\nplc_backend = fast\n")
     result = _run(pytester)
-    assert "plc_backend must be python or native" in result.stderr.str()
+    assert "plc_backend must be one of auto, python, native" in result.stderr.str()

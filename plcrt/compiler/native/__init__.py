@@ -5,15 +5,17 @@
 compares and moves, integer math with its flags, word logic, conversions,
 edges, the 100 ms timers' boxes and resets) to machine code; consecutive
 lowered pieces of a block become one *segment*, one call from the block's
-runner.  Everything else -- a piece with a call, a jump, a label or a
-loop, an instruction outside the table, an L-memory operand, an
-instrumented program (coverage, breakpoints) -- runs as the Python
-backend's code, which is generated for every piece in either case
-(``plcrt dump`` shows it).  Both backends give the same memory image after
-every scan: the differential tests compare them.
+runner.  An instrumented program's probes (coverage, breakpoints) are
+lowered too (:mod:`.probes`).  Everything else -- a piece with a call, a
+jump, a label or a loop, an instruction outside the table, an L-memory
+operand -- runs as the Python backend's code, which is generated for every
+piece in either case (``plcrt dump`` shows it).  Both backends give the
+same memory image and the same coverage after every scan: the differential
+tests compare them.
 
 This package is not the compiler of llvmlite itself (:mod:`.jit`), and
-imports it only there: the default install stays pure Python.
+imports it only there: where llvmlite is missing the rest still imports,
+and ``backend="auto"`` runs the Python backend.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from . import probes  # noqa: F401 - registers the probes' lowerings
 from .lower import Fn, NotLowered, lower_piece
 
 __all__ = ["NativePlan", "NotLowered", "plan_pou"]

@@ -14,8 +14,10 @@ from __future__ import annotations
 from ...gen.limits import MAX_STACK
 
 #: the buffers a segment can reach, in the order of the context table
+#: (NC, OC, CC, BP: an instrumented program's coverage tables, BRK: the
+#: function a breakpoint calls, see :mod:`.probes`)
 SLOTS = ("I", "Q", "M", "V", "SM", "S", "TV", "TB", "CV", "CB", "AC", "AI", "AQ",
-         "T_RUN", "T_PRE", "T_D100", "T_PREV", "EDGES")
+         "T_RUN", "T_PRE", "T_D100", "T_PREV", "EDGES", "NC", "OC", "CC", "BP", "BRK")
 SLOT = {name: i for i, name in enumerate(SLOTS)}
 
 #: operand areas a native piece may read and write directly (L is per call,
@@ -60,6 +62,15 @@ class Fn:
 
     def stmt(self, text: str) -> None:
         self.body.append(f"  {text}")
+
+    def label(self) -> str:
+        """A new basic block's name (the probes' breakpoint call only:
+        everything else keeps a piece one block)."""
+        self._n += 1
+        return f"L{self._n}"
+
+    def start(self, label: str) -> None:
+        self.body.append(f"{label}:")
 
     # -- stack -------------------------------------------------------------
     def push(self, v: str) -> None:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
+import logging
 import os
 import time
 from pathlib import Path
@@ -39,6 +40,54 @@ def available() -> bool:
     except ImportError:
         return False
     return True
+
+
+#: the one line said when ``backend="auto"`` falls back to Python
+FALLBACK = "plcrt: the native backend is not available ({why}); running on the Python backend"
+
+_log = logging.getLogger("plcrt")
+
+
+@functools.lru_cache(maxsize=1)
+def usable() -> str | None:
+    """Why the native backend cannot run here, or None when it can.
+
+    llvmlite must import and compile and run a one-instruction function (a
+    wheel for another CPU, a missing LLVM library or a refused executable
+    page all fail here, once per process, not in the middle of a load).
+    """
+    try:
+        llvm = _llvm()
+        target = llvm.Target.from_default_triple()
+        tm = target.create_target_machine(opt=0, codemodel="jitdefault")
+        mod = llvm.parse_assembly("define i32 @probe() {\nentry:\n  ret i32 7\n}\n")
+        engine = llvm.create_mcjit_compiler(mod, tm)
+        engine.finalize_object()
+        fn = ctypes.CFUNCTYPE(ctypes.c_int32)(engine.get_function_address("probe"))
+        if fn() != 7:
+            return "llvmlite's machine code gives wrong results"
+    except ImportError:
+        return "llvmlite is not installed"
+    except Exception as e:  # noqa: BLE001 - any failure means: not here
+        return f"llvmlite does not work: {type(e).__name__}"
+    return None
+
+
+def auto_backend() -> str:
+    """What ``backend="auto"`` means here: ``"native"`` where llvmlite
+    imports and works, else ``"python"``, said once per process in one
+    line on the ``plcrt`` logger (stderr for a command; in a pytest run it
+    is shown only with a failing test or when logging output is asked for)."""
+    why = usable()
+    if why is None:
+        return "native"
+    _say_fallback(why)
+    return "python"
+
+
+@functools.lru_cache(maxsize=1)
+def _say_fallback(why: str) -> None:
+    _log.warning(FALLBACK.format(why=why))
 
 
 @functools.lru_cache(maxsize=1)
@@ -150,14 +199,35 @@ class NativeContext:
     def point(self, buffers: dict[str, Any]) -> None:
         """(Re)point the table at ``buffers`` (after a restore replaced the
         timer bank's arrays)."""
-        views = []
+        views: list[Any] = []
         for i, name in enumerate(SLOTS):
             buf = buffers[name]
+            if isinstance(buf, _BREAK):    # a function, not a buffer
+                views.append(buf)
+                self.table[i] = ctypes.cast(buf, ctypes.c_void_p).value
+                continue
             size = memoryview(buf).nbytes
             view = (ctypes.c_char * size).from_buffer(buf) if size else None
             views.append(view)
             self.table[i] = ctypes.addressof(view) if view is not None else None
         self._views = views
+
+
+#: what a segment calls before a network with a breakpoint: ``(network index)``
+_BREAK = ctypes.CFUNCTYPE(None, ctypes.c_int32)
+
+
+def probe_buffers(coverage: Any) -> dict[str, Any]:
+    """The context table's probe slots for a PLC's ``coverage`` (a
+    :class:`plcrt.engine.coverage.CoverageMap`, or None without probes):
+    its tables, which the PLC's Python code writes too, and a callback to
+    its ``hit`` (which calls ``on_break``; it never raises, see
+    :mod:`plcrt.debug.session`)."""
+    if coverage is None:
+        return {"NC": bytearray(1), "OC": bytearray(1), "CC": bytearray(1),
+                "BP": bytearray(1), "BRK": bytearray(1)}
+    return {"NC": coverage.hits, "OC": coverage.power, "CC": coverage.closed,
+            "BP": coverage.breakpoints, "BRK": _BREAK(coverage.hit)}
 
 
 def llvm_version() -> str:

@@ -23,28 +23,7 @@ from plcrt.devices.modbus.slavelib import slave_of  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 from plcrt.net.serial import pty_path  # noqa: E402
 
-from .modbus_net_helpers import SLAVE, wait_for  # noqa: E402
-
-#: freeport 9600 8N1 (SMB30 = 2#0000_1001); each received character is
-#: echoed from the receive-character routine (event 8) and counted in VW200
-ECHO = """ORGANIZATION_BLOCK MAIN:OB1
-BEGIN
-Network 1
-LD     SM0.1
-MOVB   9, SMB30
-ATCH   INT_0, 8
-ENI
-END_ORGANIZATION_BLOCK
-INTERRUPT_BLOCK INT_0:INT0
-BEGIN
-Network 1
-LD     SM0.0
-MOVB   SMB2, VB101
-MOVB   1, VB100
-XMT    VB100, 0
-INCW   VW200
-END_INTERRUPT_BLOCK
-"""
+from .modbus_net_helpers import ECHO, SLAVE, wait_for  # noqa: E402
 
 
 def ok(r):

@@ -16,6 +16,8 @@ import pytest
 from plcrt.cli import main
 from plcrt.net.client import LockstepClient
 
+from .modbus_net_helpers import ECHO
+
 COUNT = """ORGANIZATION_BLOCK MAIN:OB1
 BEGIN
 Network 1
@@ -97,24 +99,7 @@ def test_bad_options_are_errors(tmp_path: Path, capsys: pytest.CaptureFixture[st
 def test_a_cpu_port_on_a_pseudo_terminal_from_the_command_line(tmp_path: Path) -> None:
     serial = pytest.importorskip("serial")
     prog = tmp_path / "echo.awl"
-    # freeport 9600 8N1; every character received is sent back
-    prog.write_text("""ORGANIZATION_BLOCK MAIN:OB1
-BEGIN
-Network 1
-LD     SM0.1
-MOVB   9, SMB30
-ATCH   INT_0, 8
-ENI
-END_ORGANIZATION_BLOCK
-INTERRUPT_BLOCK INT_0:INT0
-BEGIN
-Network 1
-LD     SM0.0
-MOVB   SMB2, VB101
-MOVB   1, VB100
-XMT    VB100, 0
-END_INTERRUPT_BLOCK
-""")
+    prog.write_text(ECHO)
     p = subprocess.Popen([sys.executable, "-m", "plcrt", "serve", str(prog), "--no-panel",
                           "--serial", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True)

@@ -20,20 +20,9 @@ from plcrt.devices.cia402.od import SdoAbort
 from plcrt.devices.cia402.plant import DrivePlant
 from plcrt.devices.cia402.statemachine import State
 
+from cia402_drive_helpers import enable
+
 DOCS = Path(__file__).resolve().parents[3] / "docs" / "cia402.md"
-
-
-def enable(d: Drive, mode: int, **params: int) -> Drive:
-    """Mode *mode*, objects ``x6081=...`` / ``x6099_01=...``, then 6, 7, 0x0F."""
-    d.write(0x6060, 0, mode)
-    for name, value in params.items():
-        d.write(int(name[1:5], 16), int(name[6:]) if len(name) > 5 else 0, value)
-    for cw in (0x06, 0x07, 0x0F):
-        d.write(0x6040, 0, cw)
-    if d.sm.state is State.SWITCHED_ON:
-        d.cycle(d.now)
-    assert d.sm.state is State.OPERATION_ENABLED
-    return d
 
 
 def pp_move(d: Drive, target: int, relative: bool = False) -> None:

@@ -14,17 +14,7 @@ from plcrt.devices.cia402.plant import DrivePlant
 from plcrt.devices.cia402.statemachine import State, state_of_statusword
 from plcrt.errors import PlcError
 
-
-def enable(d: Drive, mode: int, **params: int) -> Drive:
-    d.write(0x6060, 0, mode)
-    for key, value in params.items():
-        d.write(int(key[1:5], 16), int(key[6:]) if len(key) > 5 else 0, value)
-    for cw in (0x06, 0x07, 0x0F):
-        d.write(0x6040, 0, cw)
-    if d.sm.state is State.SWITCHED_ON:
-        d.cycle(d.now)
-    assert d.sm.state is State.OPERATION_ENABLED
-    return d
+from cia402_drive_helpers import enable
 
 
 # ---------------------------------------------------------------- enable and process data

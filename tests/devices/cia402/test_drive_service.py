@@ -19,17 +19,7 @@ from plcrt.devices.cia402.plant import DrivePlant, plant_of
 from plcrt.devices.cia402.statemachine import State
 from plcrt.errors import PlcConfigError
 
-
-def enable(d: Drive, mode: int, **params: int) -> Drive:
-    d.write(0x6060, 0, mode)
-    for name, value in params.items():
-        d.write(int(name[1:5], 16), int(name[6:]) if len(name) > 5 else 0, value)
-    for cw in (0x06, 0x07, 0x0F):
-        d.write(0x6040, 0, cw)
-    if d.sm.state is State.SWITCHED_ON:
-        d.cycle(d.now)
-    assert d.sm.state is State.OPERATION_ENABLED
-    return d
+from cia402_drive_helpers import enable
 
 
 def reset(d: Drive) -> None:

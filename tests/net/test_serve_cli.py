@@ -126,3 +126,29 @@ def test_a_modbus_map_needs_a_modbus_server(tmp_path: Path,
     assert main(["serve", str(prog), "--no-panel", "--lockstep", "0",
                  "--modbus-map", "x.toml"]) == 1
     assert "--modbus-map needs a Modbus server" in capsys.readouterr().err
+
+
+def test_s7_and_modbus_clients_beside_the_panel(tmp_path: Path) -> None:
+    """`plcrt serve PROGRAM --s7 0 --modbus 0`: python-snap7 and pymodbus
+    read the running program (VW0 counts scans) through the panel's thread."""
+    from pymodbus.client import ModbusTcpClient
+
+    from .s7_support import connect
+    p, ports = _start(["--port", "0", "--s7", "0", "--modbus", "0"], tmp_path)
+    try:
+        s7 = connect(ports["s7"])
+        try:
+            first = int.from_bytes(s7.db_read(1, 0, 2), "big")
+            time.sleep(0.2)
+            assert int.from_bytes(s7.db_read(1, 0, 2), "big") > first
+        finally:
+            s7.disconnect()
+        mb = ModbusTcpClient("127.0.0.1", port=ports["modbus"], timeout=5)
+        assert mb.connect()
+        try:
+            r = mb.read_holding_registers(0, count=1)     # 40001 = VW0
+            assert not r.isError() and r.registers[0] > first
+        finally:
+            mb.close()
+    finally:
+        assert _stop(p) == 0

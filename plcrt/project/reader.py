@@ -7,7 +7,9 @@ detected as an export's is.  The result holds that text, the blocks and
 what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
-layout, which is not read: they are refused with a message saying so.
+layout (compiled CPU code and a grid of ladder cells, no statement list),
+which is not read: they are refused with a message saying so, located at
+their main program block (docs/project-files.md, "Versions").
 """
 
 from __future__ import annotations
@@ -41,6 +43,9 @@ _CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
 #: the start of the program block: version 2, a block count, then MAIN
 #: (block version 7 or 8, type 1000, number 0)
 _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
+#: the main program block of a Micro/WIN V3 project: type 1000, one byte,
+#: then its name (1 to 64 characters)
+_V3_MAIN = re.compile(rb"\xe8\x03.[\x01-\x40]\x00", re.S)
 
 
 @dataclass
@@ -68,10 +73,12 @@ def read_project(data: bytes, file: str) -> Project:
     """The project in ``data`` (the bytes of a whole project file)."""
     box = open_container(data, file)
     if box.format == "Micro/WIN V3":
-        raise binary_error(file, "program block", 0, "Micro/WIN V3 projects (R03.xx) keep "
-                           "their program in a layout this reader does not read: open the "
-                           "project in Micro/WIN V4 and save it, or export it as STL (.awl)",
-                           PlcConfigError)
+        main = _V3_MAIN.search(box.stream)
+        raise binary_error(file, "program block", main.start() if main else 0,
+                           "Micro/WIN V3 projects (R03.xx) keep their program as compiled "
+                           "CPU code and ladder cells, a layout this reader does not read: "
+                           "open the project in Micro/WIN V4 and save it, or export it as "
+                           "STL (.awl)", PlcConfigError)
     cursor = _program_cursor(box)
     blocks = read_program_block(cursor)
     tables = read_symbol_tables(cursor)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 import random
 import sys
+import zlib
 from pathlib import Path
 
 import pytest
@@ -96,6 +97,21 @@ def test_corpus_projects_not_read_are_refused_by_name(name: str) -> None:
     with pytest.raises(kind, match=words) as e:
         plcrt.load(path)
     assert e.value.loc.file == str(path) and "byte 0x" in e.value.message
+
+
+@pytest.mark.parametrize("name", sorted(n for n, (_, w) in REFUSED.items()
+                                         if w == "Micro/WIN V3"))
+def test_v3_projects_are_refused_at_their_main_block(name: str) -> None:
+    """The refusal's offset is the main program block's header in the
+    inflated stream (type 1000, then its name), not the start of the file."""
+    path = _file(name)
+    with pytest.raises(PlcConfigError, match="compiled CPU code and ladder cells") as e:
+        read_project(path.read_bytes(), str(path))
+    at = e.value.loc.column - 1
+    stream = zlib.decompress(path.read_bytes()[0x14:])
+    assert at > 0 and stream[at:at + 2] == b"\xe8\x03"
+    size = int.from_bytes(stream[at + 3:at + 5], "little")
+    assert stream[at + 5:at + 5 + size].isalnum()      # PRINCIPAL, MAIN, ...
 
 
 @pytest.mark.parametrize("name", sorted(PAIRS))

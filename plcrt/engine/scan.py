@@ -198,7 +198,7 @@ class ScanLoop:
         Raises:
             PlcConfigError: ``mode`` is neither, or RUN after a fatal error.
         """
-        if mode not in ("RUN", "STOP"):
+        if not isinstance(mode, str) or mode not in ("RUN", "STOP"):
             raise PlcConfigError(f"CPU mode must be RUN or STOP, not {shown_value(mode)}")
         if mode == self.mode:
             return

@@ -71,7 +71,8 @@ END_ORGANIZATION_BLOCK
     assert plc.mode == "RUN" and plc["VW0"] == 5
 
 
-@pytest.mark.parametrize("bad", ["run", "PAUSE", "", None, 1])
+@pytest.mark.parametrize("bad", ["run", "PAUSE", "", None, 1, ["RUN"],
+                                 __import__("numpy").array(["RUN", "STOP"])])
 def test_other_modes_are_refused(bad: object) -> None:
     with pytest.raises(PlcConfigError):
         plcrt.load(FIRST).set_mode(bad)  # type: ignore[arg-type]

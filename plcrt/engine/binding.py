@@ -85,7 +85,12 @@ class Binding:
         key_options = {name: options[name] for name in COMPILE_OPTIONS}
         key = program_key(program, cpu=model.name, **key_options)
 
-        def make() -> CompiledProgram:
+        def make() -> CompiledProgram | None:
+            from ..compiler.native.jit import say_fallback, usable
+            why = usable()
+            if why is not None:      # the PLC stays on its Python build
+                say_fallback(why)
+                return None
             compiled = programs.peek(key, program)
             if compiled is None:
                 compiled = compile_to_program(

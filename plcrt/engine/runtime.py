@@ -80,10 +80,13 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
                                  f"got {shown_value(watchdog_ms)}")
-        auto = (backend if backend is not None else _env_backend()) == "auto"
-        backend = check_backend(backend)
-        if auto and backend == "native":
-            backend = "auto"      # Python at once, native when ready (engine/tiering.py)
+        requested = backend if backend is not None else _env_backend()
+        if isinstance(requested, str) and requested == "auto" and _llvmlite_importable():
+            # Python at once, native when ready (engine/tiering.py); whether
+            # LLVM works is found out in the compile thread
+            backend = "auto"
+        else:
+            backend = check_backend(backend)
         if backend == "native":
             from ..compiler.native.jit import available
             if not available():
@@ -334,6 +337,11 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""
         self.stop_requested = True
+
+
+def _llvmlite_importable() -> bool:
+    from ..compiler.native.jit import importable
+    return importable()
 
 
 def _env_backend() -> str:

@@ -176,4 +176,5 @@ class Tiering:
             _log.warning("plcrt: the native build could not be made (%s); this PLC keeps "
                          "running on the Python backend", type(e).__name__)
             return
-        self._rebind(native)
+        if native is not None:       # None: LLVM does not work here (said once)
+            self._rebind(native)

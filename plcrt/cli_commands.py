@@ -154,7 +154,10 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         "values": {k: json_number(v) for k, v in values.items()},
     }
     if plc is not None:
-        obj["backend"] = plc.backend["name"]
+        info = plc.backend
+        obj["backend"] = info["name"]
+        if info.get("tiered"):       # backend="auto": the scans run in Python first
+            obj["python_scans"] = info["python_scans"]
         # the CPU's own state the program sets: real-time clock and DLED
         obj["clock"] = plc.clock.now(plc.now_us).isoformat()
         obj["dled"] = plc.station.led
@@ -179,9 +182,11 @@ def backend_line(plc: Plc) -> str:
     """One line saying which code generator ran the program (``--verbose``)."""
     info = plc.backend
     if info["name"] != "native":
-        return "backend: python"
+        return "backend: python" + (" (native not ready yet)" if info.get("tiered") else "")
+    after = (f", after {info['python_scans']} scans in Python"
+             if info.get("python_scans") else "")
     return (f"backend: native ({info['pieces']} pieces as machine code, "
-            f"{len(info['python'])} in Python)")
+            f"{len(info['python'])} in Python{after})")
 
 
 def _fmt(value: int | float) -> str:

@@ -225,6 +225,15 @@ class ProgramCache:
             self.hits += 1
             return entry
 
+    def peek(self, key: tuple[Any, ...], program: Any) -> Any:
+        """:meth:`get` that counts no miss (a load that only looks whether
+        a build of another backend is made already)."""
+        with self._lock:
+            entry = self._entries.get(key) if self.max_entries > 0 else None
+            if entry is None or not (entry.program is program or entry.program == program):
+                return None
+        return self.get(key, program)
+
     def put(self, key: tuple[Any, ...], entry: Any) -> None:
         with self._lock:
             if self.max_entries <= 0:

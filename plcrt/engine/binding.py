@@ -19,6 +19,7 @@ running PLC's state (:mod:`.forking`).
 from __future__ import annotations
 
 import copy
+import time
 import zlib
 from typing import Any
 
@@ -40,16 +41,29 @@ COMPILE_OPTIONS = ("symbols", "system_symbols", "plant", "instrument", "library"
 class Binding:
     """Compiled program and bindings (a mixin of :class:`plcrt.engine.runtime.Plc`)."""
 
+    #: seconds this PLC's load spent compiling (0: from the program cache)
+    _load_s = 0.0
+
     def _compiled_program(self, program: ir.Program,
                           auto_diags: list[Diagnostic]) -> CompiledProgram:
         """The compiled program for this PLC's options, from the program
         cache or compiled now (and kept there)."""
         cfg = self._config
         options = {name: cfg[name] for name in COMPILE_OPTIONS}
+        if options["backend"] == "auto":
+            # tiered (engine/tiering.py): the native build if it is made
+            # already, else the Python build now and the native one later
+            options["backend"] = "native"
+            compiled = programs.peek(program_key(program, cpu=self.model.name, **options),
+                                     program)
+            if compiled is not None:
+                return compiled
+            options["backend"] = "python"
         key = program_key(program, cpu=self.model.name, **options)
         compiled = programs.get(key, program)
         if compiled is None:
             options["cpu"] = cfg["cpu"]
+            t0 = time.perf_counter()
             try:
                 compiled = compile_to_program(
                     program, self.model, options,
@@ -58,8 +72,34 @@ class Binding:
             except PlcCompileError as e:
                 e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
                 raise
+            self._load_s = time.perf_counter() - t0
             programs.put(key, compiled)
         return compiled
+
+    def _native_maker(self, python: CompiledProgram) -> Any:
+        """What compiles the native twin of ``python`` (in a worker thread:
+        it holds the program and options, never this PLC) and keeps it in
+        the program cache."""
+        program, model, hooks = python.program, self.model, self._parts.compile_hooks
+        options = dict(python.options, backend="native")
+        key_options = {name: options[name] for name in COMPILE_OPTIONS}
+        key = program_key(program, cpu=model.name, **key_options)
+
+        def make() -> CompiledProgram | None:
+            from ..compiler.native.jit import say_fallback, usable
+            why = usable()
+            if why is not None:      # the PLC stays on its Python build
+                say_fallback(why)
+                return None
+            compiled = programs.peek(key, program)
+            if compiled is None:
+                compiled = compile_to_program(
+                    program, model, options,
+                    probes=CoverageMap() if options["instrument"] else None, hooks=hooks)
+                programs.put(key, compiled)
+            compiled.native      # the machine code, made in this thread
+            return compiled
+        return make
 
     def _adopt(self, compiled: CompiledProgram, auto_diags: list[Diagnostic]) -> None:
         """Make this PLC an instance of ``compiled``: its own probe tables,
@@ -84,6 +124,11 @@ class Binding:
                                  f"{str(e)[:200]}); please report it with the program"
                                  ) from None
         self._filename = f"<plcrt {self.program.file}>"
+        self._ns = self._namespace(compiled)
+
+    def _namespace(self, compiled: CompiledProgram) -> dict[str, Any]:
+        """``compiled``'s code objects executed over this PLC's buffers and
+        resolved bindings (and its native segments, bound to this PLC)."""
         ns: dict[str, Any] = dict(CODECS)
         ns.update(self.mem.areas)
         ird, iwr, ptr = make_indirect(self.mem.areas, self.unit.locs,
@@ -97,7 +142,22 @@ class Binding:
             ns.update({f"_nseg{k}": call for k, call in enumerate(self._native.calls)})
         for code in compiled.codes:
             exec(code, ns)  # noqa: S102 - source built only from validated numbers
-        self._ns = ns
+        return ns
+
+    def _rebind(self, compiled: CompiledProgram) -> None:
+        """Run ``compiled`` -- the other backend's build of this PLC's
+        program and options, which binds the same objects under the same
+        names -- from the next scan on, over this PLC's own objects (the
+        switch of engine/tiering.py)."""
+        if compiled.bindings.keys() != self._entry.bindings.keys():
+            raise PlcConfigError("internal error: the two builds bind different state")
+        self._entry = compiled
+        self.unit, self.line_locs = compiled.unit, compiled.line_locs
+        ns = self._ns = self._namespace(compiled)
+        self._ob1 = ns[self.unit.pous[self.main_block].fname] \
+            if self.main_block is not None else None
+        self._int_fns = {number: ns[f"pou_INT{number}"] for number in self._int_fns}
+        self._replain()
 
     @property
     def compiled(self) -> CompiledProgram:
@@ -123,16 +183,23 @@ class Binding:
 
     @property
     def backend(self) -> dict[str, Any]:
-        """How the program runs: ``name`` (``"python"`` or ``"native"``) and,
+        """How the program runs: ``name`` (``"python"`` or ``"native"``: the
+        build running now), with ``backend="auto"`` ``tiered`` (True) and
+        ``python_scans`` (the scans run on the Python build before the
+        native one took over, or so far), and
         for native, ``pieces`` run as machine code, ``python`` (block,
         network, reason) of the pieces left in Python, ``segments``,
         ``compile_s`` and ``cached`` (machine code from the disk cache)."""
-        name = self._config["backend"]
+        name = self._entry.options.get("backend", self._config["backend"])
         plan = self.unit.native
+        tier: dict[str, Any] = {}
+        if self._python_scans is not None:
+            # backend="auto": the scans run on the Python build first
+            tier = {"tiered": True, "python_scans": self._python_scans}
         if name != "native" or plan is None:
-            return {"name": name}
+            return {"name": name, **tier}
         code = self._entry.native
-        return {"name": name, "pieces": plan.pieces, "python": list(plan.python),
+        return {**tier, "name": name, "pieces": plan.pieces, "python": list(plan.python),
                 "segments": len(plan.names),
                 "compile_s": code.compile_s if code is not None else 0.0,
                 "cached": bool(code is not None and code.cached)}

@@ -73,7 +73,7 @@ class Forking:
             raise PlcConfigError("this PLC is linked to others (plcrt.link): going back in time "
                                  "would break what they exchanged; restore before linking, or "
                                  "fork and restore the unlinked twin")
-        if (snapshot._entry.source != self._entry.source or snapshot.model != self.model
+        if (not _same_build(snapshot, self) or snapshot.model != self.model
                 or len(snapshot.devices) != len(self.devices)
                 or (snapshot.coverage is None) != (self.coverage is None)):
             raise PlcConfigError("this snapshot was taken from the same program compiled "
@@ -197,6 +197,19 @@ class Forking:
         for key, value in self.forces.items():
             dst.force(key, value)
         dst._replain()
+
+
+def _same_build(a: Any, b: Any) -> bool:
+    """Whether PLCs ``a`` and ``b`` run one compiled program, or the two
+    builds of one ``backend="auto"`` load (engine/tiering.py: they bind the
+    same state under the same names)."""
+    if a._entry.source == b._entry.source:
+        return True
+    if a._config["backend"] != "auto" or b._config["backend"] != "auto":
+        return False
+    def rest(plc: Any) -> dict[str, Any]:
+        return {k: v for k, v in plc._entry.options.items() if k != "backend"}
+    return rest(a) == rest(b)
 
 
 def _binding_pairs(src: Any, dst: Any) -> list[tuple[str, Any, Any]]:

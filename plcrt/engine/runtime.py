@@ -50,11 +50,12 @@ from .pid import make_loops
 from .ports import make_ports
 from .pulse import make_outputs
 from .scan import SMB0, ScanLoop
+from .tiering import Tiering
 from .timers import TimerBank
 from .values import check_backend, check_parsed_inputs, scan_time_us, shown_value, source_items
 
 
-class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
+class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess):
     """A loaded program, ready to scan.  Create it with :func:`plcrt.load`
     (or :meth:`from_program`, another instance of a compiled program)."""
 
@@ -79,7 +80,13 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
                                                  and 0 < watchdog_ms <= 1e9):
             raise PlcConfigError(f"watchdog_ms must be a positive number of milliseconds, "
                                  f"got {shown_value(watchdog_ms)}")
-        backend = check_backend(backend)
+        requested = backend if backend is not None else _env_backend()
+        if isinstance(requested, str) and requested == "auto" and _llvmlite_importable():
+            # Python at once, native when ready (engine/tiering.py); whether
+            # LLVM works is found out in the compile thread
+            backend = "auto"
+        else:
+            backend = check_backend(backend)
         if backend == "native":
             from ..compiler.native.jit import available
             if not available():
@@ -243,6 +250,8 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
         self.mem.areas["SM"][22:28] = ms * 3
         parts.attach_port_devices(self.ports, plant)   # a plant device sends at given times
         self._replain()
+        if backend == "auto" and _entry.options.get("backend") == "python":
+            self._tier_begin(self._native_maker(_entry), self._load_s)
 
     @classmethod
     def from_program(cls, compiled: CompiledProgram, *, data: Any = None,
@@ -328,6 +337,16 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Forking, AddressAccess):
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""
         self.stop_requested = True
+
+
+def _llvmlite_importable() -> bool:
+    from ..compiler.native.jit import importable
+    return importable()
+
+
+def _env_backend() -> str:
+    import os
+    return os.environ.get("PLCRT_BACKEND") or "auto"
 
 
 def _text_or_path(x: Any, encoding: str | None = None,

@@ -94,6 +94,9 @@ class ScanLoop:
         if self.network is not None:
             raise PlcConfigError("this PLC is linked to others: run them together with the "
                                  "network's run() (plcrt.link), not scan() or run()")
+        if self._tier is not None:   # backend="auto" on its Python build (engine/tiering.py)
+            self._tiered_scan(n)
+            return
         if self.pace == "realtime":
             for _ in range(n):
                 if self.mode != "RUN":

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from plcrt import PlcConfigError
+from plcrt.compiler.cache import programs
 from plcrt.cli import main, parse_value
 
 PROGRAMS = Path(__file__).resolve().parents[2] / "programs"
@@ -155,33 +156,65 @@ def test_run_plain_output(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_run_json(capsys: pytest.CaptureFixture[str]) -> None:
+    programs.clear()      # a first load, as a new process makes it
     code, out, _ = run_cli(capsys, "run", TIMERS, "--seconds", "2.5", "--set", "I0.0=1",
                            "--watch", "T37", "--watch", "Q0.0", "--json")
     assert code == 0
     obj = json.loads(out)
-    # the default backend: native, llvmlite being a dependency
+    # the default backend, auto: these 250 short scans run on the Python
+    # build while the native one would still be waiting to be compiled
     assert obj == {"program": TIMERS, "scans": 250, "time_s": 2.5, "mode": "RUN",
                    "values": {"T37": 24, "Q0.0": 1}, "clock": "2024-01-01T00:00:02",
-                   "dled": False, "backend": "native"}
+                   "dled": False, "backend": "python", "python_scans": 250}
 
 
 @pytest.mark.parametrize("backend", ["python", "native", "auto"])
 def test_run_says_which_backend_ran(backend: str, capsys: pytest.CaptureFixture[str]) -> None:
     """--json carries the backend that ran, --verbose says it on stderr
-    (auto is native where llvmlite works, as here)."""
-    ran = "python" if backend == "python" else "native"
+    (auto runs Python first: three scans never reach the native build)."""
+    programs.clear()
+    ran = "native" if backend == "native" else "python"
     code, out, _ = run_cli(capsys, "run", TIMERS, "--scans", "3", "--json", "--backend", backend)
     assert code == 0 and json.loads(out)["backend"] == ran
+    assert json.loads(out).get("python_scans") == (3 if backend == "auto" else None)
+    programs.clear()
     code, out, err = run_cli(capsys, "run", TIMERS, "--scans", "3", "--verbose",
                              "--backend", backend)
     assert code == 0
     line = next(x for x in err.splitlines() if x.startswith("backend: "))
-    if ran == "python":
+    if backend == "auto":
+        assert line == "backend: python (native not ready yet)"
+    elif ran == "python":
         assert line == "backend: python"
     else:
         assert re.fullmatch(r"backend: native \(\d+ pieces as machine code, \d+ in Python\)",
                             line), line
         assert line != "backend: native (0 pieces as machine code, 0 in Python)"
+
+
+def test_run_verbose_says_when_the_native_build_took_over(
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """A run long enough for the native build says after how many scans
+    it took over (the background job starts at once here)."""
+    from plcrt.engine import tiering
+    programs.clear()
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
+    monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "CHUNK_SCANS", 1)
+    import threading
+    real = tiering._start
+
+    def started(key, make):   # wait for the job, so that the switch comes in this run
+        fut = real(key, make)
+        fut.exception()
+        return fut
+    monkeypatch.setattr(tiering, "_start", started)
+    code, out, err = run_cli(capsys, "run", TIMERS, "--scans", "50", "--verbose")
+    assert code == 0
+    line = next(x for x in err.splitlines() if x.startswith("backend: "))
+    assert re.fullmatch(r"backend: native \(\d+ pieces as machine code, \d+ in Python, "
+                        r"after 1 scans in Python\)", line), line
+    assert not threading.current_thread().daemon
 
 
 def test_run_json_value_kinds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

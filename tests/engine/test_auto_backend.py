@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 import plcrt
+from plcrt.compiler.cache import programs
 from plcrt.compiler.native import jit
 
 pytest_plugins = ["pytester"]
@@ -46,7 +47,10 @@ def test_auto_is_the_default_and_native_where_llvmlite_works(
     assert jit.usable() is None
     with caplog.at_level(logging.INFO, logger="plcrt"):
         for backend in (None, "auto"):
-            plc = plcrt.load(PROGRAM, backend=backend)
+            programs.clear()
+            plc = plcrt.load(PROGRAM, backend=backend)   # Python first (engine/tiering.py)
+            assert plc.backend == {"name": "python", "tiered": True, "python_scans": 0}
+            plc._tier_up()
             assert plc.backend["name"] == "native" and plc.backend["pieces"] == 1
     assert caplog.records == []          # nothing to say when native runs
     assert plcrt.load(PROGRAM, backend="python").backend == {"name": "python"}

@@ -42,6 +42,17 @@ def available() -> bool:
     return True
 
 
+def importable() -> bool:
+    """Whether the llvmlite package imports at all (perf: without loading
+    LLVM's library, which :func:`usable` does, in the compile thread of
+    ``backend="auto"``)."""
+    try:
+        import llvmlite  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 #: the one line said when ``backend="auto"`` falls back to Python
 FALLBACK = "plcrt: the native backend is not available ({why}); running on the Python backend"
 
@@ -83,6 +94,11 @@ def auto_backend() -> str:
         return "native"
     _say_fallback(why)
     return "python"
+
+
+def say_fallback(why: str) -> None:
+    """Say :data:`FALLBACK` (once per process)."""
+    _say_fallback(why)
 
 
 @functools.lru_cache(maxsize=1)

@@ -1,0 +1,180 @@
+"""Tiered loading: ``backend="auto"`` runs Python at once, machine code when ready.
+
+What it is: :class:`Tiering`, a mixin of :class:`plcrt.engine.runtime.Plc`.
+A PLC loaded with ``backend="auto"`` where the native backend works is
+bound first to the Python build of its program (as fast to load as
+``backend="python"``).  Once it has spent some wall time scanning (about
+twice its load's compile time, at least :data:`START_AFTER_S`), the native
+build is compiled in a background thread (one job per Python build, shared
+by its forks), and the PLC switches to it at the next scan boundary after
+the job is done.  Both builds bind the same objects under the same names
+(the code generator numbers them in one order), so the switch keeps this
+PLC's resolved bindings -- edge memories, L buffers, library blocks -- and
+only executes the native build's code objects in a new namespace over
+them: memory, timers, devices and coverage tables are untouched, and the
+memory image after every scan is the same whenever the switch happens.
+
+The worker threads are daemons; at interpreter exit a job that has started
+is waited for (machine code generation must not run while the process
+tears down its libraries), and no new job starts.
+
+What it is not: the compiler (:mod:`plcrt.compiler.program`) or the scan
+loop (:mod:`.scan`, which calls :meth:`Tiering._tiered_scan`).
+"""
+
+from __future__ import annotations
+
+import atexit
+import logging
+import threading
+import time
+import weakref
+from concurrent.futures import Future
+from typing import Any, Callable
+
+__all__ = ["Tiering", "START_AFTER_S"]
+
+#: the least wall time a PLC scans in Python before its native build starts
+#: compiling: a short run (a test, ``plcrt run`` of a few seconds of
+#: simulated time) never pays for machine code it would not use
+START_AFTER_S = 0.05
+#: ... and at least this many times the seconds its load spent compiling
+#: (the native build takes a few times as long as the Python one)
+LOAD_FACTOR = 2.0
+#: scans between two looks at the background job (a look is a clock read)
+CHUNK_SCANS = 64
+
+_log = logging.getLogger("plcrt")
+#: the Python build -> the job compiling its native twin
+_jobs: "weakref.WeakKeyDictionary[Any, Future[Any]]" = weakref.WeakKeyDictionary()
+_lock = threading.Lock()
+_running: set[threading.Thread] = set()
+_closing = False
+
+
+def _start(key: Any, make: Callable[[], Any]) -> "Future[Any]":
+    """The job compiling ``key``'s native build with ``make`` (started now,
+    or the one already started for it)."""
+    with _lock:
+        fut = _jobs.get(key)
+        if fut is None:
+            fut = Future()
+            _jobs[key] = fut
+            if _closing:
+                fut.cancel()
+                return fut
+            thread = threading.Thread(target=_work, args=(fut, make), daemon=True,
+                                      name="plcrt-native-compile")
+            _running.add(thread)
+            thread.start()
+    return fut
+
+
+def _work(fut: "Future[Any]", make: Callable[[], Any]) -> None:
+    try:
+        fut.set_result(make())
+    except BaseException as e:  # noqa: BLE001 - reported where the PLC looks at it
+        fut.set_exception(e)
+    finally:
+        with _lock:
+            _running.discard(threading.current_thread())
+
+
+@atexit.register
+def _at_exit() -> None:
+    """No new job; wait for the ones under way (LLVM must not be compiling
+    while the process unloads it)."""
+    global _closing
+    with _lock:
+        _closing = True
+        threads = list(_running)
+    for thread in threads:
+        thread.join()
+
+
+class _Tier:
+    """A tiered PLC's state while it runs its Python build."""
+
+    __slots__ = ("key", "make", "start_after", "busy", "future")
+
+    def __init__(self, key: Any, make: Callable[[], Any], start_after: float) -> None:
+        self.key = key
+        self.make = make
+        self.start_after = start_after
+        self.busy = 0.0                     #: wall seconds scanned in Python
+        self.future: Future[Any] | None = _jobs.get(key)   # a fork's parent's job
+
+
+class Tiering:
+    """Python first, native when ready (a mixin of :class:`plcrt.engine.runtime.Plc`)."""
+
+    _tier: _Tier | None = None
+    #: scans run in Python before the switch (None: never tiered)
+    _python_scans: int | None = None
+
+    def _tier_begin(self, make: Callable[[], Any], load_s: float) -> None:
+        """Run the Python build now; ``make()`` compiles the native build."""
+        # perf: read at the PLC's load, so a test may set them to 0
+        self._tier = _Tier(self._entry, make, max(START_AFTER_S, LOAD_FACTOR * load_s))
+        self._python_scans = self.scans
+
+    def _tiered_scan(self, n: int) -> None:
+        """``scan(n)`` of a PLC on its Python build: in chunks, looking at
+        the native job between them and switching when it is done."""
+        clock = time.perf_counter
+        while n > 0:
+            tier = self._tier
+            if tier is None:
+                self.scan(n)
+                return
+            self._tier_poll(tier)
+            if self._tier is None:
+                continue
+            k = min(n, CHUNK_SCANS)
+            self._tier = None        # scan() below runs the plain loop
+            t0 = clock()
+            try:
+                self.scan(k)
+            finally:
+                tier.busy += clock() - t0
+                self._tier = tier
+                self._python_scans = self.scans
+            if self.mode != "RUN":    # scan() ends early only here (an observer
+                return                # may restore a snapshot: scans go back)
+            n -= k
+
+    def _tier_poll(self, tier: _Tier) -> None:
+        if tier.future is None:
+            if tier.busy >= tier.start_after:
+                tier.future = _start(tier.key, tier.make)
+            return
+        if tier.future.done():
+            self._tier_switch(tier.future)
+
+    def _tier_up(self) -> None:
+        """Compile the native build now (or wait for the job under way) and
+        switch to it before the next scan; nothing when this PLC is not on
+        the Python tier of ``backend="auto"``.  The memory image is the same
+        as without the switch (a test pins this at several scans)."""
+        tier = self._tier
+        if tier is None:
+            return
+        if tier.future is None:
+            tier.future = _start(tier.key, tier.make)
+        try:
+            tier.future.exception()      # waits for the job
+        except BaseException:  # noqa: BLE001 - a cancelled job: stay on Python
+            pass
+        self._tier_switch(tier.future)
+
+    def _tier_switch(self, future: "Future[Any]") -> None:
+        """Bind the native build over this PLC's objects (scan boundary)."""
+        self._tier = None
+        try:
+            native = future.result(timeout=0)
+        except BaseException as e:  # noqa: BLE001 - stay on Python, say why once
+            _log.warning("plcrt: the native build could not be made (%s); this PLC keeps "
+                         "running on the Python backend", type(e).__name__)
+            return
+        if native is not None:       # None: LLVM does not work here (said once)
+            self._rebind(native)

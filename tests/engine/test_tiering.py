@@ -1,0 +1,166 @@
+"""backend="auto" runs the Python build at once and switches to the native
+build at a scan boundary (plcrt/engine/tiering.py).
+
+The switch must be invisible except for speed: a PLC that switches at any
+scan has, after every scan, the memory image of the all-Python and of the
+all-native run of the same program and inputs.  Forks, snapshots taken on
+one build and restored on the other, pickling and the background job are
+pinned here too.
+"""
+
+from __future__ import annotations
+
+import pickle
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import plcrt
+from plcrt.compiler.cache import programs
+from plcrt.engine import tiering
+
+from test_backends import AREAS, structured_programs
+from test_differential import INITIAL_MEMORY, M_BYTES, SEGMENTS, V_BYTES
+
+pytest.importorskip("llvmlite")
+
+TIMERS = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\nTON T37, +10\n" \
+         "Network 2\nLD T37\nEU\n= Q0.0\nINCW VW0\nNetwork 3\nLD SM0.0\nCALL SBR_0\n" \
+         "END_ORGANIZATION_BLOCK\nSUBROUTINE_BLOCK SBR_0:SBR0\nBEGIN\nNetwork 1\n" \
+         "LD I0.1\nED\nINCB MB3\nEND_SUBROUTINE_BLOCK\n"
+
+
+@pytest.fixture(autouse=True)
+def _no_native_build_cached():
+    """A native build in the program cache is used at once, without tiers."""
+    programs.clear()
+
+
+def _image(plc: plcrt.Plc) -> tuple:
+    return (tuple(bytes(plc.mem.areas[a]) for a in AREAS), bytes(plc.timers.running),
+            list(plc.timers.preset), plc.mode)
+
+
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(program=structured_programs(), inputs=SEGMENTS, initial=INITIAL_MEMORY,
+       scan_ms=st.sampled_from((1, 10, 130)), switch=st.integers(0, 40))
+def test_the_switch_at_any_scan_gives_the_images_of_both_backends(
+        program, inputs, initial, scan_ms, switch) -> None:
+    programs.clear()    # else the native build of an earlier example is used at once
+    plcs = [plcrt.load(program, scan_ms=scan_ms, backend=b)
+            for b in ("auto", "python", "native")]
+    for plc in plcs:
+        plc.mem.areas["V"][:V_BYTES] = initial[:V_BYTES]
+        plc.mem.areas["M"][:M_BYTES] = initial[V_BYTES:]
+    auto, py, nat = plcs
+    assert auto.backend["name"] == "python" and auto.backend["tiered"]
+    scan = 0
+    for ib0, ib1, repeat in inputs:
+        for _ in range(repeat):
+            if scan == switch:
+                auto._tier_up()
+                assert auto.backend["name"] == "native"
+                assert auto.backend["python_scans"] == switch
+            for plc in plcs:
+                plc.mem.areas["PI"][0] = ib0
+                plc.mem.areas["PI"][1] = ib1
+                plc.scan()
+            scan += 1
+            assert _image(auto) == _image(py) == _image(nat), f"scan {scan}\n{program}"
+    assert auto.backend["name"] == ("native" if scan > switch else "python")
+
+
+@pytest.mark.parametrize("switch", [0, 1, 7, 33, 64, 65, 200])
+def test_a_switch_inside_one_long_run_changes_nothing(switch, monkeypatch) -> None:
+    """scan(n) runs in chunks and looks at the job between them: the image
+    after n scans is the same wherever in them the switch falls."""
+    auto = plcrt.load(TIMERS, backend="auto")
+    ref = plcrt.load(TIMERS, backend="python")
+    for plc in (ref, auto):
+        plc["I0.0"] = 1
+        plc.scan(switch)
+    auto._tier_up()
+    for plc in (ref, auto):
+        plc["I0.1"] = 1
+        plc.scan(150)
+        plc["I0.1"] = 0
+        plc.scan(150)
+    assert auto.backend["name"] == "native"
+    assert _image(auto) == _image(ref)
+    assert auto["VW0"] == 1 and auto["MB3"] == 1
+
+
+def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
+    """With no wait before the job, a running PLC switches by itself at a
+    scan boundary, and its image still equals the Python run's."""
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
+    monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    ref = plcrt.load(TIMERS, backend="python", scan_ms=1)
+    auto = plcrt.load(TIMERS, backend="auto", scan_ms=1)
+    for plc in (ref, auto):
+        plc["I0.0"] = 1
+    deadline = time.monotonic() + 60
+    while auto.backend["name"] != "native" and time.monotonic() < deadline:
+        for plc in (ref, auto):
+            plc.scan(100)
+    assert auto.backend["name"] == "native"
+    assert 0 < auto.backend["python_scans"] <= auto.scans
+    assert _image(auto) == _image(ref)
+    assert not [t for t in threading.enumerate()
+                if t.name == "plcrt-native-compile" and not t.daemon]
+
+
+def test_snapshot_fork_and_pickle_across_the_switch() -> None:
+    auto = plcrt.load(TIMERS, backend="auto")
+    ref = plcrt.load(TIMERS, backend="python")
+    for plc in (ref, auto):
+        plc["I0.0"] = 1
+        plc.scan(5)
+    before = auto.snapshot()                  # on the Python build
+    blob = pickle.dumps(auto.compiled)
+    auto._tier_up()
+    twin = auto.fork()                        # on the native build
+    assert twin.backend["name"] == "native"
+    for plc in (ref, auto, twin):
+        plc.scan(20)
+    assert _image(auto) == _image(ref) == _image(twin)
+    auto.restore(before)                      # a Python-build state into the native build
+    assert auto.backend["name"] == "native" and auto.scans == 5
+    auto.scan(20)
+    again = plcrt.load(TIMERS, backend="python")
+    again["I0.0"] = 1
+    again.scan(25)
+    assert _image(auto) == _image(again)
+    other = plcrt.Plc.from_program(pickle.loads(blob))
+    other["I0.0"] = 1
+    other.scan(25)
+    assert _image(other) == _image(again)
+    assert pickle.loads(pickle.dumps(auto.compiled)).native is not None
+
+
+def test_python_and_native_keep_their_meaning() -> None:
+    """python never switches, native is native from the first scan, and
+    auto with the native build already made uses it at once."""
+    assert plcrt.load(TIMERS, backend="python").backend == {"name": "python"}
+    native = plcrt.load(TIMERS, backend="native").backend
+    assert native["name"] == "native" and "tiered" not in native
+    assert plcrt.load(TIMERS, backend="auto").backend["name"] == "native"
+
+
+def test_a_process_with_a_job_under_way_exits(tmp_path) -> None:
+    """The worker is a daemon; exit waits for a started job and ends."""
+    code = ("import plcrt; from plcrt.engine import tiering\n"
+            "tiering.START_AFTER_S = tiering.LOAD_FACTOR = 0.0\n"
+            f"plc = plcrt.load({TIMERS!r}, backend='auto')\n"
+            "plc.scan(200)\nprint('ran', plc.scans)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120, env={"PLCRT_CACHE_DIR": str(tmp_path),
+                                           "PATH": "/usr/bin:/bin"})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "ran 200"

@@ -163,7 +163,7 @@ def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
 
 def _int(v: Any, where: str) -> int:
     if isinstance(v, bool) or not isinstance(v, int):
-        raise PlcConfigError(f"{where} must be an integer, got {v!r}")
+        raise PlcConfigError(f"{where} must be an integer, got {shown_value(v)}")
     return v
 
 
@@ -197,7 +197,7 @@ def _build(data: dict, file: str) -> Plant:
             raise PlcConfigError(f"{where} must be a table")
         kind = str(mod.get("kind", "EM253")).upper()
         if kind not in KINDS:
-            raise PlcConfigError(f"{where}: unknown module kind {kind!r} (known: {', '.join(KINDS)})")
+            raise PlcConfigError(f"{where}: unknown module kind {shown_value(kind)} (known: {', '.join(KINDS)})")
         unknown = set(mod) - _MODULE_KEYS[kind]
         if unknown:
             raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
@@ -280,7 +280,7 @@ def _analog(text: Any, kind: str, where: str) -> int:
 def _number(v: Any, where: str, lo: float, hi: float) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
             or not lo <= v <= hi:
-        raise PlcConfigError(f"{where} must be a number in {lo:g}..{hi:g}, got {v!r}")
+        raise PlcConfigError(f"{where} must be a number in {lo:g}..{hi:g}, got {shown_value(v)}")
     return float(v)
 
 
@@ -305,7 +305,7 @@ def _processes(raw: Any, where: str) -> list[dict[str, Any]]:
                 or any(isinstance(x, bool) or not isinstance(x, int) for x in rng)
                 or not -32768 <= rng[0] < rng[1] <= 32767):
             raise PlcConfigError(f"{pw}.range must be [low, high], whole counts in "
-                                 f"-32768..32767, got {rng!r}")
+                                 f"-32768..32767, got {shown_value(rng)}")
         cfg["range"] = (rng[0], rng[1])
         cfg["start"] = _number(p.get("start", cfg["offset"]), f"{pw}.start", -32768, 32767)
         if cfg["input"] in inputs:
@@ -347,14 +347,14 @@ def _encoders(raw: Any, where: str, wired: dict[int, int]) -> list[dict[str, Any
         hz = enc.get("hz")
         if isinstance(hz, bool) or not isinstance(hz, int) or not 1 <= hz <= 1_000_000:
             raise PlcConfigError(f"{ew}.hz must be a whole number of cycles per second, "
-                                 f"1..1000000, got {hz!r}")
+                                 f"1..1000000, got {shown_value(hz)}")
         times = []
         for key in ("start", "stop"):
             v = enc.get(key, 0.0 if key == "start" else None)
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
                                   or not math.isfinite(v) or v < 0
                                   or not math.isfinite(v * 1e6)):
-                raise PlcConfigError(f"{ew}.{key} must be seconds (0 or more), got {v!r}")
+                raise PlcConfigError(f"{ew}.{key} must be seconds (0 or more), got {shown_value(v)}")
             times.append(None if v is None else int(round(v * 1e6)))
         if times[1] is not None and times[1] < times[0]:
             raise PlcConfigError(f"{ew}: stop is before start")
@@ -403,7 +403,7 @@ def _axis(ax: dict, where: str) -> AxisPlant:
             raise PlcConfigError(f"{ew}: needs at (seconds), input and value") from None
         # bool('false') would be True: only a TOML boolean (or 0/1) is a value
         if not isinstance(value, (bool, int)) or value not in (0, 1):
-            raise PlcConfigError(f"{ew}: value must be true or false, got {value!r}")
+            raise PlcConfigError(f"{ew}: value must be true or false, got {shown_value(value)}")
         if not math.isfinite(at):
             raise PlcConfigError(f"{ew}: at must be a finite number of seconds, got {at}")
         if name not in EVENT_INPUTS or at < 0:
@@ -420,11 +420,11 @@ def _fieldbus(cfg: ModuleConfig, mod: dict, where: str, key: str) -> None:
         raise PlcConfigError(f"{where}.v must be a V byte address (0 or more), got {cfg.v}")
     cycle = mod.get("cycle_ms", 1)
     if isinstance(cycle, bool) or not isinstance(cycle, (int, float)) or not math.isfinite(cycle):
-        raise PlcConfigError(f"{where}.cycle_ms must be a number of milliseconds, got {cycle!r}")
+        raise PlcConfigError(f"{where}.cycle_ms must be a number of milliseconds, got {shown_value(cycle)}")
     cfg.cycle_us = int(round(cycle * 1000))
     if not 125 <= cfg.cycle_us <= 100_000 or cycle * 1000 != cfg.cycle_us:
         raise PlcConfigError(f"{where}.cycle_ms must be a whole number of µs from 0.125 to "
-                             f"100 ms, got {cycle!r}")
+                             f"100 ms, got {shown_value(cycle)}")
     drives = mod.get("drive", {})
     if not isinstance(drives, dict) or not drives:
         raise PlcConfigError(f"{where}: a FIELDBUS module needs drives "
@@ -480,7 +480,7 @@ def _drive(node: int, d: dict, where: str, default_image: int) -> DriveConfig:
     for name, value in raw.items():
         m = _PARAM_RE.fullmatch(name.strip())
         if m is None:
-            raise PlcConfigError(f"{where}.params: {name!r} is no object address "
+            raise PlcConfigError(f"{where}.params: {shown_value(name)} is no object address "
                                  f"(write INDEX:SUB in hex, e.g. \"6099:01\")")
         params.append((int(m.group(1), 16), int(m.group(2) or "0", 16),
                        _int(value, f"{where}.params.{name}"), f"{where}.params.{name}"))

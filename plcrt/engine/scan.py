@@ -45,7 +45,9 @@ class ScanLoop:
 
     @stop_requested.setter
     def stop_requested(self, value: bool) -> None:
-        self._stop = value
+        if not isinstance(value, (bool, int)):   # an array's truth is no answer
+            raise PlcConfigError(f"stop_requested is True or False, not {shown_value(value)}")
+        self._stop = bool(value)
         self._replain()
 
     @property

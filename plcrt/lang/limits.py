@@ -27,6 +27,7 @@ import stat
 from pathlib import Path
 
 from ..errors import PlcConfigError, PlcSyntaxError, SourceLoc
+from ..safetext import shown_value
 from ..paths import check_path
 
 #: default largest file read (program, symbol table, data block), in MiB.
@@ -68,7 +69,7 @@ def file_limit(max_file_mb: float | None = None) -> int:
     if isinstance(max_file_mb, bool) or not isinstance(max_file_mb, (int, float)) \
             or not 0 < max_file_mb < 1e6:
         raise PlcConfigError(f"the file size limit (--max-file-mb, max_file_mb=) must be a "
-                             f"number of MB above 0 and below 1000000, got {max_file_mb!r}")
+                             f"number of MB above 0 and below 1000000, got {shown_value(max_file_mb)}")
     return int(max_file_mb * _MIB)
 
 

@@ -93,3 +93,12 @@ END_ORGANIZATION_BLOCK
     assert plc.mode == "STOP"
     with pytest.raises(PlcConfigError, match="fatal error"):
         plc.set_mode("RUN")
+
+
+def test_stop_requested_takes_true_or_false_only() -> None:
+    plc = plcrt.load(FIRST)
+    with pytest.raises(PlcConfigError):
+        plc.stop_requested = __import__("numpy").array([1, 2])  # type: ignore[assignment]
+    plc.stop_requested = 1
+    plc.scan(2)
+    assert plc.mode == "STOP"

@@ -68,7 +68,7 @@ class DrivePlant:
         neg, pos = self.neg_stop, self.pos_stop
         for name, value in (("neg_stop", neg), ("pos_stop", pos)):
             if value is not None and not isinstance(value, int):
-                raise Cia402Error(f"plant: {name} = {value!r} must be a whole count")
+                raise Cia402Error(f"plant: {name} = {shown_value(value)} must be a whole count")
         rules = (
             (neg is not None and pos is not None and neg >= pos,
              f"neg_stop = {neg} must lie below pos_stop = {pos}"),
@@ -172,7 +172,7 @@ def plant_of(value: Any, where: str = "plant") -> DrivePlant:
                                  "axis follows its demand exactly; docs/cia402.md, \"The "
                                  "plant\")")
         if key not in PLANT_KEYS:
-            raise PlcConfigError(f"{where}: unknown key {name!r}; keys: {', '.join(PLANT_KEYS)}")
+            raise PlcConfigError(f"{where}: unknown key {shown_value(name)}; keys: {', '.join(PLANT_KEYS)}")
         if key in _ZONES:
             if not (isinstance(v, (list, tuple)) and len(v) == 2):
                 raise PlcConfigError(f"{where}.{key} must be [low, high], got {shown_value(v)}")

@@ -70,7 +70,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import PlcConfigError, PlcError
-from ..safetext import shown_value
+from ..safetext import printable, shown_value
 from ..lang.limits import file_limit, read_capped
 from .cia402.coupler import IMAGE_BYTES
 from .keys import checked_table
@@ -161,6 +161,13 @@ def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
     return _build(data, file)
 
 
+def _keys(keys: set[Any]) -> str:
+    """Unknown keys for a message: texts escaped, anything else (a dict
+    given from Python may have any keys) shown by its value."""
+    return ", ".join(sorted(printable(k) if isinstance(k, str) else shown_value(k)
+                            for k in keys))
+
+
 def _int(v: Any, where: str) -> int:
     if isinstance(v, bool) or not isinstance(v, int):
         raise PlcConfigError(f"{where} must be an integer, got {shown_value(v)}")
@@ -173,7 +180,7 @@ def _build(data: dict, file: str) -> Plant:
     # modules and only run-time warnings: reject unknown keys at every level.
     unknown = set(data) - {"module", "cpu", "pto", "pwm", "port", "ethernet"}
     if unknown:
-        raise PlcConfigError(f"{file}: unknown key(s) {', '.join(sorted(unknown))} "
+        raise PlcConfigError(f"{file}: unknown key(s) {_keys(unknown)} "
                              f"(a plant file has [module.N] tables, a [cpu] table, "
                              f"[pto.N] / [pwm.N] tables, [port.N] tables and an [ethernet] "
                              f"table)")
@@ -200,7 +207,7 @@ def _build(data: dict, file: str) -> Plant:
             raise PlcConfigError(f"{where}: unknown module kind {shown_value(kind)} (known: {', '.join(KINDS)})")
         unknown = set(mod) - _MODULE_KEYS[kind]
         if unknown:
-            raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+            raise PlcConfigError(f"{where}: unknown key(s) {_keys(unknown)} "
                                  f"(a {kind} module has {', '.join(sorted(_MODULE_KEYS[kind]))})")
         cfg = ModuleConfig(slot, kind, where=where)
         if kind == "FIELDBUS":
@@ -219,7 +226,7 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere} must be a table")
             unknown = set(ax) - _AXIS_KEYS
             if unknown:
-                raise PlcConfigError(f"{awhere}: unknown key(s) {', '.join(sorted(unknown))}")
+                raise PlcConfigError(f"{awhere}: unknown key(s) {_keys(unknown)}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
     return Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports,
@@ -238,7 +245,7 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
         raise PlcConfigError(f"{where} must be a table")
     unknown = set(cpu) - {"wire", "encoder", "process", "clock"}
     if unknown:
-        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+        raise PlcConfigError(f"{where}: unknown key(s) {_keys(unknown)} "
                              f"(known: wire, encoder, process, clock)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
@@ -453,7 +460,7 @@ def _fieldbus(cfg: ModuleConfig, mod: dict, where: str, key: str) -> None:
 def _drive(node: int, d: dict, where: str, default_image: int) -> DriveConfig:
     unknown = set(d) - _DRIVE_KEYS
     if unknown:
-        raise PlcConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+        raise PlcConfigError(f"{where}: unknown key(s) {_keys(unknown)} "
                              f"(known: {', '.join(sorted(_DRIVE_KEYS))})")
     model = d.get("model")
     if not isinstance(model, str):

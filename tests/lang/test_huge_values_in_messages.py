@@ -30,3 +30,8 @@ def test_the_file_size_limit_names_a_list_holding_a_huge_integer() -> None:
 def test_a_plant_number_that_is_a_list_holding_a_huge_integer() -> None:
     with pytest.raises(PlcConfigError, match="huge integer"):
         load_plant({"module": {"0": {"axis": {"0": {"start": HUGE}}}}})
+
+
+def test_a_plant_dict_with_keys_that_are_not_texts() -> None:
+    with pytest.raises(PlcConfigError, match="unknown key"):
+        load_plant({1: 2, "b": 3})

@@ -115,10 +115,7 @@ class LockstepServer(TcpService):
             raise PlcConfigError(f"{op} needs {', '.join(sorted(required - fields))}")
         if fields - required - optional:
             raise PlcConfigError(f"{op} takes no {printable(sorted(fields - required - optional)[0][:40])}")
-        rid = msg.get("id")
-        if rid is not None and not (isinstance(rid, int) and not isinstance(rid, bool)
-                                    and abs(rid) < 2 ** 53
-                                    or isinstance(rid, str) and len(rid) <= 64):
+        if msg.get("id") is not None and not _valid_id(msg["id"]):
             raise PlcConfigError("an id is a whole number or a text of at most 64 characters")
         return msg
 
@@ -214,9 +211,13 @@ def _request_id(line: bytes) -> Any:
         msg = jsonmsg.load(line, max_bytes=MAX_LINE, max_depth=MAX_DEPTH)
     except PlcError:
         return None
-    if isinstance(msg, dict):
-        rid = msg.get("id")
-        if isinstance(rid, int) and not isinstance(rid, bool) and abs(rid) < 2 ** 53 \
-                or isinstance(rid, str) and len(rid) <= 64:
-            return rid
+    if isinstance(msg, dict) and _valid_id(msg.get("id")):
+        return msg["id"]
     return None
+
+
+def _valid_id(rid: Any) -> bool:
+    """A request id the answer may echo: a whole number JSON carries
+    exactly, or a text of at most 64 characters."""
+    return (isinstance(rid, int) and not isinstance(rid, bool) and abs(rid) < 2 ** 53
+            or isinstance(rid, str) and len(rid) <= 64)

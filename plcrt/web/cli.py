@@ -130,15 +130,6 @@ def _is_address(host: str) -> bool:
     return True
 
 
-def _loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
-
-
 def cmd_serve(args: argparse.Namespace) -> int:
     """``plcrt serve``: 0 after Ctrl-C, 1 a program, option or port error."""
     from ..term.report import EXIT_ERROR, EXIT_OK, print_diagnostics
@@ -174,7 +165,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except PlcError as e:
         print_diagnostics(e.diagnostics)
         return EXIT_ERROR
-    if not _loopback(args.host):
+    from ..net.options import exposed
+    if exposed(args.host):
         print(f"plcrt serve: warning: listening on {args.host}: anyone who can reach this "
               f"address can run and force the PLC", file=sys.stderr)
     try:

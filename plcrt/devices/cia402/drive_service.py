@@ -97,6 +97,8 @@ DISPLAY: dict[int, Callable[[Any], int]] = {
     9: lambda d: int(d.store.get(0x6060)) & 0xFFFF,          # mode set by the master
     21: lambda d: d.di_levels(),                             # DI monitor, bit n = DI n+1
     36: lambda d: int(d.esm.state),                          # EtherCAT state
+    37: lambda d: d.esm.al_code & 0xFFFF,                    # AL status code (ETG.1000.6)
+    39: lambda d: int(d.store.get(0x6041)) & 0xFFFF,         # CoE 402 state: 6041h
 }
 
 

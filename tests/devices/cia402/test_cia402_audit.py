@@ -198,16 +198,58 @@ def test_605ah_out_of_range_aborts_with_too_high_or_too_low(model):
 
 # ---------------------------------------------------------------- the audit table
 
-def test_every_test_the_audit_table_names_exists():
-    """docs/cia402.md, "Audit against the manuals": each row names a test of
-    tests/devices/cia402/ that exists."""
+def audit_rows() -> list[str]:
+    """The statement rows of docs/cia402.md's "Audit against the manuals"."""
     text = DOCS.read_text(encoding="utf-8")
     section = text.split("## Audit against the manuals", 1)[1].split("\n## ", 1)[0]
-    named = re.findall(r"`(test_[a-z0-9_]+)`", section)
-    assert len(named) >= 15
+    return [line for line in section.splitlines()
+            if line.startswith("| ") and not line.startswith("| manual | statement")]
+
+
+def decisions_log() -> str:
+    return DOCS.read_text(encoding="utf-8").split("## Decisions log", 1)[1]
+
+
+def test_every_test_the_audit_table_names_exists():
+    """docs/cia402.md, "Audit against the manuals": each row names a test of
+    tests/devices/cia402/ that exists, or quotes a decision (“…”) that the
+    decisions log holds, or both."""
+    rows = audit_rows()
+    assert len(rows) >= 150
     here = Path(__file__).parent
     defined = set()
     for f in here.glob("test_*.py"):
         defined |= set(re.findall(r"^def (test_[a-z0-9_]+)", f.read_text(encoding="utf-8"),
                                   re.M))
-    assert sorted(set(named) - defined) == []
+    log = decisions_log()
+    missing, unlogged, bare = set(), set(), []
+    for row in rows:
+        last = row.rstrip(" |").rsplit(" | ", 1)[1]
+        named = re.findall(r"`(test_[a-z0-9_]+)`", last)
+        quoted = re.findall(r"decision “([^”]+)”", last)
+        missing |= set(named) - defined
+        unlogged |= {q for q in quoted if q not in log}
+        if not named and not quoted:
+            bare.append(row)
+    assert sorted(missing) == [] and sorted(unlogged) == [] and bare == []
+
+
+def test_the_audit_counts_are_the_tables():
+    """The counts paragraph of the audit says what the tables hold: rows with
+    a test (and how many of them also follow a decision), rows with a
+    decision alone, the OD rows of test_cia402_audit_od.py and the parts of
+    the manuals that are not simulated."""
+    text = DOCS.read_text(encoding="utf-8")
+    section = text.split("## Audit against the manuals", 1)[1].split("\n## ", 1)[0]
+    rows = audit_rows()
+    tested = [r for r in rows if "`test_" in r.rsplit(" | ", 1)[1]]
+    both = [r for r in tested if "decision “" in r.rsplit(" | ", 1)[1]]
+    od = sum(int(n) for n in re.findall(r"(?:§[\d.]+|tables|units) (\d+)",
+                                         section.split("OD rows: ", 1)[1].split(")", 1)[0]))
+    parts = section.split("### Not simulated", 1)[1].split("\n### ", 1)[0].count("\n- ")
+    total = od + len(rows) + parts
+    line = (f"{total} statements: {od} rows of the manuals' object tables, "
+            f"{len(rows)} rows of the tables below ({len(tested)} honoured with a test, "
+            f"{len(both)} of them a logged decision's reading; {len(rows) - len(tested)} "
+            f"logged decisions alone) and {parts} parts of the manuals that are not simulated")
+    assert line in " ".join(section.split()), line

@@ -246,3 +246,24 @@ def test_p18_37_and_39_read_the_al_code_and_the_402_state():
     assert d.read(0x2012, 37) == 0x0011
     d.write(0x6040, 0, 0x06)
     assert d.read(0x2012, 39) == d.statusword == 0x0631        # §7.3, CSP
+
+
+# ---------------------------------------------------------------- §4.7: every alarm by name
+
+@pytest.mark.parametrize("name,code,resettable", [
+    ("parameter_storage", 4, False), ("communication", 17, False), ("phase_loss", 8, False),
+    ("power_stage", 20640, False), ("overcurrent", 20704, False), ("under_voltage", 12828, False),
+    ("over_voltage", 12827, True), ("encoder", 10256, True)])
+def test_every_4_7_alarm_by_name_with_its_reset_rule(name, code, resettable):
+    """§4.7: each alarm the table names (by the names of `inject_fault`)
+    shows its number in 603Fh; "是" clears with a reset (15), "否" only
+    with a power cycle."""
+    d = enable(Drive(HCFA), 3)
+    assert d.inject_fault(name) == code and d.read(0x603F) == code
+    d.cycle(d.now + 1000)
+    d.write(0x6040, 0, 0x00)
+    d.write(0x6040, 0, 0x80)
+    d.cycle(d.now + 1000)
+    assert (d.read(0x603F) == 0) is resettable
+    d.power_cycle()
+    assert d.read(0x603F) == 0

@@ -44,7 +44,8 @@ def test_kinco_method_1_as_2_2_describes_it():
 def test_kinco_2_6_statusword_bits_in_pp():
     """Kinco §2.6: bits 0–6 the CiA 402 state (operation enabled 0x27 with
     bit 5 quick stop = 1), bit 9 remote, bit 12 set-point acknowledge, bit 10
-    target reached, bit 11 a limit switch; bit 7 (warning) never set."""
+    target reached, bit 11 a limit switch with bit 8 (manufacturer bit 0:
+    the abnormal stop, as on the HCFA drive); bit 7 (warning) never set."""
     d = enable(Drive(KINCO, plant=DrivePlant(pos_limit=5000)), 1, x6081=20_000,
                x6083=100_000, x6084=100_000)
     sw = d.statusword
@@ -59,5 +60,5 @@ def test_kinco_2_6_statusword_bits_in_pp():
     d.write(0x6040, 0, 0x1F)
     d.write(0x6040, 0, 0x0F)
     d.advance(3_000_000)
-    assert d.position == 5000 and d.statusword & 0x0800
+    assert d.position == 5000 and d.statusword & 0x0900 == 0x0900    # bit 8: the limit stop
     assert not d.statusword & 0x0080 and not sw & 0x0080

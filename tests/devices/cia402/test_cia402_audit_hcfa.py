@@ -267,3 +267,13 @@ def test_every_4_7_alarm_by_name_with_its_reset_rule(name, code, resettable):
     assert (d.read(0x603F) == 0) is resettable
     d.power_cycle()
     assert d.read(0x603F) == 0
+
+
+def test_60c5h_60c6h_do_not_act_in_pv():
+    """§7.5.1 gives 60C5h / 60C6h to PP and HM ("—" for CSP), §7.6.1 does
+    not list them for PV: PV ramps on 6083h above 60C5h unchanged."""
+    d = enable(Drive(HCFA), 3, x6083=400_000, x6084=400_000, x60C5=100_000, x60C6=100_000)
+    d.write(0x60FF, 0, 40_000)
+    d.advance(50_000)
+    assert d.read(0x606C) == 20_000                 # 400 000 P/s² for 50 ms
+    assert not any("60C5h" in e.text for e in d.log)

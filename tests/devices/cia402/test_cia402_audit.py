@@ -3,9 +3,11 @@ that the other CiA 402 tests do not pin.
 
 Each test names the manual's section and the statement it pins (or the
 decision of docs/decisions.md it follows where the manual is silent or
-wrong); docs/cia402.md ("Audit against the manuals") lists these statements
-with their tests, and the last test here checks that every test it names
-exists.
+wrong); docs/cia402.md ("Audit against the manuals") lists every statement
+of both manuals with its test or decision.  The last two tests here check
+that table: every test it names exists, every decision it quotes is in the
+decisions log, and its counts are the table's.  The statements of the other
+audit files: test_cia402_audit_od.py (the object tables), _hcfa.py, _kinco.py.
 """
 
 from __future__ import annotations

@@ -94,6 +94,10 @@ class Panel:
             **self.current.to_dict(), "doc": self.current.page(),
             "checkable": bool(self.current.tests)}
         msg["load_error"] = self.load_error
+        src = self.source() if self.source_of is not None else None
+        msg["editable"] = src is not None
+        if src is not None:   # a downloaded program was loaded from the editor's text
+            msg["files"] = [str(src.path) if f == "<string>" else f for f in msg["files"]]
         if self.load_error is not None and self.current is not None:
             msg["files"] = [str(self.current.program)]   # not the empty stand-in's
         return msg

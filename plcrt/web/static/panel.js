@@ -99,6 +99,7 @@ function onHello(h) {
   for (const d of h.drives) P.axisEls.push(buildAxis("drive " + d.node + " (" + d.model + ")", d));
   onDiagnostics(h.diagnostics || { items: [], more: null });
   ariaIO(P.frame);
+  if (window.plcrtEditor) window.plcrtEditor.onHello(h);   // editor.js
 }
 
 function buildTabs(h) {
@@ -265,7 +266,7 @@ function press(addr, down) {
 }
 
 document.addEventListener("keydown", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
   if (e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) { press(P.hello.inputs[n].addr, true); return; }
@@ -274,7 +275,7 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "n") send({ type: "step" });
 });
 document.addEventListener("keyup", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) press(P.hello.inputs[n].addr, false);
 });

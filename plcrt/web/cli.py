@@ -110,8 +110,8 @@ def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
             ns.programs = [str(les.program)]
             ns.symbols = str(les.symbols) if les.symbols else args.symbols
             ns.plant = str(les.plant) if les.plant else args.plant
-        if Path(ns.programs[0]).is_dir():
-            return None
+        if Path(ns.programs[0]).suffix.lower() != ".awl":
+            return None   # a project file (.mwp, .smart) is not edited as text
         return ProgramSource(Path(ns.programs[0]), tuple(Path(p) for p in ns.programs[1:]),
                              _load_options(ns))
 

@@ -255,3 +255,102 @@ def test_a_text_over_the_limit_is_refused_unread(tmp_path) -> None:
                               headers={"Content-Type": "application/json"})
         assert r.status == 400 and "larger than" in (await r.json())["message"]
     _run(tmp_path, body)
+
+
+# ---------------------------------------------------------------- lessons
+def _lesson(tmp_path: Path, program: str | None = None) -> tuple[Path, Panel]:
+    import shutil
+
+    from .test_browser_lessons import COURSE, lesson_panel
+    folder = tmp_path / "course" / "01-seal-in"
+    shutil.copytree(COURSE / "01-seal-in", folder)
+    if program is not None:
+        (folder / "lesson.awl").write_text(program)
+    return folder, lesson_panel(folder, watch_s=0.05)
+
+
+def _run_lesson(panel: Panel, body) -> None:
+    async def main():
+        client = await _client(panel)   # starts the lesson watcher
+        panel.session.start()
+        try:
+            await body(client, panel)
+        finally:
+            await client.close()
+            panel.session.close()
+    _in_thread(main)
+
+
+def test_a_lessons_editor_edits_lesson_awl_and_saving_does_not_reload_it(tmp_path) -> None:
+    folder, panel = _lesson(tmp_path)
+
+    async def body(client, panel):
+        src = await (await client.get("/editor/source")).json()
+        assert src["name"] == "lesson.awl"
+        assert src["text"] == (folder / "lesson.awl").read_text()
+        before = panel.session
+        before.plc.write("VW100", 1234)
+        status, ans = await _post(client, "/editor/save", text=NEW, stamp=src["stamp"])
+        assert ans["ok"] is True
+        assert (folder / "lesson.awl").read_bytes() == NEW.encode()   # LF as it was
+        await asyncio.sleep(0.5)          # ten looks of the watcher
+        # saving is not downloading: the PLC runs what it ran, with its memory
+        assert panel.session is before and before.plc.read("VW100") == 1234
+        # a change by another program reloads the lesson (from power-up)
+        (folder / "lesson.awl").write_text(GOOD)
+        await _until(lambda: panel.session is not before)
+        ans = await (await client.get("/editor/source")).json()
+        assert ans["text"] == GOOD and ans["stamp"] != src["stamp"]
+    _run_lesson(panel, body)
+
+
+def test_a_lesson_that_does_not_load_is_mended_by_a_download(tmp_path) -> None:
+    folder, panel = _lesson(tmp_path)
+
+    async def body(client, panel):
+        (folder / "lesson.awl").write_text(BAD)
+        await _until(lambda: panel.load_error is not None)
+        status, ans = await _post(client, "/editor/check",
+                                  text=(folder / "lesson.awl").read_text())
+        assert [d["line"] for d in ans["diagnostics"] if d["severity"] == "error"] == [6]
+        status, ans = await _post(client, "/editor/download", text=GOOD)
+        assert (ans["ok"], ans["mode"]) == (True, "stop")
+        assert panel.load_error is None
+        hello = panel.hello()
+        assert hello["files"] == [str(folder / "lesson.awl")] and hello["editable"] is True
+        assert [n["number"] for n in hello["blocks"][0]["networks"]] == [1, 2]
+    _run_lesson(panel, body)
+
+
+def test_a_project_file_is_not_edited_as_text(tmp_path) -> None:
+    import argparse
+
+    from plcrt.web.cli import build_panel
+    prog = tmp_path / "prog.awl"
+    prog.write_text(GOOD)
+    args = argparse.Namespace(
+        programs=[str(prog)], symbols=None, encoding=None, data=None, cpu=None, plant=None,
+        auto_symbols=False, backend="python", max_file_mb=None, scan_ms=10.0, clock=None,
+        no_breakpoints=False, host="127.0.0.1", allow_host=[])
+    panel = build_panel(args)
+    src = panel.source()
+    assert src is not None and src.path == prog and src.options["backend"] == "python"
+    assert panel.hello()["editable"] is True
+    # the same options naming a project file: nothing to edit as text
+    args.programs = [str(tmp_path / "project.mwp")]
+    assert panel.source() is None and panel.hello()["editable"] is False
+
+
+def test_save_refuses_a_file_it_may_not_write(tmp_path) -> None:
+    from plcrt.errors import PlcConfigError
+    from plcrt.web.editor import save
+
+    class ReadOnly(ProgramSource):
+        def writable(self) -> bool:   # as os.access says of a file of another user
+            return False
+
+    path = tmp_path / "prog.awl"
+    path.write_text(GOOD)
+    with pytest.raises(PlcConfigError, match="read-only: nothing was saved"):
+        save(ReadOnly(path), NEW, None)
+    assert path.read_text() == GOOD

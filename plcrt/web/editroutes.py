@@ -143,8 +143,12 @@ async def _download(panel: Any, src: editor.ProgramSource, text: str, mode: str,
         plc, breakpoints=old.builds.breakable, kinds=les.kinds() if les is not None else None,
         door=old.door))
 
+    given_up = False
+
     def job(cur: Any) -> str | None:
         # in the old session's thread, at a scan boundary: stop it there
+        if given_up:
+            return "the download was given up"
         why = editor.run_obstacle(cur, new.plc) if mode == "run" else None
         if why is None:
             old.control.stop()
@@ -156,7 +160,14 @@ async def _download(panel: Any, src: editor.ProgramSource, text: str, mode: str,
         return why
 
     if panel.load_error is None:
-        why = await asyncio.wrap_future(old.door.post(job))
+        try:
+            why = await asyncio.wait_for(asyncio.wrap_future(old.door.post(job)),
+                                         editor.SWAP_TIMEOUT)
+        except (asyncio.TimeoutError, PlcError):   # PlcError: the door is busy or closed
+            given_up = True
+            new.close()
+            raise PlcConfigError("the PLC did not reach a scan boundary in "
+                                 f"{editor.SWAP_TIMEOUT:g} s: nothing was downloaded") from None
     else:   # no program runs: nothing to stop or carry
         why, mode = None, "stop"
     if why is not None:

@@ -354,3 +354,27 @@ def test_save_refuses_a_file_it_may_not_write(tmp_path) -> None:
     with pytest.raises(PlcConfigError, match="read-only: nothing was saved"):
         save(ReadOnly(path), NEW, None)
     assert path.read_text() == GOOD
+
+
+def test_a_download_is_given_up_when_the_plc_reaches_no_scan_boundary(tmp_path,
+                                                                         monkeypatch) -> None:
+    from plcrt.web import editor
+    monkeypatch.setattr(editor, "SWAP_TIMEOUT", 0.2)
+    path = tmp_path / "prog.awl"
+    path.write_text(GOOD)
+
+    async def main():
+        panel = _panel(path)      # its runner thread is not started: no scan boundary
+        client = await _client(panel)
+        try:
+            old = panel.session
+            old.control.run(old.plc)
+            status, ans = await _post(client, "/editor/download", text=NEW)
+            assert status == 400 and "did not reach a scan boundary" in ans["message"]
+            assert panel.session is old
+            old.tick(wait=False)   # the job runs late: it changes nothing
+            assert old.state == "running" and old.plc.read("VW10") == 7
+        finally:
+            await client.close()
+            panel.session.close()
+    _in_thread(main)

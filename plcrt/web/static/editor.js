@@ -346,6 +346,7 @@
     $("editor-reload").addEventListener("click", () =>
       loadSource("Discard your edits and load the file again?"));
     setInterval(poll, 1500);
+    window.addEventListener("beforeunload", (e) => { if (dirty()) e.preventDefault(); });
     // the first hello may have come before this script ran
     if (window.plcrtPanel && window.plcrtPanel.hello) E.onHello(window.plcrtPanel.hello);
   });

@@ -115,6 +115,10 @@ def test_completion_and_hover_help_come_from_the_registry_and_symbols(serve, pag
     labels = page.locator(".cm-tooltip-autocomplete li").all_text_contents()
     assert any(t.startswith("Lamp") for t in labels)
     page.keyboard.press("Escape")
+    page.keyboard.type("mp\nA      T3")   # an address the text uses
+    page.wait_for_selector(".cm-tooltip-autocomplete")
+    assert "T37" in page.locator(".cm-tooltip-autocomplete li").all_text_contents()
+    page.keyboard.press("Escape")
     # hover over TON: its summary and operands
     box = page.locator(".cm-line", has_text="TON").bounding_box()
     page.mouse.move(box["x"] + 8, box["y"] + box["height"] / 2)
@@ -211,3 +215,25 @@ def _post_from_other_origin(page, panel, path, served) -> None:
     }""", served.url)
     assert seen == {"save": 403, "download": 403, "check": 403}
     assert path.read_text() == PROGRAM and panel.session is before
+
+
+def test_stl_is_highlighted_by_kind(serve, page, tmp_path) -> None:
+    panel, path = _panel(tmp_path)
+    served = serve(panel=panel)
+    _open_editor(page, served)
+    _go_to_end_of_line(page, 5)
+    page.keyboard.type("\nNetwork 2\nLD     Start\nTON    T37, 16#0A\n")
+    colors = page.evaluate("""() => {
+        const root = document.querySelector('#editor-host').shadowRoot;
+        const out = {};
+        for (const s of root.querySelectorAll('.cm-line span')) {
+          out[s.textContent] = getComputedStyle(s).color;
+        }
+        return out;
+    }""")
+    assert colors["LD"] == colors["TON"] == "rgb(13, 71, 161)"            # instructions
+    assert colors["I0.0"] == colors["T37"] == "rgb(0, 105, 92)"          # addresses
+    assert colors["16#0A"] == "rgb(230, 81, 0)"                          # constants
+    assert colors["Start"] == "rgb(173, 20, 87)"                         # symbols
+    assert colors["Network"] == colors["ORGANIZATION_BLOCK"] == "rgb(106, 27, 154)"
+    assert colors['// <img src=x onerror="window.pwned=1">'] == "rgb(117, 117, 117)"

@@ -22,6 +22,7 @@
   // pointers (&VB100, *VD4, *AC1)
   const ADDRESS = /^[&*]?(?:(?:SM|[IQMVSL])\d+\.\d+|(?:SM|AI|AQ|[IQMVSL])[BWD]\d+|AC\d|HC\d|[TC]\d+)(?![\w.])/i;
   const NUMBER = /^(?:16#[0-9A-F]+|2#[01]+|[+-]?\d+(?:\.\d+)?(?:E[+-]?\d+)?)(?![\w#])/i;
+  const USED = /\b(?:(?:SM|[IQMVS])\d+\.[0-7]|(?:SM|AI|AQ|[IQMVS])[BWD]\d+|[TC]\d+)\b/g;
   const COMMON = ["SM0.0", "SM0.1", "SM0.4", "SM0.5", "SM1.0", "SM1.1"];
 
   // ------------------------------------------------------------- the mode
@@ -38,8 +39,8 @@
         const word = stream.match(/^[^\s,;:=]+=?|^=[A-Z]*/i);
         if (!word) { stream.next(); return null; }
         const w = word[0].replace(/=$/, "").toUpperCase();
-        if (HEADERS.has(w) || HEADERS.has(word[0].toUpperCase())) { state.header = true; return "heading"; }
-        state.header = false;
+        if (w === "TITLE") { stream.skipToEnd(); return "heading"; }
+        if (HEADERS.has(w)) return "heading";
         return E.insns.has(word[0].toUpperCase()) ? "keyword" : null;
       }
       if (stream.match(ADDRESS)) return "atom";
@@ -164,7 +165,9 @@
       }
       const h = window.plcrtPanel && window.plcrtPanel.hello;
       const addrs = h ? h.inputs.concat(h.outputs).map((x) => x.addr) : [];
-      for (const a of addrs.concat(COMMON)) {
+      // and the addresses the text already uses (the first 500)
+      const used = ctx.state.doc.toString().match(USED) || [];
+      for (const a of addrs.concat(COMMON, used.slice(0, 500))) {
         if (!seen.has(a.toUpperCase())) { seen.add(a.toUpperCase()); options.push({ label: a, type: "constant" }); }
       }
     }

@@ -237,3 +237,28 @@ def test_stl_is_highlighted_by_kind(serve, page, tmp_path) -> None:
     assert colors["Start"] == "rgb(173, 20, 87)"                         # symbols
     assert colors["Network"] == colors["ORGANIZATION_BLOCK"] == "rgb(106, 27, 154)"
     assert colors['// <img src=x onerror="window.pwned=1">'] == "rgb(117, 117, 117)"
+
+
+def test_a_download_while_running_goes_on_with_the_memory(serve, page, tmp_path) -> None:
+    panel, path = _panel(tmp_path)
+    served = serve(panel=panel)
+    _open_editor(page, served)
+    page.click("#run")
+    page.locator('[data-input="I0.0"]').click()
+    page.wait_for_function("() => window.plcrtPanel.frame.io['Q0.0'] === 1")
+    # Q0.0 -> Q0.1: the new program no longer drives Q0.0
+    page.evaluate("() => { const v = window.plcrtEditor.view; const t = v.state.doc.toString(); "
+                  "const i = t.indexOf('Q0.0'); "
+                  "v.dispatch({changes: {from: i, to: i + 4, insert: 'Q0.1'}}); }")
+    page.wait_for_function("() => document.querySelector('#editor-count')"
+                           ".textContent === 'no errors'")
+    page.click("#editor-download")
+    page.wait_for_function("() => document.querySelector('#editor-status')"
+                           ".textContent.startsWith('downloaded')")
+    assert page.locator("#editor-status").text_content().startswith("downloaded in RUN")
+    # still running; the switch stayed on; Q0.1 follows it, Q0.0 kept its state
+    page.wait_for_function("() => window.plcrtPanel.frame.io['Q0.1'] === 1")
+    assert page.evaluate("() => window.plcrtPanel.frame.run") == "running"
+    assert page.evaluate("() => window.plcrtPanel.frame.io['I0.0']") == 1
+    assert panel.session.plc.read("Q0.0") == 1   # no longer shown: the program does not use it
+    assert page.errors == []

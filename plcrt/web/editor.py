@@ -115,14 +115,16 @@ class ProgramSource:
         return os.access(self.path, os.W_OK) and os.access(self.path.parent, os.W_OK)
 
 
-#: builds the source of the program on screen (None: nothing to edit)
-SourceOf = Callable[[], ProgramSource | None]
+#: the source of the current lesson's program (the argument: the lesson or
+#: None); None: nothing to edit
+SourceOf = Callable[[Any], "ProgramSource | None"]
 
 
 def check_text(source: ProgramSource, text: str) -> dict[str, Any]:
     """``plcrt check`` of ``text``: ``ok`` (no error) and the diagnostics,
     each ``line`` and ``column`` in the text (null for one in another
-    file), ``severity``, ``message`` and ``where`` (block and network)."""
+    file), ``severity``, ``message`` and ``where`` (block and network),
+    errors kept first when there are more than :data:`MAX_DIAGNOSTICS`."""
     check_size(text)
     try:
         diags = list(source.load(text, check=True).diagnostics)
@@ -136,9 +138,7 @@ def check_text(source: ProgramSource, text: str) -> dict[str, Any]:
 def diagnostics(diags: list[Diagnostic]) -> dict[str, Any]:
     """Diagnostics for the page: errors first, at most
     :data:`MAX_DIAGNOSTICS`, every text made printable."""
-    order = {"error": 0, "warning": 1}
-    shown, more = capped(sorted(diags, key=lambda d: order.get(d.severity, 2)),
-                         MAX_DIAGNOSTICS, ordered=True)
+    shown, more = capped(diags, MAX_DIAGNOSTICS, ordered=True)
     items = []
     for d in shown:
         loc = d.loc

@@ -28,7 +28,7 @@ from aiohttp import WSMsgType, web
 from ..errors import PlcError, capped
 from ..safetext import excerpt, printable
 from . import course as course_mod
-from .editor import ProgramSource
+from .editor import ProgramSource, SourceOf
 from .editroutes import add_routes as add_editor_routes
 from .protocol import MAX_MESSAGE, ProtocolError, dumps, parse
 from .session import Client, PanelSession
@@ -66,8 +66,7 @@ class Panel:
                  current: course_mod.Lesson | None = None,
                  load_lesson: LessonLoader | None = None,
                  hosts: Iterable[str] = (), watch_s: float = WATCH_S,
-                 source_of: Callable[[course_mod.Lesson | None], ProgramSource | None]
-                 | None = None) -> None:
+                 source_of: SourceOf | None = None) -> None:
         self.session = session
         self.source_of = source_of
         self.lessons = lessons or []

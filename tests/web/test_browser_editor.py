@@ -262,3 +262,27 @@ def test_a_download_while_running_goes_on_with_the_memory(serve, page, tmp_path)
     assert page.evaluate("() => window.plcrtPanel.frame.io['I0.0']") == 1
     assert panel.session.plc.read("Q0.0") == 1   # no longer shown: the program does not use it
     assert page.errors == []
+
+
+def test_switching_lessons_asks_before_unsaved_edits_go(serve, page, tmp_path) -> None:
+    import shutil
+
+    from .test_browser_lessons import COURSE, lesson_panel
+    course = tmp_path / "course"
+    for name in ("01-seal-in", "02-timers"):
+        shutil.copytree(COURSE / name, course / name)
+    served = serve(panel=lesson_panel(course / "01-seal-in"))
+    _open_editor(page, served)
+    assert _text(page) == (course / "01-seal-in" / "lesson.awl").read_text()
+    _go_to_end_of_line(page, 1)
+    page.keyboard.type(" // mine")
+    page.once("dialog", lambda d: d.dismiss())
+    page.select_option("#lessons", "02-timers")
+    assert page.locator("#lessons").input_value() == "01-seal-in"
+    assert "// mine" in _text(page)
+    page.once("dialog", lambda d: d.accept())
+    page.select_option("#lessons", "02-timers")
+    page.wait_for_function("() => window.plcrtEditor.view.state.doc.toString()"
+                           ".includes('T37')")
+    assert _text(page) == (course / "02-timers" / "lesson.awl").read_text()
+    assert "// mine" not in (course / "01-seal-in" / "lesson.awl").read_text()

@@ -252,6 +252,7 @@
   }
 
   function dirty() { return E.view !== null && E.view.state.doc.toString() !== E.base; }
+  E.dirty = dirty;
   function dirtyMark() { $("editor-name").classList.toggle("dirty", dirty()); }
 
   function setText(text) {
@@ -337,9 +338,9 @@
     const before = E.files;
     E.files = files;
     $("edit-toggle").hidden = !h.editable;
-    if (E.loaded && before !== null && before !== files) {
-      loadSource("Another program is open now. Discard your edits and load it?");
-    }
+    // another program (a lesson switched to, asked about before): its file,
+    // never the edits of the previous one, which Save would write into it
+    if (E.loaded && before !== null && before !== files) loadSource(null);
   };
 
   document.addEventListener("DOMContentLoaded", () => {

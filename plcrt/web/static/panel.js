@@ -647,7 +647,15 @@ function buildLesson(h) {
                                 h.load_error.message));
   }
 }
-$("lessons").addEventListener("change", () => send({ type: "lesson", id: $("lessons").value }));
+$("lessons").addEventListener("change", () => {
+  // another lesson is another program file: the editor's unsaved edits would go
+  const ed = window.plcrtEditor;
+  if (ed && ed.dirty() && !window.confirm("Switch lessons and discard your unsaved edits?")) {
+    $("lessons").value = P.hello.lesson.id;
+    return;
+  }
+  send({ type: "lesson", id: $("lessons").value });
+});
 $("check").addEventListener("click", () => {
   $("check").disabled = true;
   $("check-results").replaceChildren(el("li", {}, "running the tests ..."));

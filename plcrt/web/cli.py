@@ -102,6 +102,19 @@ def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
         return PanelSession(plc, breakpoints=not args.no_breakpoints, kinds=les.kinds(),
                             door=door)
 
+    def source_of(les: course.Lesson | None) -> Any:
+        # the program file the editor edits: the lesson's, else the first one
+        from .editor import ProgramSource
+        ns = argparse.Namespace(**vars(args))
+        if les is not None:
+            ns.programs = [str(les.program)]
+            ns.symbols = str(les.symbols) if les.symbols else args.symbols
+            ns.plant = str(les.plant) if les.plant else args.plant
+        if Path(ns.programs[0]).suffix.lower() != ".awl":
+            return None   # a project file (.mwp, .smart) is not edited as text
+        return ProgramSource(Path(ns.programs[0]), tuple(Path(p) for p in ns.programs[1:]),
+                             _load_options(ns))
+
     # --host NAME (not an address) is a name the page is opened under
     hosts = [*getattr(args, "allow_host", []),
              *([] if _is_address(getattr(args, "host", "")) else [getattr(args, "host", "")])]
@@ -109,7 +122,7 @@ def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
     if len(args.programs) == 1 and first.is_dir():
         les = course.lesson(first)
         return Panel(load_lesson(les), lessons=course.lessons(first.parent), current=les,
-                     load_lesson=load_lesson, hosts=hosts)
+                     load_lesson=load_lesson, hosts=hosts, source_of=source_of)
     plc = load_from_args(args, args.scan_ms)
     print_diagnostics(plc.diagnostics)
     current = None
@@ -119,7 +132,24 @@ def build_panel(args: argparse.Namespace, door: Any = None) -> Any:
     session = PanelSession(plc, breakpoints=not args.no_breakpoints,
                            kinds=current.kinds() if current else None, door=door)
     return Panel(session, lessons=lessons, current=current,
-                 load_lesson=load_lesson if current else None, hosts=hosts)
+                 load_lesson=load_lesson if current else None, hosts=hosts, source_of=source_of)
+
+
+def _load_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The keyword arguments of :func:`plcrt.load` that ``plcrt serve``'s
+    options give (as ``load_from_args`` passes them), for the editor's
+    texts."""
+    data, plant = getattr(args, "data", None), getattr(args, "plant", None)
+    return {"symbols": Path(args.symbols) if args.symbols else None,
+            "data": Path(data) if data else None, "scan_ms": args.scan_ms,
+            "cpu": getattr(args, "cpu", None),
+            "pace": "realtime" if getattr(args, "realtime", False) else "simulated",
+            "plant": Path(plant) if plant else None,
+            "encoding": getattr(args, "encoding", None),
+            "max_file_mb": getattr(args, "max_file_mb", None),
+            "auto_symbols": getattr(args, "auto_symbols", False),
+            "clock": getattr(args, "clock", None),
+            "backend": getattr(args, "backend", None), "entry": getattr(args, "entry", None)}
 
 
 def _is_address(host: str) -> bool:

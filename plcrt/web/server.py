@@ -28,6 +28,8 @@ from aiohttp import WSMsgType, web
 from ..errors import PlcError, capped
 from ..safetext import excerpt, printable
 from . import course as course_mod
+from .editor import ProgramSource, SourceOf
+from .editroutes import add_routes as add_editor_routes
 from .protocol import MAX_MESSAGE, ProtocolError, dumps, parse
 from .session import Client, PanelSession
 
@@ -55,13 +57,18 @@ class Panel:
             server's own address and ``localhost`` (``plcrt serve --host
             NAME``, ``--allow-host NAME``); see :func:`host_ok`.
         watch_s: seconds between two looks at the current lesson's files.
+        source_of: the program file the editor edits, and how a text of it
+            is loaded, for the current lesson (or None); without it the
+            editor has nothing to edit.
     """
 
     def __init__(self, session: PanelSession, *, lessons: list[course_mod.Lesson] | None = None,
                  current: course_mod.Lesson | None = None,
                  load_lesson: LessonLoader | None = None,
-                 hosts: Iterable[str] = (), watch_s: float = WATCH_S) -> None:
+                 hosts: Iterable[str] = (), watch_s: float = WATCH_S,
+                 source_of: SourceOf | None = None) -> None:
         self.session = session
+        self.source_of = source_of
         self.lessons = lessons or []
         self.current = current
         self.load_lesson = load_lesson
@@ -75,6 +82,10 @@ class Panel:
         self.stamp = current.stamp() if current is not None else ()
         self.switching = asyncio.Lock()
 
+    def source(self) -> ProgramSource | None:
+        """What the editor edits now (:mod:`plcrt.web.editor`)."""
+        return None if self.source_of is None else self.source_of(self.current)
+
     def hello(self) -> dict[str, Any]:
         msg = dict(self.session.hello())
         msg["lessons"] = [le.to_dict() for le in self.lessons]
@@ -82,6 +93,10 @@ class Panel:
             **self.current.to_dict(), "doc": self.current.page(),
             "checkable": bool(self.current.tests)}
         msg["load_error"] = self.load_error
+        src = self.source() if self.source_of is not None else None
+        msg["editable"] = src is not None
+        if src is not None:   # a downloaded program was loaded from the editor's text
+            msg["files"] = [str(src.path) if f == "<string>" else f for f in msg["files"]]
         if self.load_error is not None and self.current is not None:
             msg["files"] = [str(self.current.program)]   # not the empty stand-in's
         return msg
@@ -232,6 +247,7 @@ def make_app(panel: Panel) -> web.Application:
     app.router.add_get("/ws", ws_handler)
     app.router.add_get("/lesson/{name}", lesson_file)
     app.router.add_static("/static/", STATIC, show_index=False)
+    add_editor_routes(app, panel, replace_session, origin_ok)
     app.on_startup.append(on_startup)
     app.on_shutdown.append(on_shutdown)
     app.on_response_prepare.append(_headers)
@@ -309,20 +325,28 @@ async def _install(panel: Panel, les: course_mod.Lesson, notice: str | None = No
         except PlcError as e:
             new = await loop.run_in_executor(None, _unloaded)
             error = load_error(les, e)
-        old = panel.session
-        panel.session, panel.current, panel.load_error, panel.stamp = new, les, error, stamp
-        for conn in panel.conns:
-            if conn.client is not None:
-                old.disconnect(conn.client)
-            conn.attach(panel)
-            assert conn.client is not None
-            if notice is not None:
-                conn.client.mailbox.put({"type": "notice", "level": "info", "message": notice})
-            if error is not None:
-                conn.client.mailbox.put({"type": "error", "request": "lesson",
-                                         "message": error["message"]})
-        new.start()
-        await loop.run_in_executor(None, old.close)
+        panel.current, panel.load_error, panel.stamp = les, error, stamp
+        await replace_session(panel, new, notice,
+                              None if error is None else error["message"])
+
+
+async def replace_session(panel: Panel, new: PanelSession, notice: str | None = None,
+                          error: str | None = None) -> None:
+    """Make ``new`` the session every page shows (each gets its ``hello``,
+    then ``notice`` and ``error``), start it and close the old one."""
+    old = panel.session
+    panel.session = new
+    for conn in panel.conns:
+        if conn.client is not None:
+            old.disconnect(conn.client)
+        conn.attach(panel)
+        assert conn.client is not None
+        if notice is not None:
+            conn.client.mailbox.put({"type": "notice", "level": "info", "message": notice})
+        if error is not None:
+            conn.client.mailbox.put({"type": "error", "request": "lesson", "message": error})
+    new.start()
+    await asyncio.get_running_loop().run_in_executor(None, old.close)
 
 
 def load_error(les: course_mod.Lesson, e: PlcError) -> dict[str, Any]:
@@ -392,4 +416,4 @@ async def _check(panel: Panel, conn: _Conn, msg: dict[str, Any]) -> None:
 
 
 __all__ = ["MAX_FRAME", "Panel", "STATIC", "WATCH_S", "host_ok", "load_error", "make_app",
-           "origin_ok"]
+           "origin_ok", "replace_session"]

@@ -41,7 +41,9 @@ def test_program_text_cannot_run_script_or_inject_elements(serve, page) -> None:
     page.wait_for_function("() => window.plcrtPanel.frame.scans === 1")
     page.wait_for_timeout(300)
     assert page.evaluate("() => window.__pwned") is None
-    assert page.locator("script").count() == 1                      # panel.js only
+    # the page's own scripts only: the panel, the editor and its CodeMirror bundle
+    assert page.evaluate("() => [...document.scripts].map(s => new URL(s.src).pathname)") == [
+        "/static/panel.js", "/static/vendor/codemirror.min.js", "/static/editor.js"]
     assert page.locator("img, iframe").count() == 0
     assert page.locator("#networks svg svg, #networks foreignObject").count() == 0
     assert page.evaluate("() => [...document.querySelectorAll('*')].filter(e => "

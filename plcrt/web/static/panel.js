@@ -99,6 +99,7 @@ function onHello(h) {
   for (const d of h.drives) P.axisEls.push(buildAxis("drive " + d.node + " (" + d.model + ")", d));
   onDiagnostics(h.diagnostics || { items: [], more: null });
   ariaIO(P.frame);
+  if (window.plcrtEditor) window.plcrtEditor.onHello(h);   // editor.js
 }
 
 function buildTabs(h) {
@@ -265,7 +266,7 @@ function press(addr, down) {
 }
 
 document.addEventListener("keydown", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
   if (e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) { press(P.hello.inputs[n].addr, true); return; }
@@ -274,7 +275,7 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "n") send({ type: "step" });
 });
 document.addEventListener("keyup", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) press(P.hello.inputs[n].addr, false);
 });
@@ -646,7 +647,15 @@ function buildLesson(h) {
                                 h.load_error.message));
   }
 }
-$("lessons").addEventListener("change", () => send({ type: "lesson", id: $("lessons").value }));
+$("lessons").addEventListener("change", () => {
+  // another lesson is another program file: the editor's unsaved edits would go
+  const ed = window.plcrtEditor;
+  if (ed && ed.dirty() && !window.confirm("Switch lessons and discard your unsaved edits?")) {
+    $("lessons").value = P.hello.lesson.id;
+    return;
+  }
+  send({ type: "lesson", id: $("lessons").value });
+});
 $("check").addEventListener("click", () => {
   $("check").disabled = true;
   $("check-results").replaceChildren(el("li", {}, "running the tests ..."));

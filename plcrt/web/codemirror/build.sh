@@ -4,7 +4,7 @@
 # The bundle is committed: serving or installing plcrt never runs this.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
-out="$here/../../plcrt/web/static/vendor"
+out="$here/../static/vendor"
 cd "$here"
 npm ci --no-audit --no-fund
 mkdir -p "$out"
@@ -20,7 +20,7 @@ for (const f of Object.keys(meta.inputs)) {
   const m = f.match(/node_modules\/((?:@[^/]+\/)?[^/]+)\//);
   if (m) pkgs.add(m[1]);
 }
-let text = "codemirror.min.js bundles the following packages (built by tools/codemirror/build.sh).\n";
+let text = "codemirror.min.js bundles the following packages (built by plcrt/web/codemirror/build.sh).\n";
 for (const p of [...pkgs].sort()) {
   const dir = path.join("node_modules", p);
   const info = JSON.parse(fs.readFileSync(path.join(dir, "package.json"), "utf8"));

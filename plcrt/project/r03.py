@@ -26,10 +26,11 @@ from __future__ import annotations
 
 import re
 
+from ..errors import PlcConfigError
 from .codes import AREAS
 from .program import Block, Net
 from .r03codes import decode_network
-from .stream import Cursor
+from .stream import Cursor, binary_error
 
 __all__ = ["read_v3_program", "find_v3_main", "MAX_NETWORKS", "MAX_CELLS"]
 
@@ -93,9 +94,14 @@ def _block(c: Cursor) -> Block:
     name = c.text()
     if not name:
         raise c.error("a block without a name", start)
-    # 8 bytes (zero in every project seen), then the times the block was
-    # created and last changed (two Windows SYSTEMTIMEs)
-    c.skip(8 + 16 + 16)
+    # 8 bytes, zero in every project seen: the place a block password would
+    # be kept, so a block with anything there is not read (docs/project-files.md)
+    at = c.pos
+    if any(c.take(8)):
+        raise binary_error(c.file, c.section, at, f"{kind} {name!r}: a field of the block "
+                           "header this reader does not know is set (it may hold a "
+                           "password); the block is not read", PlcConfigError)
+    c.skip(16 + 16)                            # created, last changed (SYSTEMTIMEs)
     block = Block(kind, 1 if kind == "OB" else number, name, "")
     c.expect(0, 1, "block header")
     for index in range(c.count(2, MAX_NETWORKS, "number of networks")):

@@ -196,7 +196,8 @@ def test_a_project_with_a_password_is_refused(smart: bool) -> None:
 
 @pytest.mark.parametrize("head, kind, words", [
     (b"PK\3\4" + bytes(40), PlcConfigError, "SMART V3"),
-    (b"GJK\0R03.10" + bytes(6) + b"\x10\0\0\0" + zlib.compress(bytes(16)), PlcConfigError, "V3"),
+    (b"GJK\0R03.10" + bytes(6) + b"\x10\0\0\0" + zlib.compress(bytes(16)), PlcSyntaxError,
+     "no main program block"),
     (b"GJK\0R05.00" + bytes(60), PlcSyntaxError, "signature"),
     (b"GJK\0R04.00" + bytes(10), PlcSyntaxError, "ends inside its header"),
 ])

@@ -147,3 +147,24 @@ def _same_run(a, b, scans: int) -> None:
         a.scan()
         b.scan()
     assert a.mem.snapshot().areas == b.mem.snapshot().areas
+
+
+def test_smart_code_0x2db_is_the_mul_di_box_of_its_network() -> None:
+    """The one SMART statement of the corpus with code 0x2db follows a MOVD
+    into the same double word, and its network's only arithmetic box is
+    MUL_DI: the code is ``*D`` (MUL_DI compiles to MOVD IN1, OUT and *D IN2,
+    OUT), as the code table says."""
+    from plcrt.project.codes import OPCODES
+    from plcrt.project.container import open_container
+    path = _file("Kity23__test__项目 1.smart")
+    stream = open_container(path.read_bytes(), str(path)).stream
+    statement = b"\0\0\xdb\x02\x01\x01"
+    at = stream.find(statement)
+    assert at > 0 and stream.find(statement, at + 1) < 0
+    before = stream.rfind(b"\0\0\x0e\x03\x01\x01", 0, at)          # MOVD
+    assert 0 < before and at - before < 200
+    network = stream[before - 400:stream.find(b"Time_Out", at) + 2000]
+    boxes = {name for name in (b"MUL_DI", b"MUL_I", b"MUL", b"DIV_DI", b"ADD_DI")
+             if b"\x00" + name + b"\x00" in network or bytes([len(name)]) + name in network}
+    assert boxes == {b"MUL_DI"}
+    assert OPCODES[0x2DB] == "*D"

@@ -25,6 +25,7 @@ the data block of a V3 project (their layout is not decoded).
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass, field
 
 from ..errors import PlcConfigError
 from .codes import AREAS
@@ -32,7 +33,7 @@ from .program import Block, Net
 from .r03codes import decode_network
 from .stream import Cursor, binary_error
 
-__all__ = ["read_v3_program", "find_v3_main", "MAX_NETWORKS", "MAX_CELLS"]
+__all__ = ["V3Program", "read_v3_program", "find_v3_main", "MAX_NETWORKS", "MAX_CELLS"]
 
 #: most networks of one block (the editor keeps 100; Micro/WIN V3 allows 255)
 MAX_NETWORKS = 1000
@@ -65,13 +66,25 @@ _ROW = 25
 _EN = b"EN"
 
 
+@dataclass
+class V3Program:
+    """The blocks of a V3 program block, where the section ends, and the
+    networks whose cells name symbols: (network, offset of its code,
+    the names, the addresses its code uses), checked once the symbol table
+    is read."""
+
+    blocks: list[Block]
+    end: int
+    symbolic: list[tuple[str, int, set[str], set[str]]] = field(default_factory=list)
+
+
 def find_v3_main(stream: bytes) -> int:
     """The offset of the main program block's header (its number, 0), or -1."""
     match = _MAIN.search(stream)
     return match.start() if match else -1
 
 
-def read_v3_program(stream: bytes, file: str) -> list[Block]:
+def read_v3_program(stream: bytes, file: str) -> V3Program:
     """The blocks of the V3 program block in the inflated ``stream``."""
     at = find_v3_main(stream)
     c = Cursor(stream, file, "program block", max(at - 2, 0))
@@ -80,10 +93,13 @@ def read_v3_program(stream: bytes, file: str) -> list[Block]:
     count = c.count(2, 512, "number of program blocks")
     if count == 0:
         raise c.error("the program block lists no block", at - 2)
-    return [_block(c) for _ in range(count)]
+    out = V3Program([], 0)
+    out.blocks = [_block(c, out) for _ in range(count)]
+    out.end = c.pos
+    return out
 
 
-def _block(c: Cursor) -> Block:
+def _block(c: Cursor, program: V3Program) -> Block:
     start = c.pos
     number = c.u2()
     at = c.pos
@@ -105,7 +121,7 @@ def _block(c: Cursor) -> Block:
     block = Block(kind, 1 if kind == "OB" else number, name, "")
     c.expect(0, 1, "block header")
     for index in range(c.count(2, MAX_NETWORKS, "number of networks")):
-        block.networks.append(_network(c, block, index))
+        block.networks.append(_network(c, block, index, program))
     lines = _lines(c)
     # line 0 is the block's title (TITLE= of the export), the rest its comment
     block.comment = lines[0] if lines else ""
@@ -133,7 +149,7 @@ def _lines(c: Cursor) -> list[str]:
     return out
 
 
-def _network(c: Cursor, block: Block, index: int) -> Net:
+def _network(c: Cursor, block: Block, index: int, program: V3Program) -> Net:
     start = c.pos
     where = f"network {index + 1} of {block.ident}"
     number = c.u2()
@@ -157,22 +173,25 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
     net.statements = decode_network(code, lambda off, msg: c.error(f"{where}: {msg}",
                                                                    code_at + off))
     c.expect(1, 1, "network cells")
-    drawn, addresses, complete = 0, set(), True
+    drawn, addresses, names, complete = 0, set(), set(), True
     for _ in range(c.count(2, MAX_CELLS, "number of ladder cells")):
-        kind, cell_addresses, cell_complete = _cell(c)
+        kind, cell_addresses, cell_names, cell_complete = _cell(c)
         drawn += kind not in (0x0, 0x1)
         addresses.update(cell_addresses)
+        names.update(cell_names)
         complete = complete and cell_complete
     if drawn and not net.statements:
         raise c.error(f"{where} has LAD content but no compiled code (an incomplete "
                       "network Micro/WIN did not compile): compile the project in "
                       "Micro/WIN and save it", start)
-    _check_drawing(c, where, net, addresses, complete, code_at)
+    used = _check_drawing(c, where, net, addresses, complete, code_at)
+    if names:
+        program.symbolic.append((where, code_at, names, used))
     return net
 
 
 def _check_drawing(c: Cursor, where: str, net: Net, drawn: set[str], complete: bool,
-                   at: int) -> None:
+                   at: int) -> set[str]:
     """The addresses the ladder cells name are those the decoded code uses
     (all of them where every cell operand is an address; a symbol's address
     is not known here): a second reading of the network, so that a code
@@ -183,17 +202,18 @@ def _check_drawing(c: Cursor, where: str, net: Net, drawn: set[str], complete: b
             sorted(drawn - used))
         raise c.error(f"{where}: the compiled code and the ladder cells name other "
                       f"addresses ({missing})", at)
+    return used
 
 
-def _cell(c: Cursor) -> tuple[int, list[str], bool]:
+def _cell(c: Cursor) -> tuple[int, list[str], list[str], bool]:
     """Read one ladder cell: (its kind: 0 empty, 1 a wire, 0x14 a contact,
-    0x1b a coil, a box's code; the addresses it names; whether every
-    operand of it is an address this reader writes)."""
+    0x1b a coil, a box's code; the addresses it names; the symbols it names;
+    whether every operand of it is an address this reader writes)."""
     start = c.pos
     head = c.take(_CELL_HEAD)
     if head[0] != 0 or head[3] != 1:
         raise c.error("a ladder cell of a layout this reader does not know", start)
-    addresses, complete = [], True
+    addresses, names, complete = [], [], True
     for _ in range(c.count(2, MAX_CELL_OPERANDS, "number of cell operands")):
         at = c.pos
         if c.u2() == 0xFFFF:
@@ -206,7 +226,7 @@ def _cell(c: Cursor) -> tuple[int, list[str], bool]:
                           "symbol", at)
         record = c.take(size)
         if form == 2:
-            c.skip(c.u1())
+            names.append(c.take(c.u1()).decode("latin-1"))
         if form != 1:
             complete = complete and form == 0
             continue
@@ -215,7 +235,7 @@ def _cell(c: Cursor) -> tuple[int, list[str], bool]:
             complete = False
         else:
             addresses.append(address)
-    return head[4] | head[5] << 8, addresses, complete
+    return head[4] | head[5] << 8, addresses, names, complete
 
 
 def _cell_address(record: bytes) -> str | None:

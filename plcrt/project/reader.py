@@ -8,8 +8,9 @@ what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
-read by :mod:`.r03`; their symbol tables, data block and CPU are not read
-(docs/project-files.md, "Micro/WIN V3 projects").
+read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table);
+their data block and CPU are not read (docs/project-files.md, "Micro/WIN V3
+projects").
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from .container import Container, open_container
 from .datapage import read_data_block
 from .program import Block, read_program_block
 from .r03 import read_v3_program
+from .r03tables import check_symbolic_cells, read_v3_symbols
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
 
@@ -45,7 +47,7 @@ _CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
 #: (block version 7 or 8, type 1000, number 0)
 _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
 #: what a Micro/WIN V3 project holds that the reader does not read
-_V3_NOTE = ("a Micro/WIN V3 project: its program block is read; its symbol table, data "
+_V3_NOTE = ("a Micro/WIN V3 project: its program block and symbol table are read; its data "
             "block and system block are not (their layout is not decoded)")
 
 
@@ -93,11 +95,15 @@ def read_project(data: bytes, file: str) -> Project:
 
 
 def _v3_project(box: Container) -> Project:
-    blocks = read_v3_program(box.stream, box.file)
-    program = blocks_text(blocks)
-    codec = decode_bytes(program.encode("latin-1"), box.file).encoding
-    return Project(box.file, box.format, box.version, blocks, _recode(program, codec), codec,
-                   notes=[_V3_NOTE])
+    v3 = read_v3_program(box.stream, box.file)
+    rows, why = read_v3_symbols(box.stream, box.file, v3.end)
+    notes = [_V3_NOTE] + ([why] if why else [])
+    if not why:
+        check_symbolic_cells(v3, rows, Cursor(box.stream, box.file, "program block"))
+    program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
+    codec = decode_bytes((program + symbols).encode("latin-1"), box.file).encoding
+    return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
+                   codec, _recode(symbols, codec), notes=notes)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -190,3 +190,48 @@ def test_a_block_header_field_that_may_be_a_password_is_not_read() -> None:
     with pytest.raises(PlcConfigError, match="may hold a password") as e:
         read_project(_pack(head, forged), "x.mwp")
     assert e.value.loc.column - 1 == at
+
+
+def test_symbols_of_a_v3_project_agree_with_its_cells() -> None:
+    """Proyecto Final's symbol table is read; every ladder cell that names a
+    symbol sits in a network whose code uses the symbol's address (the
+    reader checks it), and the loaded program watches by those names."""
+    from plcrt.project.r03 import read_v3_program
+    path = _file(FINAL)
+    head, stream = _stream(path)
+    symbolic = read_v3_program(stream, str(path)).symbolic
+    assert sum(len(names) for _, _, names, _ in symbolic) >= 24
+    project = read_project(path.read_bytes(), str(path))
+    rows = [line.split("\t") for line in project.symbols.splitlines()]
+    assert len(rows) == 24 and ["Boton_ON", "I0.0"] in rows and ["Cont1", "C0"] in rows
+    plc = plcrt.load(path)
+    plc.write("Boton_ON", True)
+    plc.scan()
+    assert plc.read("B1") == plc.read("Q0.0") == 1
+
+
+def test_a_symbol_at_another_address_than_the_code_uses_is_refused() -> None:
+    """Boton_ON moved from I0.0 to I0.2 in the table: the networks whose
+    cells name it use I0.0, so the first of them is refused."""
+    head, stream = _stream(_file(FINAL))
+    at = stream.find(b"\x08Boton_ON", stream.find(b"USR1")) + 9
+    assert stream[at:at + 11] == bytes.fromhex("0100010100000000000000")
+    forged = stream[:at + 7] + b"\x02" + stream[at + 8:]
+    with pytest.raises(PlcSyntaxError, match=r"network 1 of OB1: the ladder cells name "
+                       r"symbols the compiled code does not use at their addresses "
+                       r"\(Boton_ON\)"):
+        read_project(_pack(head, forged), "x.mwp")
+
+
+def test_a_symbol_row_of_another_layout_leaves_the_table_unread() -> None:
+    """A named row whose last bytes are set (not seen: a comment, perhaps)
+    is not guessed: the table is not read, a note says why, the program
+    loads."""
+    head, stream = _stream(_file(FINAL))
+    at = stream.find(b"\x08Boton_ON", stream.find(b"USR1")) + 9 + 19
+    forged = stream[:at] + b"\x05" + stream[at + 1:]
+    project = read_project(_pack(head, forged), "x.mwp")
+    assert project.symbols == ""
+    assert any("symbol table is not read" in note and "Boton_ON" in note
+               for note in project.notes)
+    assert "Network 14" in project.awl

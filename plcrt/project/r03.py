@@ -18,8 +18,8 @@ editor other than ladder.  Each refusal is a
 byte offset in the decompressed project (docs/project-files.md,
 "Micro/WIN V3 projects").
 
-It does not read the container (:mod:`.container`), the symbol tables or
-the data block of a V3 project (their layout is not decoded).
+It does not read the container (:mod:`.container`), the symbol table
+(:mod:`.r03tables`), the data block or the system block of a V3 project.
 """
 
 from __future__ import annotations

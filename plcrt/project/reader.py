@@ -8,9 +8,9 @@ what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
-read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table);
-their data block and CPU are not read (docs/project-files.md, "Micro/WIN V3
-projects").
+read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table),
+and the CPU they are for; their data block and system block are not read
+(docs/project-files.md, "Micro/WIN V3 projects").
 """
 
 from __future__ import annotations
@@ -46,9 +46,11 @@ _CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
 #: the start of the program block: version 2, a block count, then MAIN
 #: (block version 7 or 8, type 1000, number 0)
 _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
+#: the CPU a Micro/WIN V3 project is for, at the start of its stream
+_V3_CPU = re.compile(rb"\x00(CPU [ -~]{1,40}?)\x00")
 #: what a Micro/WIN V3 project holds that the reader does not read
-_V3_NOTE = ("a Micro/WIN V3 project: its program block and symbol table are read; its data "
-            "block and system block are not (their layout is not decoded)")
+_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table and CPU are read; its "
+            "data block and system block are not (their layout is not decoded)")
 
 
 @dataclass
@@ -102,8 +104,10 @@ def _v3_project(box: Container) -> Project:
         check_symbolic_cells(v3, rows, Cursor(box.stream, box.file, "program block"))
     program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
     codec = decode_bytes((program + symbols).encode("latin-1"), box.file).encoding
+    cpu = _V3_CPU.search(box.stream, 0, 0x40)
     return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
-                   codec, _recode(symbols, codec), notes=notes)
+                   codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
+                   notes=notes)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -40,6 +40,8 @@ FIRST = f"{PAIR}Practica 1.mwp"
 BELITA = "Belita-Lili__PracticasPLC_cecyt3__Proyecto1.mwp"
 #: the V3 projects of the corpus that load
 V3 = (BELITA, ESDRAS, FINAL, FIRST)
+#: the CPU SOURCES.md names for each
+CPUS = {BELITA: "CPU 221", ESDRAS: "CPU 216", FINAL: "CPU 216", FIRST: "CPU 216"}
 #: project -> its export, as SOURCES.md pairs them
 EXPORTS = {ESDRAS: f"{PAIR}Proyecto Esdras__practica 1.awl",
            FINAL: f"{PAIR}Proyecto Final__practica 1.awl",
@@ -83,6 +85,7 @@ def test_v3_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -> No
     path = _file(name)
     project = read_project(path.read_bytes(), str(path))
     assert project.format == "Micro/WIN V3" and project.version == "R03.10"
+    assert project.cpu == CPUS[name]
     assert any("Micro/WIN V3" in note for note in project.notes)
     plc = plcrt.load(path)
     out = tmp_path / "o.awl"

@@ -52,6 +52,12 @@ _KINDS = {0x3E8: "OB", 0x3E9: "SBR", 0x3EA: "INT"}
 #: the main program block: number 0, type 1000, one byte (4), a name of 1 to
 #: 64 characters (a two-byte length)
 _MAIN = re.compile(rb"\x00\x00\xe8\x03\x04[\x01-\x40]\x00", re.S)
+#: ladder cell kind -> the statements it compiles to, counted against the
+#: code (a contact: LD, A or O; a negated contact: LDN, AN or ON; a coil: =;
+#: a box: its instruction); empty cells and wires compile to nothing
+_CELL_STATEMENTS = {0x14: ("LD", "A", "O"), 0x15: ("LDN", "AN", "ON"), 0x1B: ("=",),
+                    0x136: ("CTU",), 0x1F4: ("TON",)}
+_WIRES = (0x0, 0x1)
 #: the fixed part of a ladder cell, up to its operand count
 _CELL_HEAD = 0xAD
 #: operand records of a ladder cell, after their index: a constant (a box's
@@ -173,10 +179,12 @@ def _network(c: Cursor, block: Block, index: int, program: V3Program) -> Net:
     net.statements = decode_network(code, lambda off, msg: c.error(f"{where}: {msg}",
                                                                    code_at + off))
     c.expect(1, 1, "network cells")
-    drawn, addresses, names, complete = 0, set(), set(), True
+    drawn, kinds, addresses, names, complete = 0, [], set(), set(), True
     for _ in range(c.count(2, MAX_CELLS, "number of ladder cells")):
-        kind, cell_addresses, cell_names, cell_complete = _cell(c)
-        drawn += kind not in (0x0, 0x1)
+        kind, cell_addresses, cell_names, cell_complete, head = _cell(c)
+        drawn += kind not in _WIRES
+        if kind not in _WIRES and head:        # a box counts by its first cell
+            kinds.append(kind)
         addresses.update(cell_addresses)
         names.update(cell_names)
         complete = complete and cell_complete
@@ -184,10 +192,26 @@ def _network(c: Cursor, block: Block, index: int, program: V3Program) -> Net:
         raise c.error(f"{where} has LAD content but no compiled code (an incomplete "
                       "network Micro/WIN did not compile): compile the project in "
                       "Micro/WIN and save it", start)
+    _check_cells(c, where, net, kinds, code_at)
     used = _check_drawing(c, where, net, addresses, complete, code_at)
     if names:
         program.symbolic.append((where, code_at, names, used))
     return net
+
+
+def _check_cells(c: Cursor, where: str, net: Net, kinds: list[int], at: int) -> None:
+    """As many contacts, negated contacts, coils and boxes of each kind as
+    the decoded code has statements for them."""
+    for kind in kinds:
+        if kind not in _CELL_STATEMENTS:
+            raise c.error(f"{where}: a ladder cell of kind 0x{kind:x} this reader does not "
+                          "know", at)
+    for kind, mnemonics in _CELL_STATEMENTS.items():
+        drawn = kinds.count(kind)
+        coded = sum(m in mnemonics for m, _ in net.statements)
+        if drawn != coded:
+            raise c.error(f"{where}: the ladder cells draw {drawn} and the compiled code "
+                          f"has {coded} of {'/'.join(mnemonics)}", at)
 
 
 def _check_drawing(c: Cursor, where: str, net: Net, drawn: set[str], complete: bool,
@@ -205,16 +229,18 @@ def _check_drawing(c: Cursor, where: str, net: Net, drawn: set[str], complete: b
     return used
 
 
-def _cell(c: Cursor) -> tuple[int, list[str], list[str], bool]:
+def _cell(c: Cursor) -> tuple[int, list[str], list[str], bool, bool]:
     """Read one ladder cell: (its kind: 0 empty, 1 a wire, 0x14 a contact,
     0x1b a coil, a box's code; the addresses it names; the symbols it names;
-    whether every operand of it is an address this reader writes)."""
+    whether every operand of it is an address this reader writes; whether it
+    has operands: a contact, a coil, a box's first cell)."""
     start = c.pos
     head = c.take(_CELL_HEAD)
     if head[0] != 0 or head[3] != 1:
         raise c.error("a ladder cell of a layout this reader does not know", start)
     addresses, names, complete = [], [], True
-    for _ in range(c.count(2, MAX_CELL_OPERANDS, "number of cell operands")):
+    nops = c.count(2, MAX_CELL_OPERANDS, "number of cell operands")
+    for _ in range(nops):
         at = c.pos
         if c.u2() == 0xFFFF:
             continue
@@ -235,7 +261,7 @@ def _cell(c: Cursor) -> tuple[int, list[str], list[str], bool]:
             complete = False
         else:
             addresses.append(address)
-    return head[4] | head[5] << 8, addresses, names, complete
+    return head[4] | head[5] << 8, addresses, names, complete, bool(nops)
 
 
 def _cell_address(record: bytes) -> str | None:

@@ -238,3 +238,24 @@ def test_a_symbol_row_of_another_layout_leaves_the_table_unread() -> None:
     assert any("symbol table is not read" in note and "Boton_ON" in note
                for note in project.notes)
     assert "Network 14" in project.awl
+
+
+@pytest.mark.parametrize("network, old, new, words", [
+    # AN I0.3 made A I0.3: the cells still draw four negated contacts
+    (1, b"\x30\xc0", b"\x20\xc0", "the ladder cells draw 3 and the compiled code has 4 of "
+                                  "LD/A/O"),
+    # TON T37 made CTU C37: the cells still draw a TON box
+    (5, b"\xa6\x44\x00\x25", b"\xa8\x44\x00\x25", "the ladder cells draw 0 and the compiled "
+                                                   "code has 1 of CTU"),
+])
+def test_code_that_compiles_other_cells_than_drawn_is_refused(network: int, old: bytes,
+                                                              new: bytes, words: str) -> None:
+    """A contact, negated contact, coil or box of the drawing is one
+    statement of its kind in the code: a code read as another instruction
+    on the same address is refused, naming the network."""
+    head, stream = _stream(_file(ESDRAS))
+    at = stream.find(old)
+    assert at > 0 and stream.find(old, at + 1) < 0
+    forged = stream[:at] + new + stream[at + len(old):]
+    with pytest.raises(PlcSyntaxError, match=f"network {network} of OB1: {words}"):
+        read_project(_pack(head, forged), "x.mwp")

@@ -88,10 +88,13 @@ def test_v3_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -> No
     assert project.cpu == CPUS[name]
     assert any("Micro/WIN V3" in note for note in project.notes)
     plc = plcrt.load(path)
-    out = tmp_path / "o.awl"
-    assert main(["export", str(path), "--awl", str(out)]) == 0
-    again = plcrt.load(out)
+    out, table = tmp_path / "o.awl", tmp_path / "o.txt"
+    assert main(["export", str(path), "--awl", str(out), "--symbols", str(table)]) == 0
+    again = plcrt.load(out, symbols=table if project.symbols else None)
     assert ir_of(again.program) == ir_of(plc.program)
+    for line in project.symbols.splitlines():
+        name, address = line.split("\t")[:2]
+        assert again.symbols.lookup(name).address == plc.symbols.lookup(name).address == address
     _same_run(plc, again, 300)
 
 

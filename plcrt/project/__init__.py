@@ -1,4 +1,4 @@
-"""Micro/WIN V4 (``.mwp``) and Micro/WIN SMART V2 (``.smart``) project files.
+"""Micro/WIN V3 and V4 (``.mwp``) and Micro/WIN SMART V2 (``.smart``) project files.
 
 A front end beside :mod:`plcrt.lang`: it reads a project file (container,
 bounded decompression, program block, symbol tables, data block) and hands
@@ -11,7 +11,9 @@ Importing :mod:`.frontend` registers the reader in
 Submodules: :mod:`.stream` (the bounded cursor), :mod:`.container`
 (header, password, zlib), :mod:`.program` (blocks, networks, statements),
 :mod:`.tables` (symbol tables), :mod:`.datapage` (data block), :mod:`.codes`
-(the code tables), :mod:`.awl` (the export text), :mod:`.reader` (the
+(the code tables), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
+(Micro/WIN V3 projects: blocks and cells, compiled code, symbol table),
+:mod:`.awl` (the export text), :mod:`.reader` (the
 sections in order), :mod:`.frontend` (what ``load`` calls), :mod:`.cli`
 (``plcrt export``).  The package imports them when a name below is first
 used, so importing :mod:`plcrt.project.cli` for ``plcrt --help`` stays

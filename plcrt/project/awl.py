@@ -59,6 +59,8 @@ def block_text(block: Block) -> list[str]:
     head, tail = _HEADS[block.kind]
     name = _one_line(block.name) or block.ident
     lines = [f"{head} {name}:{block.ident}", f"TITLE={_one_line(block.comment)}"]
+    if block.remarks.strip():
+        lines.extend(_comment_lines(block.remarks))
     for section, keyword in _SECTIONS:
         rows = [v for v in block.variables if v[0] == section]
         if rows or (block.kind == "SBR" and block.variables):

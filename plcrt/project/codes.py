@@ -48,6 +48,9 @@ OPCODES: dict[int, str] = {
     0x29E: "BTI", 0x2A0: "ITD",
     0x2BC: "CTU",
     0x2C6: "+R", 0x2D5: "+I", 0x2D6: "+D",
+    # 0x2DB is *D: the one use seen is a MUL_DI box (its cell's name), whose
+    # code is MOVD IN1, OUT then 0x2DB IN2, OUT, as an export writes MUL_DI
+    0x2DB: "*D",
     0x2F0: "CRETI", 0x2F1: "ENI", 0x2F2: "DISI",
     0x30D: "MOVW", 0x30E: "MOVD", 0x30F: "MOVR",
     0x31C: "NEXT", 0x31D: "JMP", 0x31F: "LSCR", 0x320: "SCRT", 0x321: "SCRE",

@@ -59,6 +59,8 @@ class Block:
     #: (section, name, type, comment) of the local variable table
     variables: list[tuple[str, str, str, str]] = field(default_factory=list)
     protected: bool = False
+    #: the block's comment, the lines the export writes after ``TITLE=``
+    remarks: str = ""
 
     @property
     def ident(self) -> str:

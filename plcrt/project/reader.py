@@ -8,8 +8,9 @@ what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
-which is not read: they are refused with a message saying so, located at
-their main program block (docs/project-files.md, "Versions").
+read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table),
+and the CPU they are for; their data block and system block are not read
+(docs/project-files.md, "Micro/WIN V3 projects").
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ from .awl import blocks_text
 from .container import Container, open_container
 from .datapage import read_data_block
 from .program import Block, read_program_block
+from .r03 import read_v3_program
+from .r03tables import check_symbolic_cells, read_v3_symbols
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
 
@@ -43,9 +46,11 @@ _CPU = re.compile(rb"\x00(.)\x00(CPU [ -~]{1,40})", re.S)
 #: the start of the program block: version 2, a block count, then MAIN
 #: (block version 7 or 8, type 1000, number 0)
 _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
-#: the main program block of a Micro/WIN V3 project: type 1000, one byte,
-#: then its name (1 to 64 characters)
-_V3_MAIN = re.compile(rb"\xe8\x03.[\x01-\x40]\x00", re.S)
+#: the CPU a Micro/WIN V3 project is for, at the start of its stream
+_V3_CPU = re.compile(rb"\x00(CPU [ -~]{1,40}?)\x00")
+#: what a Micro/WIN V3 project holds that the reader does not read
+_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table and CPU are read; its "
+            "data block and system block are not (their layout is not decoded)")
 
 
 @dataclass
@@ -73,12 +78,7 @@ def read_project(data: bytes, file: str) -> Project:
     """The project in ``data`` (the bytes of a whole project file)."""
     box = open_container(data, file)
     if box.format == "Micro/WIN V3":
-        main = _V3_MAIN.search(box.stream)
-        raise binary_error(file, "program block", main.start() if main else 0,
-                           "Micro/WIN V3 projects (R03.xx) keep their program as compiled "
-                           "CPU code and ladder cells, a layout this reader does not read: "
-                           "open the project in Micro/WIN V4 and save it, or export it as "
-                           "STL (.awl)", PlcConfigError)
+        return _v3_project(box)
     cursor = _program_cursor(box)
     blocks = read_program_block(cursor)
     tables = read_symbol_tables(cursor)
@@ -94,6 +94,20 @@ def read_project(data: bytes, file: str) -> Project:
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
                    _recode(symbols, codec), _recode(data, codec), cpu, notes)
+
+
+def _v3_project(box: Container) -> Project:
+    v3 = read_v3_program(box.stream, box.file)
+    rows, why = read_v3_symbols(box.stream, box.file, v3.end)
+    notes = [_V3_NOTE] + ([why] if why else [])
+    if not why:
+        check_symbolic_cells(v3, rows, Cursor(box.stream, box.file, "program block"))
+    program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
+    codec = decode_bytes((program + symbols).encode("latin-1"), box.file).encoding
+    cpu = _V3_CPU.search(box.stream, 0, 0x40)
+    return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
+                   codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
+                   notes=notes)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -23,7 +23,7 @@ import pytest
 
 import plcrt
 from plcrt.cli import main
-from plcrt.errors import PlcConfigError, PlcSyntaxError
+from plcrt.errors import PlcSyntaxError
 from plcrt.project import read_project
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -48,13 +48,11 @@ READ = {
 }
 #: projects refused, and the words of the refusal
 REFUSED = {
-    "Belita-Lili__PracticasPLC_cecyt3__Proyecto1.mwp": (PlcConfigError, "Micro/WIN V3"),
-    f"{ESDRAS}Practica 1.mwp": (PlcConfigError, "Micro/WIN V3"),
-    f"{ESDRAS}Proyecto Esdras__Practica 1.mwp": (PlcConfigError, "Micro/WIN V3"),
-    f"{ESDRAS}Proyecto Final__PT1_IIIB_SDL.mwp": (PlcConfigError, "Micro/WIN V3"),
+    # drawn networks Micro/WIN did not compile (docs/project-files.md); the
+    # Micro/WIN V3 projects that load are tests/project/test_project_v3.py's
     "YashviArya12__PLC_Ladder_Logic_Program_.Projects__PLC_PROJECTS__Analog to digital "
-    "input__analog.mwp": (PlcConfigError, "Micro/WIN V3"),
-    # a drawn network Micro/WIN did not compile (docs/project-files.md)
+    "input__analog.mwp": (PlcSyntaxError, "network 1 of OB1 has LAD content but no compiled "
+                                          "code"),
     "Kity23__test__项目 1.smart": (PlcSyntaxError, "network 4 of SBR0 has LAD content but no "
                                                  "compiled code"),
 }
@@ -99,19 +97,16 @@ def test_corpus_projects_not_read_are_refused_by_name(name: str) -> None:
     assert e.value.loc.file == str(path) and "byte 0x" in e.value.message
 
 
-@pytest.mark.parametrize("name", sorted(n for n, (_, w) in REFUSED.items()
-                                         if w == "Micro/WIN V3"))
-def test_v3_projects_are_refused_at_their_main_block(name: str) -> None:
-    """The refusal's offset is the main program block's header in the
-    inflated stream (type 1000, then its name), not the start of the file."""
-    path = _file(name)
-    with pytest.raises(PlcConfigError, match="compiled CPU code and ladder cells") as e:
+def test_v3_project_without_compiled_code_is_refused_at_its_network() -> None:
+    """The refusal's offset is the first network's header (its number, 0,
+    and the header version, 2) in the inflated stream."""
+    path = _file("YashviArya12__PLC_Ladder_Logic_Program_.Projects__PLC_PROJECTS__Analog to "
+                 "digital input__analog.mwp")
+    with pytest.raises(PlcSyntaxError, match="no compiled code") as e:
         read_project(path.read_bytes(), str(path))
     at = e.value.loc.column - 1
     stream = zlib.decompress(path.read_bytes()[0x14:])
-    assert at > 0 and stream[at:at + 2] == b"\xe8\x03"
-    size = int.from_bytes(stream[at + 3:at + 5], "little")
-    assert stream[at + 5:at + 5 + size].isalnum()      # PRINCIPAL, MAIN, ...
+    assert stream[at:at + 4] == b"\0\0\2\0" and b"\xe8\x03\x04" in stream[at - 64:at]
 
 
 @pytest.mark.parametrize("name", sorted(PAIRS))
@@ -152,3 +147,24 @@ def _same_run(a, b, scans: int) -> None:
         a.scan()
         b.scan()
     assert a.mem.snapshot().areas == b.mem.snapshot().areas
+
+
+def test_smart_code_0x2db_is_the_mul_di_box_of_its_network() -> None:
+    """The one SMART statement of the corpus with code 0x2db follows a MOVD
+    into the same double word, and its network's only arithmetic box is
+    MUL_DI: the code is ``*D`` (MUL_DI compiles to MOVD IN1, OUT and *D IN2,
+    OUT), as the code table says."""
+    from plcrt.project.codes import OPCODES
+    from plcrt.project.container import open_container
+    path = _file("Kity23__test__项目 1.smart")
+    stream = open_container(path.read_bytes(), str(path)).stream
+    statement = b"\0\0\xdb\x02\x01\x01"
+    at = stream.find(statement)
+    assert at > 0 and stream.find(statement, at + 1) < 0
+    before = stream.rfind(b"\0\0\x0e\x03\x01\x01", 0, at)          # MOVD
+    assert 0 < before and at - before < 200
+    network = stream[before - 400:stream.find(b"Time_Out", at) + 2000]
+    boxes = {name for name in (b"MUL_DI", b"MUL_I", b"MUL", b"DIV_DI", b"ADD_DI")
+             if b"\x00" + name + b"\x00" in network or bytes([len(name)]) + name in network}
+    assert boxes == {b"MUL_DI"}
+    assert OPCODES[0x2DB] == "*D"

@@ -7,8 +7,9 @@ mutant to look at.  ``PLCRT_FUZZ_PROJECTS`` (default 25) says how many
 mutants of each kind are tried per seed file, ``PLCRT_FUZZ_SEED`` draws
 other ones: ``PLCRT_FUZZ_PROJECTS=20000 pytest tests/project/test_project_fuzz.py``
 is the long run.  The seeds are the tests' own project files and, where
-the shared corpus is present, one ``.mwp`` and one ``.smart`` of it (every
-project file of it when ``PLCRT_FUZZ_PROJECTS`` is set).  Memory is traced
+the shared corpus is present, its largest Micro/WIN V4, Micro/WIN V3 and
+SMART V2 project (every project file of it when ``PLCRT_FUZZ_PROJECTS`` is
+set).  Memory is traced
 for every tenth mutant and for the bombs (tracing costs time).
 """
 
@@ -53,10 +54,14 @@ def _seeds() -> dict[str, bytes]:
     env = os.environ.get("PLCRT_CORPUS")
     folder = Path(env) / "mwp" if env else CORPUS
     if folder.is_dir():
-        for f in sorted(folder.iterdir()):
+        kinds: set[bytes] = set()
+        # one file of each version (the largest), every file in a long run
+        files = sorted(folder.iterdir(), key=lambda f: (-f.stat().st_size, f.name))
+        for f in files:
             data = f.read_bytes() if f.suffix in (".mwp", ".smart") else b""
-            if data[:8] in (b"GJK\0R04.", b"SH3\0R02.") and (
-                    LONG or not any(n.endswith(f.suffix) for n in seeds if "~" in n)):
+            if data[:8] in (b"GJK\0R04.", b"GJK\0R03.", b"SH3\0R02.") and (
+                    LONG or data[:8] not in kinds):
+                kinds.add(data[:8])
                 seeds[f"corpus~{f.name}"] = data
     return seeds
 
@@ -144,6 +149,8 @@ def test_zlib_bombs_are_bounded(declared: int) -> None:
     _check(head + struct.pack("<I", declared) + packed, "bomb.mwp")
     smart_head = b"SH3\0R02.04.00.00" + bytes(26 + 66)
     _check(smart_head + struct.pack("<I", declared) + packed, "bomb.smart")
+    v3_head = b"GJK\0R03.10" + bytes(6)
+    _check(v3_head + struct.pack("<I", declared) + packed, "bomb3.mwp")
 
 
 def test_a_stream_longer_than_declared_is_refused() -> None:

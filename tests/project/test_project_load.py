@@ -73,6 +73,7 @@ MOVR   1.5, VD28
 +I     VW20, VW22
 +D     +1000, VD24
 +R     VD28, VD32
+*D     +1000, VD24
 Network 4 // timers and counters
 LD     I1.0
 TON    T37, 10
@@ -196,7 +197,8 @@ def test_a_project_with_a_password_is_refused(smart: bool) -> None:
 
 @pytest.mark.parametrize("head, kind, words", [
     (b"PK\3\4" + bytes(40), PlcConfigError, "SMART V3"),
-    (b"GJK\0R03.10" + bytes(6) + b"\x10\0\0\0" + zlib.compress(bytes(16)), PlcConfigError, "V3"),
+    (b"GJK\0R03.10" + bytes(6) + b"\x10\0\0\0" + zlib.compress(bytes(16)), PlcSyntaxError,
+     "no main program block"),
     (b"GJK\0R05.00" + bytes(60), PlcSyntaxError, "signature"),
     (b"GJK\0R04.00" + bytes(10), PlcSyntaxError, "ends inside its header"),
 ])
@@ -208,9 +210,8 @@ def test_other_files_are_refused_by_name(head: bytes, kind: type, words: str) ->
 
 #: codes refused on purpose: 0x7fff is no code; 0x148, 0x157 and 0x3eb are
 #: named by the public format description (eq_alt, eq_altp, fbcall) without
-#: the STL Micro/WIN writes for them; 0x2db is a SMART math code of the
-#: corpus that is MUL or *D (docs/project-files.md, "Instruction codes")
-@pytest.mark.parametrize("unknown", [0x7FFF, 0x148, 0x157, 0x3EB, 0x2DB])
+#: the STL Micro/WIN writes for them (docs/project-files.md, "Instruction codes")
+@pytest.mark.parametrize("unknown", [0x7FFF, 0x148, 0x157, 0x3EB])
 def test_unknown_instruction_code_names_block_network_and_offset(unknown: int) -> None:
     assert unknown not in OPCODES
     program = parse_program(EVERY_CODE, "x.awl")

@@ -248,7 +248,7 @@ def test_forced_encoding_drops_its_own_bom() -> None:
 def test_syntax_error_in_a_guessed_file_mentions_the_guess(tmp_path: Path) -> None:
     """A syntax error in a file decoded with low confidence carries a note
     naming the guess and --encoding; a confident decoding carries none."""
-    bad = ob1("Čerpadlo").replace("=      Q0.0", "=      Q0.0 (")
+    bad = ob1("Čerpadlo").replace("=      Q0.0", "=      Q0.0 ;;")
     path = tmp_path / "cz.awl"
     path.write_bytes(bad.encode("cp1250"))
     with pytest.raises(PlcSyntaxError) as info:

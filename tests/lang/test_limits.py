@@ -140,7 +140,7 @@ LONG = "X" * 200_000
     f"LD I0.0\nCALL {LONG}",            # unknown subroutine
     f"LD I0.0\nMOVW 16#{'F' * 5000}, VW0",   # a constant of thousands of digits
     f"LD V{'9' * 5000}.0\n= Q0.0",      # an address of thousands of digits
-    f"LD I0.0 {LONG}\n= Q0.0",          # a syntax error
+    f"LD I0.0; {LONG}\n= Q0.0",         # a syntax error
 ])
 def test_messages_quote_at_most_40_characters_of_program_text(network: str) -> None:
     """Every message quoting program text shows 40 characters and an ellipsis."""

@@ -64,6 +64,18 @@ def test_basic_micro_win_v4_block() -> None:
     assert program.file == "p.awl" and program.source == OB1
 
 
+def test_v3_export_operands_set_apart_by_a_blank() -> None:
+    """Micro/WIN V3 exports write a box's operands apart by a blank
+    (``TON T37 +5``, ``CTU C0 +2``): they read as V4's comma-separated form."""
+    v3 = parse_program(wrap("LD I0.0\nTON T37 +5\nLD I0.1\nLD M5.0\nCTU C0 +2"), "v3.awl")
+    v4 = parse_program(wrap("LD I0.0\nTON T37, +5\nLD I0.1\nLD M5.0\nCTU C0, +2"), "v4.awl")
+    assert [(i.mnemonic, [o.text for o in i.operands]) for i in insns(v3)] == [
+        ("LD", ["I0.0"]), ("TON", ["T37", "+5"]), ("LD", ["I0.1"]), ("LD", ["M5.0"]),
+        ("CTU", ["C0", "+2"])]
+    assert [(i.mnemonic, [o.text for o in i.operands]) for i in insns(v3)] == \
+        [(i.mnemonic, [o.text for o in i.operands]) for i in insns(v4)]
+
+
 def test_locations_are_one_based_with_block_and_network() -> None:
     """Insn and operand locs give line/column plus block id and network number."""
     pou = only_pou(parse_program(OB1, "p.awl"))
@@ -401,11 +413,11 @@ def test_instruction_before_first_network() -> None:
     assert "Network" in err.message
 
 
-def test_missing_comma_between_operands() -> None:
-    """Two operands without a comma point at the second one."""
-    err = syntax_error(wrap("MOVB 1 VB0"))
-    assert (err.loc.line, err.loc.column) == (4, 8)
-    assert "','" in err.message
+def test_a_comma_without_an_operand() -> None:
+    """A comma must be followed by an operand: the error points after it."""
+    err = syntax_error(wrap("MOVB 1, ,VB0"))
+    assert (err.loc.line, err.loc.column) == (4, 9)
+    assert "expected operand" in err.message
 
 
 def test_missing_end_var() -> None:
@@ -434,17 +446,17 @@ def test_bad_block_ids() -> None:
 def test_several_errors_one_per_block() -> None:
     """Errors in different blocks are all reported, in file order."""
     good = wrap("LD I0.0", "SUBROUTINE_BLOCK S:SBR0")
-    text = (wrap("LD I0.0 I0.1") + good.replace("SBR0", "SBR1")
+    text = (wrap("LD I0.0 ;;") + good.replace("SBR0", "SBR1")
             + wrap("MOVB 'x", "SUBROUTINE_BLOCK T:SBR2"))
     err = syntax_error(text)
     assert [(d.loc.line, d.loc.block) for d in err.diagnostics] == [(4, "OB1"), (14, "SBR2")]
-    assert str(err).startswith("bad.awl:4:9: error: ")
+    assert str(err).startswith("bad.awl:4:10: error: ")
 
 
 def test_every_broken_line_of_a_block_is_reported_in_one_run() -> None:
     """A user fixing a large export sees all broken instruction lines of a
     block at once, not one per run; the lines after them still parse."""
-    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0 I0.1\n=      Q0.0\n"
+    text = ("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0 ;;\n=      Q0.0\n"
             "Network 2\nLD     I0.2 ,\n=      Q0.1\nNetwork 3\nMOVB   'x\n"
             "END_ORGANIZATION_BLOCK\n")
     err = syntax_error(text)
@@ -455,7 +467,7 @@ def test_the_blocks_without_errors_are_kept_as_a_partial_program() -> None:
     """PlcSyntaxError.partial holds exactly the blocks that parsed whole (a
     viewer draws them); a block with a broken line or a missing END_... is
     left out."""
-    text = (wrap("LD I0.0 I0.1") + wrap("LD I0.0\n= Q0.0", "SUBROUTINE_BLOCK S:SBR1")
+    text = (wrap("LD I0.0 ;;") + wrap("LD I0.0\n= Q0.0", "SUBROUTINE_BLOCK S:SBR1")
             + "SUBROUTINE_BLOCK T:SBR2\nBEGIN\nNetwork 1\nLD I0.0\n"
             + wrap("LD I0.1\n= Q0.1", "SUBROUTINE_BLOCK U:SBR3"))
     err = syntax_error(text)

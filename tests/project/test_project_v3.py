@@ -15,7 +15,6 @@ corpus folder).  Skipped where the corpus or a file is absent.
 
 from __future__ import annotations
 
-import re
 import struct
 import sys
 import zlib
@@ -56,14 +55,10 @@ REVISIONS = {
                                  "networks, TON T37 +20) were published in different "
                                  "commits and hold other programs"),
 }
-#: the V3 export writes a box's operands apart by a blank (``TON T37 +5``);
-#: plcrt's parser, as Micro/WIN V4's export, takes them apart by a comma
-_V3_OPERANDS = re.compile(r"(?m)^(\w+) +(\S+) +([+-]\d+)[ \t]*(?=\r?$)")
-
-
 def _export_text(name: str) -> str:
-    text = _file(name).read_bytes().decode("cp1252")
-    return _V3_OPERANDS.sub(r"\1 \2, \3", text)
+    """The export as published: a V3 export sets a box's operands apart by a
+    blank (``TON T37 +5``), which plcrt reads as V4's comma."""
+    return _file(name).read_bytes().decode("cp1252")
 
 
 def _export(name: str):

@@ -200,8 +200,10 @@ def _apply(model: Model, op: Any) -> Model:
         title = r.text(op.get("title", model.title), "title", MAX_TEXT)
         if len(title.splitlines()) > 1:
             raise PlcConfigError("edit title: a network title is one line")
-        return replace(model, title=title,
-                       comment=r.text(op.get("comment", model.comment), "comment", MAX_TEXT))
+        comment = r.text(op.get("comment", model.comment), "comment", MAX_TEXT)
+        # the parser keeps titles and comment lines without surrounding blanks
+        return replace(model, title=title.strip(),
+                       comment="\n".join(c.strip() for c in comment.splitlines()))
     if kind == "move":
         src = _path(op.get("from"), "from")
         moved = get(model, src)

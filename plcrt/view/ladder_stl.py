@@ -54,6 +54,11 @@ def network_to_model(network: ir.Network) -> Model | NoLadder:
 
     The model is given only when writing it back gives the network's own
     instructions (same mnemonics, same operand texts, same order)."""
+    noted = next((i for i in network.insns if i.comment), None)
+    if noted is not None:
+        # LAD has a comment per network, none per element (docs/ladder-view.md)
+        return NoLadder(f"{_line(noted.mnemonic, _ops(noted))} has a comment of its own, "
+                        "which a ladder element cannot keep")
     ladder = lad.to_ladder(network)
     if not ladder.ok:
         return NoLadder(ladder.reason)

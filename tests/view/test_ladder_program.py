@@ -1,0 +1,71 @@
+"""A drawn network saved into its program: the network's lines are
+replaced, the rest of the file is kept byte for byte, and the program is
+checked as ``plcrt check`` checks it (what only the whole program can tell,
+such as a call of a missing subroutine, is refused there)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from plcrt.errors import PlcError
+from plcrt.lang.stl import parse_program
+from plcrt.view.ladder_check import check_in_program, replace_network
+from plcrt.view.ladder_edit import apply_edit
+from plcrt.view.ladder_stl import network_to_model
+
+ROOT = Path(__file__).resolve().parents[2]
+SEAL = (ROOT / "programs" / "seal_in.awl").read_text(encoding="utf-8")
+
+
+def _model(text: str, index: int):
+    m = network_to_model(parse_program(text).pous[0].networks[index])
+    assert not hasattr(m, "reason")
+    return m
+
+
+@pytest.mark.parametrize("index", [0, 1])
+def test_saving_a_network_keeps_the_rest_of_the_file(index: int) -> None:
+    model = apply_edit(_model(SEAL, index), {"op": "insert", "at": ["rung", "logic"],
+                                            "side": "after",
+                                            "element": {"el": "NC", "ops": ["I0.7"]}})
+    new = check_in_program(SEAL, "OB1", index + 1, model)
+    old_nets = parse_program(SEAL).pous[0].networks
+    new_nets = parse_program(new).pous[0].networks
+    assert [n.insns[-2].mnemonic + n.insns[-2].operands[0].text
+            for n in new_nets][index] == "ANI0.7"
+    other = 1 - index
+    assert ([(i.mnemonic, [o.text for o in i.operands]) for i in new_nets[other].insns]
+            == [(i.mnemonic, [o.text for o in i.operands]) for i in old_nets[other].insns])
+    assert new.startswith(SEAL.split("Network 1")[0])          # the header, byte for byte
+    assert new.endswith("END_ORGANIZATION_BLOCK\n")
+    assert network_to_model(new_nets[index]) == model
+
+
+def test_unchanged_model_saves_the_same_instructions() -> None:
+    # the same instructions, titles and comments (the comment lines are
+    # written as "//text": the parser keeps them without the blank)
+    for k in range(2):
+        again = replace_network(SEAL, "MAIN", k + 1, _model(SEAL, k))
+        assert ([(n.title, n.comment, [(i.mnemonic, [o.text for o in i.operands])
+                                       for i in n.insns])
+                 for n in parse_program(again).pous[0].networks]
+                == [(n.title, n.comment, [(i.mnemonic, [o.text for o in i.operands])
+                                          for i in n.insns])
+                    for n in parse_program(SEAL).pous[0].networks])
+
+
+def test_what_only_the_program_can_tell_is_refused_there() -> None:
+    model = apply_edit(_model(SEAL, 1), {"op": "output", "at": ["rung"], "element": {
+        "el": "box", "insn": "CALL", "ops": ["NO_SUCH_BLOCK"]}})    # fits the element checks
+    with pytest.raises(PlcError, match="NO_SUCH_BLOCK"):
+        check_in_program(SEAL, "OB1", 2, model)
+
+
+def test_unknown_block_or_network_is_named() -> None:
+    m = _model(SEAL, 0)
+    with pytest.raises(PlcError, match="no block"):
+        replace_network(SEAL, "SBR7", 1, m)
+    with pytest.raises(PlcError, match="no network 9"):
+        replace_network(SEAL, "OB1", 9, m)

@@ -46,7 +46,7 @@ from ..lang import ir
 from ..safetext import excerpt
 from .ladder_check import check_operands, check_round_trip
 from .ladder_model import (MAX_DEPTH, MAX_ELEMENTS, MAX_TEXT, Box, Coil, Logic, Model, Node,
-                           Parallel, Series, _Reader, count_elements, join, model_from_json,
+                           Parallel, Series, JsonReader, count_elements, join, model_from_json,
                            model_to_json)
 from .ladder_stl import NoLadder, model_to_stl, network_to_model
 
@@ -121,11 +121,11 @@ def _update(x: Any, path: tuple[Any, ...], fn: Callable[[Any], Any], done: tuple
 # ---------------------------------------------------------------------------
 
 def _logic_of(raw: Any, name: str) -> Logic:
-    return _Reader().logic(raw, f"edit {name}", 1)
+    return JsonReader().logic(raw, f"edit {name}", 1)
 
 
 def _out_of(raw: Any, name: str) -> Coil | Box | Node:
-    return _Reader().out(raw, f"edit {name}", 1)
+    return JsonReader().out(raw, f"edit {name}", 1)
 
 
 def _is_logic(x: Any) -> bool:
@@ -196,7 +196,7 @@ def _apply(model: Model, op: Any) -> Model:
     if extra:
         raise PlcConfigError(f"edit {kind}: unknown field {excerpt(repr(extra[0]), 40)}")
     if kind == "title":
-        r = _Reader()
+        r = JsonReader()
         title = r.text(op.get("title", model.title), "title", MAX_TEXT)
         if len(title.splitlines()) > 1:
             raise PlcConfigError("edit title: a network title is one line")
@@ -229,8 +229,8 @@ def _apply(model: Model, op: Any) -> Model:
                     else _out_of(op.get("element"), "element"))
         return _update(model, at, lambda _: new)
     # operands
-    raw = _Reader().list_(op.get("ops"), "edit ops", 32)
-    ops = tuple(_Reader().text(o, f"edit ops[{k}]") for k, o in enumerate(raw))
+    raw = JsonReader().list_(op.get("ops"), "edit ops", 32)
+    ops = tuple(JsonReader().text(o, f"edit ops[{k}]") for k, o in enumerate(raw))
     old = get(model, at)
     if not hasattr(old, "ops") or len(ops) != len(old.ops) and not isinstance(old, Box):
         raise PlcConfigError(f"edit: {_where(at)} has {len(getattr(old, 'ops', ()))} "

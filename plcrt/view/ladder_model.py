@@ -19,7 +19,7 @@ from deep inside.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Union
 
 from ..errors import PlcConfigError
@@ -146,7 +146,7 @@ class Model:
     rung: Node | Box | None = None
     rail: tuple[Coil | Box, ...] = ()
     title: str = ""
-    comment: str = field(default="", compare=True)
+    comment: str = ""
 
 
 Element = Union[Contact, Series, Parallel, Coil, Box, Node]
@@ -220,7 +220,7 @@ def _out_json(x: Coil | Box | Node) -> dict[str, Any]:
             "outs": [_out_json(o) for o in x.outs]}
 
 
-class _Reader:
+class JsonReader:
     """Reads an untrusted JSON document into a :class:`Model`; ``where`` is
     the path of the value being read, for messages."""
 
@@ -319,7 +319,7 @@ def model_from_json(doc: Any) -> Model:
     checked (:class:`PlcConfigError` naming the place).  The structure is
     checked for what JSON can say; whether the drawing has an STL form is
     :func:`plcrt.view.ladder_stl.model_to_stl`'s check."""
-    r = _Reader()
+    r = JsonReader()
     d = r.dict_(doc, "", {"format", "version", "title", "comment", "rung", "rail"}, 0)
     r.count = 0
     if d.get("format") != FORMAT or d.get("version") != VERSION:
@@ -335,6 +335,7 @@ def model_from_json(doc: Any) -> Model:
     return Model(rung, rail, title, comment)  # type: ignore[arg-type]
 
 
-__all__ = ["Box", "COMPARE_TYPES", "CONTACTS", "Coil", "Contact", "Element", "FORMAT", "Logic",
-           "MAX_ELEMENTS", "MODIFIERS", "Model", "Node", "Parallel", "RELATIONS", "Series",
-           "VERSION", "as_items", "count_elements", "join", "model_from_json", "model_to_json"]
+__all__ = ["Box", "COMPARE_TYPES", "CONTACTS", "Coil", "Contact", "Element", "FORMAT",
+           "JsonReader", "Logic", "MAX_ELEMENTS", "MODIFIERS", "Model", "Node", "Parallel",
+           "RELATIONS", "Series", "VERSION", "as_items", "count_elements", "join",
+           "model_from_json", "model_to_json"]

@@ -29,16 +29,15 @@ from ..safetext import excerpt
 #: JSON format name and version of :func:`model_to_json`
 FORMAT = "plcrt-ladder"
 VERSION = 1
-#: the most elements (contacts, coils, boxes, branches) one model may hold;
-#: Micro/WIN's LAD editor limits a network to a grid of 32 columns by 32 rows
+#: the most elements (contacts, coils, boxes, branches) one model may hold
+#: (the largest network of the samples and the corpus has 22)
 MAX_ELEMENTS = 256
 #: the deepest nesting of the JSON document (and of the tree)
 MAX_DEPTH = 40
 #: the longest operand, title or comment text accepted
 MAX_OPERAND = 256
 MAX_TEXT = 4096
-#: the most operands of one element (CALL of a block with its parameters:
-#: Micro/WIN allows 16 parameters per subroutine)
+#: the most operands of one element (a CALL: the block and its parameters)
 MAX_OPERANDS = 24
 
 #: contact kinds of the JSON form -> the STL mnemonic of the series (``A``) form

@@ -45,10 +45,10 @@ from ..errors import PlcConfigError
 from ..lang import ir
 from ..safetext import excerpt
 from .ladder_check import check_operands, check_round_trip
-from .ladder_model import (MAX_DEPTH, MAX_ELEMENTS, MAX_TEXT, Box, Coil, Logic, Model, Node,
-                           Parallel, Series, JsonReader, count_elements, join, model_from_json,
-                           model_to_json)
-from .ladder_stl import NoLadder, model_to_stl, network_to_model
+from .ladder_model import (MAX_DEPTH, MAX_ELEMENTS, MAX_TEXT, Box, Coil, Contact, JsonReader,
+                           Logic, Model, Node, Parallel, Series, count_elements, join,
+                           model_from_json, model_to_json)
+from .ladder_stl import NoLadder, model_to_stl, network_to_model, stl_line
 
 #: the undo history keeps this many models
 MAX_HISTORY = 200
@@ -124,12 +124,14 @@ def _logic_of(raw: Any, name: str) -> Logic:
     return JsonReader().logic(raw, f"edit {name}", 1)
 
 
-def _out_of(raw: Any, name: str) -> Coil | Box | Node:
-    return JsonReader().out(raw, f"edit {name}", 1)
+def _out_of(raw: Any, name: str, at: tuple[Any, ...]) -> Coil | Box | Node:
+    """An output from the page; on the rail (``at`` under ``rail``) a rail
+    element (``LBL``, ``LSCR`` ...)."""
+    return JsonReader().out(raw, f"edit {name}", 1, rail=bool(at) and at[0] == "rail")
 
 
 def _is_logic(x: Any) -> bool:
-    return isinstance(x, (Series, Parallel)) or type(x).__name__ == "Contact"
+    return isinstance(x, (Contact, Series, Parallel))
 
 
 def _insert(model: Model, at: tuple[Any, ...], side: Any, new: Logic) -> Model:
@@ -166,18 +168,27 @@ def _parallel(model: Model, at: tuple[Any, ...], count: Any, branch: Logic) -> M
 
 def _output(model: Model, at: tuple[Any, ...], index: Any, new: Coil | Box | Node) -> Model:
     def fn(x: Any) -> Any:
-        if isinstance(x, Box) and not x.inputs:
+        if isinstance(x, tuple):  # the rail
+            return x[:place(x)] + (new,) + x[place(x):]
+        if isinstance(x, Box) and x.inputs:
+            raise PlcConfigError(f"edit: {_where(at)} is a counter box, which has no ENO")
+        if isinstance(x, Box):
             nxt = x.next or Node(None)
-            return replace(x, next=add(nxt))
+            return replace(x, next=replace(nxt, outs=add(nxt.outs)))
         if not isinstance(x, Node):
             raise PlcConfigError(f"edit: {_where(at)} is not a node or a box")
-        return add(x)
+        return replace(x, outs=add(x.outs))
 
-    def add(node: Node) -> Node:
-        i = len(node.outs) if index is None else index
-        if isinstance(i, bool) or not isinstance(i, int) or not 0 <= i <= len(node.outs):
-            raise PlcConfigError(f"edit: index must be from 0 to {len(node.outs)}")
-        return replace(node, outs=node.outs[:i] + (new,) + node.outs[i:])
+    def place(outs: tuple[Any, ...]) -> int:
+        i = len(outs) if index is None else index
+        if isinstance(i, bool) or not isinstance(i, int) or not 0 <= i <= len(outs):
+            raise PlcConfigError(f"edit: index must be from 0 to {len(outs)}")
+        return i
+
+    def add(outs: tuple[Any, ...]) -> tuple[Any, ...]:
+        return outs[:place(outs)] + (new,) + outs[place(outs):]
+    if at == ("rail",) and model.rung is not None:
+        raise PlcConfigError("edit: a network with a rung has no elements on the rail")
     return _update(model, at, fn)
 
 
@@ -200,10 +211,10 @@ def _apply(model: Model, op: Any) -> Model:
         title = r.text(op.get("title", model.title), "title", MAX_TEXT)
         if len(title.splitlines()) > 1:
             raise PlcConfigError("edit title: a network title is one line")
-        comment = r.text(op.get("comment", model.comment), "comment", MAX_TEXT)
-        # the parser keeps titles and comment lines without surrounding blanks
-        return replace(model, title=title.strip(),
-                       comment="\n".join(c.strip() for c in comment.splitlines()))
+        # blanks around the title and the comment lines go (normalize: the
+        # parser does not keep them)
+        return replace(model, title=title,
+                       comment=r.text(op.get("comment", model.comment), "comment", MAX_TEXT))
     if kind == "move":
         src = _path(op.get("from"), "from")
         moved = get(model, src)
@@ -218,7 +229,7 @@ def _apply(model: Model, op: Any) -> Model:
     if kind == "parallel":
         return _parallel(model, at, op.get("count", 1), _logic_of(op.get("branch"), "branch"))
     if kind == "output":
-        return _output(model, at, op.get("index"), _out_of(op.get("element"), "element"))
+        return _output(model, at, op.get("index"), _out_of(op.get("element"), "element", at))
     if kind == "delete":
         if not at:
             raise PlcConfigError("edit: delete needs a path")
@@ -226,7 +237,7 @@ def _apply(model: Model, op: Any) -> Model:
     if kind == "replace":
         old = get(model, at)
         new: Any = (_logic_of(op.get("element"), "element") if _is_logic(old)
-                    else _out_of(op.get("element"), "element"))
+                    else _out_of(op.get("element"), "element", at))
         return _update(model, at, lambda _: new)
     # operands
     raw = JsonReader().list_(op.get("ops"), "edit ops", 32)
@@ -310,7 +321,7 @@ def model_json(network: ir.Network) -> dict[str, Any]:
     or ``{"ladder": null, "stl": TEXT, "reason": WHY}`` when it stays STL."""
     got = network_to_model(network)
     if isinstance(got, NoLadder):
-        stl = "".join(f"{i.mnemonic:<6} {', '.join(o.text for o in i.operands)}".rstrip() + "\n"
+        stl = "".join(stl_line(i.mnemonic, tuple(o.text for o in i.operands)) + "\n"
                       for i in network.insns)
         return {"ladder": None, "stl": stl, "reason": got.reason}
     return {"ladder": model_to_json(got), "stl": model_to_stl(got)}

@@ -57,7 +57,7 @@ def network_to_model(network: ir.Network) -> Model | NoLadder:
     noted = next((i for i in network.insns if i.comment), None)
     if noted is not None:
         # LAD has a comment per network, none per element (docs/ladder-view.md)
-        return NoLadder(f"{_line(noted.mnemonic, _ops(noted))} has a comment of its own, "
+        return NoLadder(f"{stl_line(noted.mnemonic, _ops(noted))} has a comment of its own, "
                         "which a ladder element cannot keep")
     ladder = lad.to_ladder(network)
     if not ladder.ok:
@@ -70,8 +70,8 @@ def network_to_model(network: ir.Network) -> Model | NoLadder:
     want = [(i.mnemonic, tuple(o.text for o in i.operands)) for i in network.insns]
     for k, (got, exp) in enumerate(zip(lines, want)):
         if got != exp:
-            return NoLadder(f"instruction {k + 1} ({_line(*exp)}) is not where Micro/WIN's LAD "
-                            f"editor writes it: the drawing's STL has {_line(*got)} there")
+            return NoLadder(f"instruction {k + 1} ({stl_line(*exp)}) is not where Micro/WIN's LAD "
+                            f"editor writes it: the drawing's STL has {stl_line(*got)} there")
     if len(lines) != len(want):
         return NoLadder(f"the drawing's STL has {len(lines)} instructions, the network "
                         f"{len(want)}")
@@ -120,7 +120,7 @@ def model_to_stl(model: Model) -> str:
     Raises :class:`PlcConfigError` for a drawing that has no STL form (a
     parallel branch that starts with P, N or NOT, a stack deeper than nine
     levels, a branch without an output ...)."""
-    return "".join(_line(m, ops) + "\n" for m, ops in model_lines(model))
+    return "".join(stl_line(m, ops) + "\n" for m, ops in model_lines(model))
 
 
 def network_text(model: Model, number: int) -> str:
@@ -131,7 +131,8 @@ def network_text(model: Model, number: int) -> str:
     return head + "\n" + comment + model_to_stl(model)
 
 
-def _line(mnemonic: str, ops: tuple[str, ...]) -> str:
+def stl_line(mnemonic: str, ops: tuple[str, ...]) -> str:
+    """One instruction as an export writes it (``LD     I0.0``)."""
     return f"{mnemonic:<6} {', '.join(ops)}" if ops else mnemonic
 
 
@@ -283,7 +284,8 @@ def _changes_top(o: Coil | Box | Node) -> bool:
 
 def normalize(model: Model) -> Model:
     """The model as reading its STL gives it: a node whose only output is a
-    branch is one node with the two logics in series."""
+    branch is one node with the two logics in series; the title and the
+    comment lines without blanks around them."""
     def node(n: Node) -> Node:
         outs = tuple(fix(o) for o in n.outs)
         if len(outs) == 1 and isinstance(outs[0], Node) and outs[0].logic is not None:
@@ -301,8 +303,10 @@ def normalize(model: Model) -> Model:
 
     rung = model.rung
     new = node(rung) if isinstance(rung, Node) else rung
-    return Model(new, model.rail, model.title, model.comment)
+    # the parser keeps a title and comment lines without surrounding blanks
+    comment = "\n".join(c.strip() for c in model.comment.splitlines())
+    return Model(new, model.rail, model.title.strip(), comment)
 
 
 __all__ = ["NoLadder", "model_lines", "model_to_stl", "network_text", "network_to_model",
-           "normalize"]
+           "normalize", "stl_line"]

@@ -277,10 +277,34 @@ def _edit(draw, model: Model):
     return {"op": "title", "title": "t"}
 
 
+LOADABLE = CONTACTS.filter(lambda c: c["el"] not in ("P", "N", "NOT"))
+LOGIC = st.recursive(LOADABLE, lambda inner: st.builds(
+    lambda kind, first, rest: {"el": kind, "items": [first] + rest},
+    st.sampled_from(["series", "parallel"]), inner, st.lists(st.one_of(inner, CONTACTS),
+                                                            min_size=1, max_size=3)),
+    max_leaves=8)
+NODES = st.recursive(OUTS, lambda inner: st.builds(
+    lambda logic, outs: {"el": "node", "logic": logic, "outs": outs},
+    LOGIC, st.lists(inner, min_size=1, max_size=3)), max_leaves=6)
+
+
+@st.composite
+def _random_model(draw) -> Model:
+    """A random drawing from the page; one the editor would refuse (a
+    branch that starts with P, ...) is replaced by a sample network."""
+    doc = {"format": "plcrt-ladder", "version": 1, "title": "", "comment": "", "rail": [],
+           "rung": {"el": "node", "logic": draw(LOGIC),
+                    "outs": draw(st.lists(NODES, min_size=1, max_size=3))}}
+    try:
+        return History(Model()).apply({"op": "replace", "at": ["rung"], "element": doc["rung"]})
+    except PlcConfigError:
+        return _model(draw(st.sampled_from(START)))
+
+
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.data())
 def test_random_edits_give_checked_round_tripping_stl(data) -> None:
-    h = History(_model(data.draw(st.sampled_from(START))))
+    h = History(data.draw(_random_model()))
     accepted = [h.model]
     for _ in range(data.draw(st.integers(1, 8))):
         op = data.draw(_edit(h.model))
@@ -298,3 +322,39 @@ def test_random_edits_give_checked_round_tripping_stl(data) -> None:
     body = "".join(network_text(m, k + 1) for k, m in enumerate(accepted))
     plcrt.load(f"ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\n{body}END_ORGANIZATION_BLOCK\n",
                library=True, backend="python")
+
+
+def test_a_network_drawn_from_nothing() -> None:
+    empty = Model()
+    assert model_to_stl(empty) == ""
+    m = apply_edit(empty, {"op": "replace", "at": ["rung"], "element": {
+        "el": "node", "logic": {"el": "NO", "ops": ["I0.0"]},
+        "outs": [{"el": "coil", "insn": "=", "ops": ["Q0.0"]}]}})
+    m = apply_edit(m, {"op": "parallel", "at": ["rung", "logic"],
+                       "branch": {"el": "NO", "ops": ["Q0.0"]}})
+    m = apply_edit(m, {"op": "insert", "at": ["rung", "logic"], "side": "after",
+                       "element": {"el": "NC", "ops": ["I0.1"]}})
+    assert model_to_stl(m) == SEAL                                   # the seal-in rung
+    assert apply_edit(m, {"op": "delete", "at": ["rung"]}) == Model()
+
+
+def test_counter_inputs_and_rail_elements() -> None:
+    m = _model("LD     I0.0\nLD     I0.1\nCTU    C0, +10\n")
+    m = apply_edit(m, {"op": "insert", "at": ["rung", "inputs", 0], "side": "after",
+                       "element": {"el": "P"}})
+    assert _stl(m) == ["LD I0.0", "EU", "LD I0.1", "CTU C0,+10"]
+    with pytest.raises(PlcConfigError, match="counter box, which has no ENO"):
+        apply_edit(m, {"op": "output", "at": ["rung"],
+                       "element": {"el": "coil", "insn": "=", "ops": ["Q0.0"]}})
+    with pytest.raises(PlcConfigError, match="counter"):
+        apply_edit(m, {"op": "delete", "at": ["rung", "inputs", 1]})
+    rail = _model("LBL    3\n")
+    rail = apply_edit(rail, {"op": "output", "at": ["rail"],
+                             "element": {"el": "coil", "insn": "LSCR", "ops": ["S0.1"]}})
+    assert _stl(rail) == ["LBL 3", "LSCR S0.1"]
+    with pytest.raises(PlcConfigError, match="not a rail element"):
+        apply_edit(rail, {"op": "replace", "at": ["rail", 0],
+                          "element": {"el": "coil", "insn": "=", "ops": ["Q0.0"]}})
+    with pytest.raises(PlcConfigError, match="with a rung has no elements"):
+        apply_edit(_model(SEAL), {"op": "output", "at": ["rail"],
+                                  "element": {"el": "coil", "insn": "LBL", "ops": ["1"]}})

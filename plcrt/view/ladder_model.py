@@ -19,6 +19,7 @@ from deep inside.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any, Union
 
@@ -206,12 +207,40 @@ def _logic_json(x: Logic) -> dict[str, Any]:
             "items": [_logic_json(i) for i in x.items]}
 
 
+_PIN = re.compile(r"~(\w+)$|([@_])(\d+)r?$|(\w+)([=>])(\d+)r?$")
+
+
+def pins(insn: str) -> list[dict[str, Any]]:
+    """Where the page shows each operand of a coil or box, from the shape
+    table (:mod:`plcrt.isa.shape`): ``{"power": "IN"}`` for a power input,
+    ``{"place": "above"|"below", "op": i}`` for an operand written above or
+    below the element, ``{"name": "IN1", "op": i, "side": "in"|"out"}`` for a
+    pin.  Empty for CALL (its pins are the called block's parameters, in
+    order) and for what the table does not describe."""
+    out: list[dict[str, Any]] = []
+    for item in shape(insn).pins.split():
+        m = _PIN.match(item)
+        if m is None:  # pragma: no cover - the shape table's own test pins its grammar
+            continue
+        if m.group(1):
+            out.append({"power": m.group(1)})
+        elif m.group(2):
+            out.append({"place": "above" if m.group(2) == "@" else "below",
+                        "op": int(m.group(3))})
+        else:
+            out.append({"name": m.group(4), "op": int(m.group(6)),
+                        "side": "out" if m.group(5) == ">" else "in"})
+    return out
+
+
 def _out_json(x: Coil | Box | Node) -> dict[str, Any]:
     if isinstance(x, Coil):
-        return {"el": "coil", "insn": x.insn, "ops": list(x.ops), "lad": shape(x.insn).lad}
+        return {"el": "coil", "insn": x.insn, "ops": list(x.ops), "lad": shape(x.insn).lad,
+                "pins": pins(x.insn)}
     if isinstance(x, Box):
         d: dict[str, Any] = {"el": "box", "insn": x.insn, "ops": list(x.ops),
-                             "lad": x.ops[0] if x.insn == "CALL" and x.ops else shape(x.insn).lad}
+                             "lad": x.ops[0] if x.insn == "CALL" and x.ops else shape(x.insn).lad,
+                             "pins": pins(x.insn)}
         d["next"] = None if x.next is None else _out_json(x.next)
         d["inputs"] = [_logic_json(i) for i in x.inputs]
         return d
@@ -285,8 +314,8 @@ class JsonReader:
         raise self.fail(where, f"unknown element {excerpt(str(el), 40)!r}")
 
     def out(self, x: Any, where: str, depth: int, rail: bool = False) -> Coil | Box | Node:
-        d = self.dict_(x, where, {"el", "insn", "ops", "lad", "next", "inputs", "logic", "outs"},
-                       depth)
+        d = self.dict_(x, where, {"el", "insn", "ops", "lad", "pins", "next", "inputs", "logic",
+                                  "outs"}, depth)
         el = d.get("el")
         if el == "node" and not rail:
             logic = None if d.get("logic") is None else self.logic(d["logic"], where + ".logic",
@@ -337,4 +366,4 @@ def model_from_json(doc: Any) -> Model:
 __all__ = ["Box", "COMPARE_TYPES", "CONTACTS", "Coil", "Contact", "Element", "FORMAT",
            "JsonReader", "Logic", "MAX_ELEMENTS", "MODIFIERS", "Model", "Node", "Parallel",
            "RELATIONS", "Series", "VERSION", "as_items", "count_elements", "join",
-           "model_from_json", "model_to_json"]
+           "model_from_json", "model_to_json", "pins"]

@@ -148,3 +148,23 @@ def test_rail_elements_and_empty_network() -> None:
     assert model_to_stl(model) == "LBL    3\n"
     empty, _ = _network("")
     assert network_to_model(empty) == Model()
+
+
+def test_pins_place_every_operand_of_every_coil_and_box() -> None:
+    from plcrt.isa.registry import REGISTRY, load_families
+    from plcrt.isa.shape import shape
+    from plcrt.view.ladder_model import pins
+    load_families()
+    described = 0
+    for mnemonic, spec in REGISTRY.items():
+        if (shape(mnemonic).kind not in ("coil", "box") or not shape(mnemonic).pins
+                or spec.variadic):   # variadic ones (ATCH, CALL ...) check their own count
+            continue
+        described += 1
+        shown = [p["op"] for p in pins(mnemonic) if "op" in p]
+        # each operand once, except the in-out operand of STL's two-operand
+        # arithmetic, which is both IN1 and OUT of the LAD box
+        assert set(shown) == set(range(len(spec.roles))), mnemonic
+    assert described > 100
+    ton = model_to_json(network_to_model(_network("LD     I0.0\nTON    T37, +10\n")[0]))
+    assert ton["rung"]["outs"][0]["pins"][1] == {"power": "IN"}

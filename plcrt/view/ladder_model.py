@@ -308,8 +308,8 @@ class JsonReader:
         if el == "CMP":
             cmp = self.text(d.get("cmp"), where + ".cmp", 4)
             if not (len(cmp) >= 2 and cmp[0] in COMPARE_TYPES and cmp[1:] in RELATIONS):
-                raise self.fail(where, f"unknown compare {excerpt(cmp, 8)!r} "
-                                       f"(a type of {COMPARE_TYPES} and one of {' '.join(RELATIONS)})")
+                raise self.fail(where, f"unknown compare {excerpt(cmp, 8)!r} (a type of "
+                                       f"{COMPARE_TYPES} and one of {' '.join(RELATIONS)})")
             return Contact("CMP", self.ops(d, where, 2), cmp)
         raise self.fail(where, f"unknown element {excerpt(str(el), 40)!r}")
 
@@ -329,7 +329,8 @@ class JsonReader:
         kind = shape(insn).kind
         want = ("rail",) if rail else (("coil",) if el == "coil" else ("box",))
         if kind not in want:
-            raise self.fail(where, f"{excerpt(insn, 16)!r} is not a {'rail element' if rail else el}")
+            what = "rail element" if rail else el
+            raise self.fail(where, f"{excerpt(insn, 16)!r} is not a {what}")
         ops = self.ops(d, where)
         if el == "coil":
             return Coil(insn, ops)

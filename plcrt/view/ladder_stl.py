@@ -290,7 +290,8 @@ def normalize(model: Model) -> Model:
         outs = tuple(fix(o) for o in n.outs)
         if len(outs) == 1 and isinstance(outs[0], Node) and outs[0].logic is not None:
             child = outs[0]
-            logic = child.logic if n.logic is None else join(Series, [n.logic] + as_items(child.logic))
+            logic = (child.logic if n.logic is None
+                     else join(Series, [n.logic] + as_items(child.logic)))
             return Node(logic, child.outs)
         return Node(n.logic, outs)
 

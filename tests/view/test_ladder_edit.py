@@ -16,8 +16,7 @@ import plcrt
 from plcrt.errors import PlcConfigError
 from plcrt.lang.stl import parse_program
 from plcrt.view.ladder_edit import History, apply_edit, edit_json, get, model_json
-from plcrt.view.ladder_model import (MAX_ELEMENTS, Box, Coil, Contact, Model, Node, Parallel,
-                                     Series, model_to_json)
+from plcrt.view.ladder_model import Box, Coil, Model, Node, Parallel, Series, model_to_json
 from plcrt.view.ladder_stl import model_to_stl, network_text, network_to_model
 
 SEAL = "LD     I0.0\nO      Q0.0\nAN     I0.1\n=      Q0.0\n"

@@ -3,9 +3,10 @@
 Three checks, from cheap to complete:
 
 * :func:`check_operands`: each element's mnemonic is in the instruction
-  registry, it has the operand count the registry gives, and each operand
+  registry, it has the operand count the registry gives, each operand
   that is an address or a constant fits the instruction's role (the checks
-  ``plcrt check`` runs, :mod:`plcrt.gen.resolve`); symbols and ``#locals``
+  ``plcrt check`` runs, :mod:`plcrt.gen.resolve`), and a timer box's number
+  is one of its kind; symbols and ``#locals``
   are checked for their spelling only, since the symbol table and the
   block's interface are the program's;
 * :func:`check_round_trip`: the model's STL, read by the STL parser, gives
@@ -30,10 +31,13 @@ from ..isa.registry import lookup
 from ..lang import ir
 from ..lang.stl import parse_program
 from ..memory.cpu import cpu_model
+from ..memory.hardware import timer_kind_ok
 from ..safetext import excerpt
 from .ladder_model import Box, Coil, Contact, Model, Node, Parallel, Series
 from .ladder_stl import NoLadder, model_lines, network_text, network_to_model, normalize
 
+#: timer boxes, whose number says which box may use it
+TIMER_BOXES = ("TON", "TOF", "TONR")
 #: the program a network is wrapped in for the parser (OB1, no interface)
 _WRAP = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\n{}END_ORGANIZATION_BLOCK\n"
 
@@ -87,6 +91,11 @@ def check_operands(model: Model, cpu: str | None = None) -> None:
         roles = spec.roles
         if (len(ops) < len(roles)) if spec.variadic else (len(ops) != len(roles)):
             raise PlcConfigError(f"{where}: takes {len(roles)} operand(s), got {len(ops)}")
+        if mnemonic in TIMER_BOXES and ops and ops[0][:1] in "Tt" and ops[0][1:].isdigit():
+            # the timer number decides the kind (System Manual, timers; isa/timers.py)
+            if not timer_kind_ok(mnemonic, int(ops[0][1:])):
+                raise PlcConfigError(f"{where}: {excerpt(ops[0], 8)} is not a {mnemonic} timer "
+                                     "number (TONR: T0-T31, T64-T95; TON/TOF: the others)")
         for k, text in enumerate(ops):
             if not text.strip() or text != text.strip():
                 raise PlcConfigError(f"{where}: operand {k + 1} is empty or has blanks around it")

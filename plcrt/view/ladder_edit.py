@@ -261,28 +261,41 @@ def check_model(model: Model, cpu: str | None = None) -> Model:
     return check_round_trip(model)
 
 
-def apply_edit(model: Model | dict[str, Any], op: Any, *, cpu: str | None = None) -> Model:
+Check = Callable[[Model], Any]
+
+
+def apply_edit(model: Model | dict[str, Any], op: Any, *, cpu: str | None = None,
+               check: Check | None = None) -> Model:
     """Apply one edit operation (module docstring) and return the checked
-    new model; raises :class:`PlcConfigError` and leaves nothing changed
-    when the operation or its result is refused.  ``model`` may be the
-    JSON form (untrusted: it is read and checked too)."""
+    new model; raises :class:`PlcConfigError` (or what ``check`` raises) and
+    leaves nothing changed when the operation or its result is refused.
+    ``model`` may be the JSON form (untrusted: it is read and checked too).
+    ``check`` is called with the new model last: with the program at hand,
+    ``lambda m: check_in_program(text, block, number, m)`` refuses what only
+    the whole program can tell (a missing subroutine, a symbol not in the
+    table)."""
     if not isinstance(model, Model):
         model = check_model(model_from_json(model), cpu)
-    return check_model(_apply(model, op), cpu)
+    new = check_model(_apply(model, op), cpu)
+    if check is not None:
+        check(new)
+    return new
 
 
 class History:
     """A model with undo and redo: a stack of immutable models (at most
     :data:`MAX_HISTORY`; the oldest steps are forgotten first)."""
 
-    def __init__(self, model: Model, *, cpu: str | None = None) -> None:
+    def __init__(self, model: Model, *, cpu: str | None = None,
+                 check: Check | None = None) -> None:
         self._past: list[Model] = []
         self._future: list[Model] = []
         self.model = model
         self.cpu = cpu
+        self.check = check
 
     def apply(self, op: Any) -> Model:
-        new = apply_edit(self.model, op, cpu=self.cpu)
+        new = apply_edit(self.model, op, cpu=self.cpu, check=self.check)
         self._past.append(self.model)
         del self._past[:-MAX_HISTORY]
         self._future.clear()

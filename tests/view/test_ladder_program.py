@@ -69,3 +69,22 @@ def test_unknown_block_or_network_is_named() -> None:
         replace_network(SEAL, "SBR7", 1, m)
     with pytest.raises(PlcError, match="no network 9"):
         replace_network(SEAL, "OB1", 9, m)
+
+
+def test_timer_numbers_of_the_other_kind_are_refused_by_the_element_check() -> None:
+    for box, number in (("TON", "T0"), ("TONR", "T37"), ("TOF", "T95")):
+        with pytest.raises(PlcError, match=f"not a {box} timer number"):
+            apply_edit(_model(SEAL, 1), {"op": "output", "at": ["rung"], "element": {
+                "el": "box", "insn": box, "ops": [number, "+10"]}})
+
+
+def test_an_edit_checked_in_its_program() -> None:
+    from plcrt.view.ladder_edit import History
+
+    h = History(_model(SEAL, 1), check=lambda m: check_in_program(SEAL, "OB1", 2, m))
+    h.apply({"op": "output", "at": ["rung"], "element": {"el": "coil", "insn": "=",
+                                                         "ops": ["Q0.2"]}})
+    with pytest.raises(PlcError, match="NO_SUCH_BLOCK"):
+        h.apply({"op": "output", "at": ["rung"], "element": {
+            "el": "box", "insn": "CALL", "ops": ["NO_SUCH_BLOCK"]}})
+    assert [o.ops for o in h.model.rung.outs] == [("Q0.1",), ("Q0.2",)]

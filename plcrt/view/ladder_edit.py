@@ -192,6 +192,25 @@ def _output(model: Model, at: tuple[Any, ...], index: Any, new: Coil | Box | Nod
     return _update(model, at, fn)
 
 
+def _element_for(model: Model, at: tuple[Any, ...], raw: Any) -> Any:
+    """The element from the page for the place ``at``: a contact or logic
+    block where logic goes, a node after ENO, a node or a counter box as the
+    rung, a coil, box or branch among outputs, a rail element on the rail."""
+    get(model, at)  # the place exists
+    last, before = at[-1], (at[-2] if len(at) > 1 else None)
+    if last == "logic" or before == "inputs" or (
+            isinstance(last, int) and isinstance(get(model, at[:-1]), (Series, Parallel))):
+        return _logic_of(raw, "element")
+    new = _out_of(raw, "element", at)
+    if last == "next" and not isinstance(new, Node):
+        raise PlcConfigError("edit: what follows a box's ENO is a node")
+    if last == "rung" and not (isinstance(new, Node) or isinstance(new, Box) and new.inputs):
+        raise PlcConfigError("edit: a rung is a node or a counter box with its inputs")
+    if isinstance(last, int) and before not in ("outs", "rail"):
+        raise PlcConfigError(f"edit: nothing can be put at {_where(at)}")
+    return new
+
+
 def _apply(model: Model, op: Any) -> Model:
     if not isinstance(op, dict):
         raise PlcConfigError("edit: an operation is a JSON object")
@@ -200,7 +219,7 @@ def _apply(model: Model, op: Any) -> Model:
                "output": {"at", "index", "element"}, "delete": {"at"},
                "replace": {"at", "element"}, "operands": {"at", "ops"},
                "move": {"from", "to", "side", "index"}, "title": {"title", "comment"}}
-    if kind not in allowed:
+    if not isinstance(kind, str) or kind not in allowed:
         raise PlcConfigError(f"edit: unknown operation {excerpt(repr(kind), 40)} "
                              f"(one of {', '.join(allowed)})")
     extra = [k for k in op if k != "op" and k not in allowed[kind]]
@@ -217,6 +236,8 @@ def _apply(model: Model, op: Any) -> Model:
                        comment=r.text(op.get("comment", model.comment), "comment", MAX_TEXT))
     if kind == "move":
         src = _path(op.get("from"), "from")
+        if not src:
+            raise PlcConfigError("edit move: the path is empty")
         moved = get(model, src)
         rest = _update(model, src, lambda _: _DELETE)
         to = _path(op.get("to"), "to")
@@ -224,6 +245,8 @@ def _apply(model: Model, op: Any) -> Model:
             return _insert(rest, to, op.get("side", "after"), moved)
         return _output(rest, to, op.get("index"), moved)
     at = _path(op.get("at"))
+    if not at:
+        raise PlcConfigError(f"edit {kind}: the path is empty")
     if kind == "insert":
         return _insert(model, at, op.get("side", "after"), _logic_of(op.get("element"), "element"))
     if kind == "parallel":
@@ -231,13 +254,9 @@ def _apply(model: Model, op: Any) -> Model:
     if kind == "output":
         return _output(model, at, op.get("index"), _out_of(op.get("element"), "element", at))
     if kind == "delete":
-        if not at:
-            raise PlcConfigError("edit: delete needs a path")
         return _update(model, at, lambda _: _DELETE)
     if kind == "replace":
-        old = get(model, at)
-        new: Any = (_logic_of(op.get("element"), "element") if _is_logic(old)
-                    else _out_of(op.get("element"), "element", at))
+        new = _element_for(model, at, op.get("element"))
         return _update(model, at, lambda _: new)
     # operands
     raw = JsonReader().list_(op.get("ops"), "edit ops", 32)

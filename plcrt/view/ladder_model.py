@@ -294,7 +294,7 @@ class JsonReader:
 
     def logic(self, x: Any, where: str, depth: int) -> Logic:
         d = self.dict_(x, where, {"el", "ops", "cmp", "items"}, depth)
-        el = d.get("el")
+        el = self.text(d.get("el"), where + ".el", 16)
         if el in ("series", "parallel"):
             raw = self.list_(d.get("items"), where + ".items", MAX_ELEMENTS)
             if len(raw) < 2:
@@ -316,7 +316,7 @@ class JsonReader:
     def out(self, x: Any, where: str, depth: int, rail: bool = False) -> Coil | Box | Node:
         d = self.dict_(x, where, {"el", "insn", "ops", "lad", "pins", "next", "inputs", "logic",
                                   "outs"}, depth)
-        el = d.get("el")
+        el = self.text(d.get("el"), where + ".el", 16)
         if el == "node" and not rail:
             logic = None if d.get("logic") is None else self.logic(d["logic"], where + ".logic",
                                                                     depth + 1)

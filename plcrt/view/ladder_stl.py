@@ -148,6 +148,8 @@ def model_lines(model: Model) -> list[Line]:
     if isinstance(model.rung, Box):
         w.counter(model.rung)
     elif model.rung is not None:
+        if not isinstance(model.rung, Node):
+            raise PlcConfigError("a rung is a node or a counter box")
         if model.rung.logic is None:
             raise PlcConfigError("a rung starts with a contact from the rail")
         w.load(model.rung.logic)
@@ -261,6 +263,8 @@ class _Writer:
             self.branch(o)
 
     def branch(self, node: Node) -> None:
+        if not isinstance(node, Node):
+            raise PlcConfigError("what follows a box's ENO is a node")
         if node.logic is not None:
             self.and_(node.logic)
         self.outs(node.outs)

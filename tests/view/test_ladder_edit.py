@@ -27,6 +27,12 @@ def _net(stl: str, n: int = 1):
     return parse_program(text).pous[0].networks[0]
 
 
+def _read_back(model: Model):
+    """The model of the network that the model's STL text is, as parsed."""
+    text = f"ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\n{network_text(model, 1)}END_ORGANIZATION_BLOCK\n"
+    return network_to_model(parse_program(text).pous[0].networks[0])
+
+
 def _model(stl: str) -> Model:
     m = network_to_model(_net(stl))
     assert isinstance(m, Model)
@@ -312,8 +318,7 @@ def test_random_edits_give_checked_round_tripping_stl(data) -> None:
             assert h.model == accepted[-1]
     # every accepted model reads back from its STL as itself ...
     for m in accepted:
-        back = network_to_model(_net(model_to_stl(m)))
-        assert back == m, model_to_stl(m)
+        assert _read_back(m) == m, model_to_stl(m)
     # ... and all of them, one network each, pass plcrt check
     body = "".join(network_text(m, k + 1) for k, m in enumerate(accepted))
     plcrt.load(f"ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\n{body}END_ORGANIZATION_BLOCK\n",
@@ -354,3 +359,57 @@ def test_counter_inputs_and_rail_elements() -> None:
     with pytest.raises(PlcConfigError, match="with a rung has no elements"):
         apply_edit(_model(SEAL), {"op": "output", "at": ["rail"],
                                   "element": {"el": "coil", "insn": "LBL", "ops": ["1"]}})
+
+
+# ---------------------------------------------------------------------------
+# Untrusted JSON: whatever the page sends is a model and an edit, or a
+# PlcConfigError; never another exception
+# ---------------------------------------------------------------------------
+
+JSON = st.recursive(
+    st.none() | st.booleans() | st.integers(-5, 300) | st.floats(allow_nan=True)
+    | st.sampled_from(["", "el", "NO", "node", "series", "rung", "logic", "outs", "I0.0", "=",
+                       "MOVW", "CALL", "CMP", "W=", "\n", "//", ",", "\x1b[2J"]),
+    lambda inner: st.lists(inner, max_size=4)
+    | st.dictionaries(st.sampled_from(["el", "ops", "items", "logic", "outs", "insn", "next",
+                                       "inputs", "cmp", "op", "at", "side", "element",
+                                       "branch", "count", "index", "from", "to", "x"]),
+                      inner, max_size=5),
+    max_leaves=12)
+
+
+def _mutate(doc, path, value):
+    """``doc`` with the value at ``path`` (keys and indexes) replaced."""
+    if not path:
+        return value
+    head, rest = path[0], path[1:]
+    if isinstance(doc, dict) and head in doc:
+        return {**doc, head: _mutate(doc[head], rest, value)}
+    if isinstance(doc, list) and isinstance(head, int) and head < len(doc):
+        return doc[:head] + [_mutate(doc[head], rest, value)] + doc[head + 1:]
+    return doc
+
+
+def _places(doc, path=()):
+    yield path
+    items = doc.items() if isinstance(doc, dict) else enumerate(doc) if isinstance(doc, list) \
+        else ()
+    for k, v in items:
+        yield from _places(v, path + (k,))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_untrusted_documents_and_operations_never_raise_anything_else(data) -> None:
+    doc = model_to_json(_model(data.draw(st.sampled_from(START))))
+    place = data.draw(st.sampled_from(list(_places(doc))))
+    doc = _mutate(doc, place, data.draw(JSON))
+    op = data.draw(st.one_of(JSON, st.builds(
+        lambda kind, at, el: {"op": kind, "at": at, "element": el},
+        st.sampled_from(["insert", "output", "replace", "delete"]),
+        st.lists(st.sampled_from(["rung", "logic", "outs", 0, 1, 2]), max_size=5), JSON)))
+    try:
+        new = apply_edit(doc, op)
+    except PlcConfigError:
+        return
+    assert _read_back(new) == new

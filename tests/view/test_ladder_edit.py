@@ -125,6 +125,14 @@ REFUSED = [
     ({"op": "insert", "at": ["rung", "logic"],
       "element": {"el": "CMP", "cmp": "W=>", "ops": ["VW0", "1"]}}, "unknown compare"),
     ("insert", "JSON object"),
+    ({"op": "replace", "at": ["rung"], "element": {"el": "coil", "insn": "=", "ops": ["Q0.0"]}},
+     "a rung is a node"),
+    ({"op": "replace", "at": [], "element": {"el": "coil", "insn": "=", "ops": ["Q0.0"]}},
+     "path is empty"),
+    ({"op": "move", "from": [], "to": ["rung"]}, "path is empty"),
+    ({"op": ["insert"]}, "unknown operation"),
+    ({"op": "insert", "at": ["rung", "logic"], "element": {"el": ["NO"], "ops": ["I0.0"]}},
+     "expected a text"),
 ]
 
 

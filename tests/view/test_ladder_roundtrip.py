@@ -3,12 +3,17 @@ read as the editable ladder model, written as STL, parsed again.
 
 The comparison is the IR of the network: the same instructions (mnemonic
 and operand texts, in order) with the same title and comment; only the
-source locations differ.  A network without a ladder form must say why,
+source locations differ.  The text is compared too: each instruction line
+as written in the file and as the model writes it are the same up to
+blanks, and the count of networks whose lines are identical character for
+character (Micro/WIN's export layout, ``LD     I0.0``; indentation aside)
+is printed.  A network without a ladder form must say why,
 and the counts per source are printed (``pytest -s`` or ``-rP``) as
 docs/ladder-view.md lists them."""
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from pathlib import Path
 
@@ -19,7 +24,7 @@ from plcrt.lang import ir
 from plcrt.lang.stl import parse_program
 from plcrt.view.ladder import to_ladder
 from plcrt.view.ladder_model import model_from_json, model_to_json
-from plcrt.view.ladder_stl import NoLadder, network_text, network_to_model
+from plcrt.view.ladder_stl import NoLadder, model_to_stl, network_text, network_to_model
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = sorted(p for d in ("programs", "examples", "library") for p in (ROOT / d).rglob("*.awl"))
@@ -38,9 +43,14 @@ def _ir(net: ir.Network) -> tuple:
             tuple((i.mnemonic, tuple(o.text for o in i.operands)) for i in net.insns))
 
 
+def _blanks(line: str) -> str:
+    return re.sub(r"\s*,\s*", ", ", " ".join(line.split()))
+
+
 def _round_trip(path: Path) -> tuple[int, Counter]:
     prog = parse_sources(path)
-    ok, reasons = 0, Counter()
+    source = prog.source.splitlines()
+    ok, same, reasons = 0, 0, Counter()
     for pou in prog.pous:
         for net in pou.networks:
             model = network_to_model(net)
@@ -58,7 +68,12 @@ def _round_trip(path: Path) -> tuple[int, Counter]:
             assert len(back) == 1 and _ir(back[0]) == _ir(net), f"{pou.ident}/{net.number}"
             assert network_to_model(back[0]) == model
             assert model_from_json(model_to_json(model)) == model
-    print(f"\n{path.name}: {ok} network(s) as ladder, {sum(reasons.values())} stay STL")
+            written = [line.strip() for line in model_to_stl(model).splitlines()]
+            original = [source[i.loc.line - 1].strip() for i in net.insns]
+            assert [_blanks(x) for x in written] == [_blanks(x) for x in original]
+            same += written == original
+    print(f"\n{path.name}: {ok} network(s) as ladder ({same} with the same text), "
+          f"{sum(reasons.values())} stay STL")
     for why, n in reasons.most_common():
         print(f"  {n} x {why}")
     return ok, reasons

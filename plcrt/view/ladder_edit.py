@@ -41,12 +41,14 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any, Callable
 
-from ..errors import PlcConfigError
+from ..errors import PlcConfigError, SourceLoc
 from ..lang import ir
 from ..safetext import excerpt
+from .ladder import Box as LadBox
+from .ladder import to_ladder
 from .ladder_check import check_operands, check_round_trip
-from .ladder_model import (MAX_DEPTH, MAX_ELEMENTS, MAX_TEXT, Box, Coil, Contact, JsonReader,
-                           Logic, Model, Node, Parallel, Series, count_elements, join,
+from .ladder_model import (MAX_DEPTH, MAX_ELEMENTS, MAX_OPERANDS, MAX_TEXT, Box, Coil, Contact,
+                           JsonReader, Logic, Model, Node, Parallel, Series, count_elements, join,
                            model_from_json, model_to_json)
 from .ladder_stl import NoLadder, model_to_stl, network_to_model, stl_line
 
@@ -348,23 +350,61 @@ class History:
 # JSON for the page
 # ---------------------------------------------------------------------------
 
-def model_json(network: ir.Network) -> dict[str, Any]:
+def model_json(network: ir.Network, *, program: ir.Program | None = None) -> dict[str, Any]:
     """What the page draws for a network: ``{"ladder": MODEL, "stl": TEXT}``,
-    or ``{"ladder": null, "stl": TEXT, "reason": WHY}`` when it stays STL."""
+    or ``{"ladder": null, "stl": TEXT, "reason": WHY}`` when it stays STL.
+    With ``program``, a CALL box's pins are named after the called
+    subroutine's parameters (a library block's are named without it)."""
     got = network_to_model(network)
     if isinstance(got, NoLadder):
         stl = "".join(stl_line(i.mnemonic, tuple(o.text for o in i.operands)) + "\n"
                       for i in network.insns)
         return {"ladder": None, "stl": stl, "reason": got.reason}
-    return {"ladder": model_to_json(got), "stl": model_to_stl(got)}
+    return _page(got, program)
 
 
-def edit_json(doc: Any, op: Any, *, cpu: str | None = None) -> dict[str, Any]:
+def edit_json(doc: Any, op: Any, *, cpu: str | None = None,
+              program: ir.Program | None = None, check: Check | None = None) -> dict[str, Any]:
     """:func:`apply_edit` on JSON: the model's JSON and an operation in,
-    ``{"ladder": MODEL, "stl": TEXT}`` out."""
-    new = apply_edit(doc, op, cpu=cpu)
-    return {"ladder": model_to_json(new), "stl": model_to_stl(new)}
+    ``{"ladder": MODEL, "stl": TEXT}`` out (CALL pins as in :func:`model_json`)."""
+    return _page(apply_edit(doc, op, cpu=cpu, check=check), program)
 
 
-__all__ = ["History", "MAX_HISTORY", "apply_edit", "check_model", "edit_json", "get",
-           "model_json"]
+def _page(model: Model, program: ir.Program | None) -> dict[str, Any]:
+    doc = model_to_json(model)
+    _name_call_pins(doc, program)
+    return {"ladder": doc, "stl": model_to_stl(model)}
+
+
+def _name_call_pins(x: Any, program: ir.Program | None) -> None:
+    if isinstance(x, list):
+        for i in x:
+            _name_call_pins(i, program)
+    elif isinstance(x, dict):
+        if x.get("el") == "box" and x.get("insn") == "CALL" and x.get("ops"):
+            params = call_parameters(x["ops"][0], program)
+            x["pins"] = [dict(params[k], op=k + 1) if k < len(params) else {"op": k + 1}
+                         for k in range(len(x["ops"]) - 1)]
+        for v in x.values():
+            _name_call_pins(v, program)
+
+
+def call_parameters(block: str, program: ir.Program | None = None) -> list[dict[str, str]]:
+    """The parameters of a CALL's block, in CALL order (IN, IN_OUT, OUT):
+    ``[{"name": "Start", "side": "in"}, ...]``, from the subroutine of
+    ``program`` or the library description (``library/*.toml``); empty when
+    neither knows the block.  The renderer's naming (:mod:`plcrt.view.ladder`)
+    is asked with as many arguments as a CALL may have."""
+    loc = SourceLoc("<ladder>", 1, 1)
+    args = (block,) + tuple(f"P{k}" for k in range(MAX_OPERANDS - 1))
+    insns = (ir.Insn("LD", (ir.Operand("SM0.0", loc),), loc),
+             ir.Insn("CALL", tuple(ir.Operand(a, loc) for a in args), loc))
+    ladder = to_ladder(ir.Network(1, "", insns, loc), program=program)
+    rung = ladder.rung
+    box = rung.outs[0] if rung is not None and not isinstance(rung, LadBox) else None
+    pins = box.pins if isinstance(box, LadBox) else ()
+    return [{"name": p.name, "side": "out" if p.right else "in"} for p in pins if p.name]
+
+
+__all__ = ["History", "MAX_HISTORY", "apply_edit", "call_parameters", "check_model", "edit_json",
+           "get", "model_json"]

@@ -88,3 +88,23 @@ def test_an_edit_checked_in_its_program() -> None:
         h.apply({"op": "output", "at": ["rung"], "element": {
             "el": "box", "insn": "CALL", "ops": ["NO_SUCH_BLOCK"]}})
     assert [o.ops for o in h.model.rung.outs] == [("Q0.1",), ("Q0.2",)]
+
+
+def test_call_pins_are_named_after_the_block() -> None:
+    from plcrt.engine.runtime import parse_sources
+    from plcrt.view.ladder_edit import call_parameters, model_json
+
+    prog = parse_sources(ROOT / "programs" / "subroutine.awl")
+    sbr = next(p for p in prog.pous if p.kind == "SBR")
+    interface = [(v.name, "out" if v.section == "OUT" else "in")
+                 for v in sbr.variables if v.section != "TEMP"]
+    assert [(p["name"], p["side"]) for p in call_parameters(sbr.name, prog)] == interface
+    calls = [n for n in prog.pous[0].networks if any(i.mnemonic == "CALL" for i in n.insns)]
+    box = model_json(calls[0], program=prog)["ladder"]["rung"]["outs"][0]
+    assert [(p["name"], p["op"]) for p in box["pins"]] == [
+        (name, k + 1) for k, (name, _) in enumerate(interface)]
+    unnamed = model_json(calls[0])["ladder"]["rung"]["outs"][0]     # without the program
+    assert unnamed["pins"] == [{"op": k + 1} for k in range(len(interface))]
+    # a library block is named from library/*.toml
+    assert call_parameters("POS_GOTO_R")[0] == {"name": "EmNo", "side": "in"}
+    assert call_parameters("NO_SUCH_BLOCK") == []

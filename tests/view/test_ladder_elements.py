@@ -168,3 +168,14 @@ def test_pins_place_every_operand_of_every_coil_and_box() -> None:
     assert described > 100
     ton = model_to_json(network_to_model(_network("LD     I0.0\nTON    T37, +10\n")[0]))
     assert ton["rung"]["outs"][0]["pins"][1] == {"power": "IN"}
+
+
+def test_a_coil_line_between_branches_is_written_with_the_fewest_stack_instructions() -> None:
+    # the manual and the corpus do not show this form (docs/decisions.md)
+    head = "LD     I0.0\nLPS\nA      I0.1\n=      Q0.1\n"
+    fewest = head + "LPP\n=      Q0.2\nA      I0.3\n=      Q0.3\n"
+    other = head + "LRD\n=      Q0.2\nLPP\nA      I0.3\n=      Q0.3\n"
+    model = network_to_model(_network(fewest)[0])
+    assert isinstance(model, Model) and model_to_stl(model) == fewest
+    got = network_to_model(_network(other)[0])
+    assert isinstance(got, NoLadder) and got.reason.startswith("instruction 5 (LRD)")

@@ -99,7 +99,7 @@ def test_show_draws_the_blocks_that_parsed_when_others_have_syntax_errors(
     """A large export with a few broken lines still shows every block that
     parsed; the errors come first and the exit code says the input is bad."""
     main_file = tmp_path / "main.awl"
-    main_file.write_text("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0 I0.1\n"
+    main_file.write_text("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0 ;;\n"
                          "= Q0.0\nEND_ORGANIZATION_BLOCK\n"
                          "SUBROUTINE_BLOCK S:SBR0\nBEGIN\nNetwork 1 // kept\nLD I0.2\n"
                          "= Q0.2\nEND_SUBROUTINE_BLOCK\n", encoding="utf-8")

@@ -72,7 +72,7 @@ def test_check_notes_the_guess_after_a_syntax_error(
     """The note about a guessed encoding follows the syntax error."""
     path = tmp_path / "cz.awl"
     path.write_bytes(("ORGANIZATION_BLOCK MAIN:OB1\r\nBEGIN\r\nNetwork 1 // Čerpadlo\r\n"
-                      "LD     I0.0 (\r\nEND_ORGANIZATION_BLOCK\r\n").encode("cp1250"))
+                      "LD     I0.0 ;;\r\nEND_ORGANIZATION_BLOCK\r\n").encode("cp1250"))
     code, out, err = run_cli(capsys, "check", str(path))
     assert code == 1
     lines = err.splitlines()

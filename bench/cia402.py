@@ -44,6 +44,7 @@ import platform
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout without installing
@@ -192,21 +193,42 @@ class _Tpdos:
                 raise RuntimeError(f"{count - self.count} TPDOs missing")
 
 
-def can_csp(n: int, cycles: int) -> tuple[tuple[float, float], tuple[float, float]]:
-    """Eight (*n*) drives in CSP over the virtual bus: (PDO path, SDO-only
-    loop), each as (drive-seconds per wall second, per CPU second of the
-    process: its threads, the bus's included)."""
+def can_networks(local: bool) -> tuple:
+    """A connected (drive, master) pair of ``canopen.Network``: plcrt's
+    in-process bus (``cia402.bus``) or python-can's ``virtual`` bus."""
+    import canopen
+
+    from plcrt import cia402
+
+    channel = f"plcrt-bench-can-{time.monotonic_ns()}"
+    if local:
+        return cia402.bus(channel), cia402.bus(channel)
+    dev, mst = canopen.Network(), canopen.Network()
+    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
+    dev.connect(interface="virtual", channel=channel)
+    mst.connect(interface="virtual", channel=channel)
+    return dev, mst
+
+
+def target_of(k: int) -> int:
+    """The triangle wave of the CAN runs: +-20 000 counts, 400 per cycle at most."""
+    return 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)
+
+
+def can_csp(n: int, cycles: int, local: bool = False, sdo: bool = True,
+            profile: Any = None) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Eight (*n*) drives in CSP over a CAN bus (*local*: plcrt's in-process
+    bus, else python-can's ``virtual`` bus): (PDO path, SDO-only loop), each
+    as (drive-seconds per wall second, per CPU second of the process: its
+    threads, the bus's included); the SDO-only figures are (0, 0) without
+    *sdo*.  *profile*: a ``cProfile.Profile`` enabled around the PDO cycles."""
     import struct
 
     import canopen
 
     from plcrt import cia402
 
-    channel = f"plcrt-bench-can-{time.monotonic_ns()}"
-    dev, mst = canopen.Network(), canopen.Network()
-    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
-    dev.connect(interface="virtual", channel=channel)
-    mst.connect(interface="virtual", channel=channel)
+    dev, mst = can_networks(local)
     ids = range(1, n + 1)
     sims = [cia402.attach(dev, i, clock="sync") for i in ids]
     tpdos = _Tpdos()
@@ -249,18 +271,23 @@ def can_csp(n: int, cycles: int) -> tuple[tuple[float, float], tuple[float, floa
         for cw in (0x06, 0x07, 0x0F, 0x0F):
             cycle(cw, 0)
         gc.collect()
+        if profile is not None:
+            profile.enable()
         start, cpu = time.perf_counter(), time.process_time()
         for k in range(cycles):
-            cycle(0x0F, 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100))
+            cycle(0x0F, target_of(k))
         pdo_x = ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
+        if profile is not None:
+            profile.disable()
         assert all(s.drive.sm.state.name == "OPERATION_ENABLED" for s in sims)
+        if not sdo:
+            return pdo_x, (0.0, 0.0)
         for sim in sims:                      # today's loop: SDO only, manual time
             sim.clock = "manual"
         start, cpu = time.perf_counter(), time.process_time()
         for k in range(cycles):
-            target = 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)
             for node in nodes:
-                node.sdo.download(0x607A, 0, struct.pack("<i", target))
+                node.sdo.download(0x607A, 0, struct.pack("<i", target_of(k)))
                 node.sdo.upload(0x6064, 0)
             for sim in sims:
                 sim.advance(CYCLE_US / 1e6)

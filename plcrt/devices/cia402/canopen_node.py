@@ -399,22 +399,30 @@ class CanopenDrive:
         frames: list = []
         try:
             with self._lock:
-                drive = self.drive
-                if self.clock == "sync":
-                    t = drive.now + self._sync_period_us()
+                drive, pdos, clock = self.drive, self.pdos, self.clock
+                if clock == "sync":
+                    t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
                     drive.advance(t)
-                elif self.clock == "wall":
+                elif clock == "wall":
                     self._catch_up()
                 t = drive.now
-                frames, values = self.pdos.on_sync(t)
-                if values or self.clock == "sync":
-                    drive.exchange(t, self._rx_values(values))
-                frames += self.pdos.events(t)
-                self._check_emcy()
+                frames, values = pdos.on_sync(t)
+                if values or clock == "sync":
+                    if (0x6060, 0) in values:
+                        values = self._rx_values(values)
+                    drive.exchange(t, values)
+                if pdos.event_tx:                  # perf: no event-driven TPDO, no search
+                    frames += pdos.events(t)
+                if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test
+                    self._check_emcy()
         except Exception:
             log.exception("node %d: SYNC failed", self.drive.node_id)
+        send = self.network.send_message
         for can_id, data in frames:
-            self._send(can_id, data)
+            try:
+                send(can_id, data)                 # perf: _send inline
+            except Exception:                      # the bus went away: the drive goes on
+                self._once(f"send{can_id}", "CiA 301", f"frame 0x{can_id:X} not sent")
 
     @staticmethod
     def _rx_values(values: dict) -> dict:

@@ -38,20 +38,45 @@ connected that way would poll it from a Notifier thread).
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from typing import Any, Optional
 
 import can
 import canopen
+from canopen.network import MessageListener
 
-__all__ = ["LocalBus", "LocalNetwork", "MAX_CHANNEL"]
+__all__ = ["Frame", "LocalBus", "LocalNetwork", "MAX_CHANNEL"]
 
 #: The longest channel name taken (a name is a key of this process's table).
 MAX_CHANNEL = 64
 
 _channels: dict[str, tuple["LocalBus", ...]] = {}
 _channels_lock = threading.Lock()
+_canopen_log = logging.getLogger("canopen.network")   # where canopen's listener logs
+
+
+class Frame(can.Message):
+    """A ``can.Message`` built with only what a CAN 2.0 frame of canopen
+    needs (perf: ``can.Message.__init__`` takes thirteen arguments)."""
+
+    __slots__ = ()
+
+    def __init__(self, can_id: int, data: Any, remote: bool = False) -> None:  # noqa: D107
+        self.timestamp = 0.0
+        self.arbitration_id = can_id
+        self.is_extended_id = can_id > 0x7FF
+        self.is_remote_frame = remote
+        self.is_error_frame = False
+        self.channel = None
+        self.is_fd = False
+        self.is_rx = True
+        self.bitrate_switch = False
+        self.error_state_indicator = False
+        self.data = data = bytearray() if remote else (
+            data if data.__class__ is bytearray else bytearray(data))
+        self.dlc = len(data)
 
 
 class LocalBus(can.BusABC):
@@ -66,6 +91,8 @@ class LocalBus(can.BusABC):
         #: The receivers of this party (``can.Listener``); a LocalNetwork
         #: puts its dispatch here.
         self.listeners: list[Any] = []
+        #: How a frame reaches this party (a LocalNetwork puts its dispatch here).
+        self.deliver = self._to_listeners
         self._open = True
         with _channels_lock:
             _channels[channel] = _channels.get(channel, ()) + (self,)
@@ -76,8 +103,11 @@ class LocalBus(can.BusABC):
         msg.timestamp = time.time()
         for bus in _channels.get(self.channel, ()):     # perf: a tuple, replaced on join/leave
             if bus is not self:
-                for listener in bus.listeners:
-                    listener.on_message_received(msg)
+                bus.deliver(msg)
+
+    def _to_listeners(self, msg: can.Message) -> None:
+        for listener in self.listeners:
+            listener.on_message_received(msg)
 
     def _recv_internal(self, timeout: Optional[float]) -> tuple[None, bool]:
         return None, False                            # frames are delivered, not polled
@@ -119,13 +149,44 @@ class LocalNetwork(canopen.Network):
     joins the in-process channel; frames sent to it are dispatched in the
     sender's thread."""
 
+    _plain: Any = None          # the one listener seen to hand 11-bit frames to notify
+
     def connect(self, channel: str = "plcrt", **kwargs: Any) -> "LocalNetwork":  # type: ignore[override]
         if self.bus is not None:
             raise can.CanOperationError(f"already connected to {self.bus.channel_info}")
-        self.bus = LocalBus(channel)
+        bus = self.bus = LocalBus(channel)
         self.notifier = _Dispatch(self.listeners)
-        self.bus.listeners = self.listeners
+        bus.listeners = self.listeners
+        bus.deliver = self._deliver
         return self
+
+    def _deliver(self, msg: can.Message) -> None:
+        """A frame from the channel: as the listeners would take it, with
+        the common case -- an 11-bit data frame and the network's own
+        dispatch as the only listener -- handed to ``notify`` directly."""
+        listeners = self.listeners
+        if (len(listeners) == 1 and not (msg.is_extended_id or msg.is_remote_frame
+                                         or msg.is_error_frame)
+                and (listeners[0] is self._plain or self._plain_head(listeners[0]))):
+            # perf: what canopen's MessageListener does with such a frame,
+            # without the calls in between
+            try:
+                self.notify(msg.arbitration_id, msg.data, msg.timestamp)
+            except Exception as e:
+                _canopen_log.error(str(e))
+            return
+        for listener in listeners:
+            listener.on_message_received(msg)
+
+    def _plain_head(self, listener: Any) -> bool:
+        """Whether *listener* hands an 11-bit data frame to this network's
+        ``notify`` and does nothing else: canopen's MessageListener of this
+        network, or a filter that says so (``passes_base_frames_to``)."""
+        inner = getattr(listener, "passes_base_frames_to", listener)
+        if inner.__class__ is MessageListener and inner.network is self:
+            self._plain = listener
+            return True
+        return False
 
     def send_message(self, can_id: int, data: bytes, remote: bool = False) -> None:
         """As canopen's, without its send lock: delivery runs receivers, and a
@@ -134,5 +195,4 @@ class LocalNetwork(canopen.Network):
         bus = self.bus
         if not bus:
             raise RuntimeError("Not connected to CAN bus")
-        bus.send(can.Message(is_extended_id=can_id > 0x7FF, arbitration_id=can_id,
-                             data=data, is_remote_frame=remote))
+        bus.send(Frame(can_id, data, remote))

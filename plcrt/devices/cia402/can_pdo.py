@@ -284,7 +284,7 @@ class CanPdos:
             self._once(note, "nmt", "CiA 301 §7.3.2.2",
                        f"RPDO ignored ({ch.name}): PDOs act in NMT OPERATIONAL only")
             return None
-        size = self._codec(ch)[3]
+        size = (ch.codec[1] or self._codec(ch))[3]       # perf: the codec at hand
         if len(data) < size:
             self._once(note, f"short{ch.number}", "CiA 301 §7.2.2.3",
                        f"{ch.name} of {len(data)} bytes not processed: its mapping needs "
@@ -315,7 +315,9 @@ class CanPdos:
             ch.syncs += 1
             if ch.syncs >= ch.trans:
                 ch.syncs = 0
-                frames.append(self._sent(ch, self.sample(ch), t))
+                data = self.sample(ch)
+                ch.sent, ch.sent_at = data, t           # perf: _sent inline
+                frames.append((ch.cob_id & 0x7FF, data))
         return frames, values
 
     def events(self, t: int) -> list[Frame]:

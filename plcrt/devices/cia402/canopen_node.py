@@ -111,6 +111,12 @@ class _Frames(can.Listener):
         self.inner = inner
         self.ports: list["CanopenDrive"] = []
 
+    @property
+    def passes_base_frames_to(self) -> Any:
+        """The listener an 11-bit frame goes to unchanged (can_bus.py's
+        LocalNetwork hands such frames to the network itself)."""
+        return self.inner
+
     def on_message_received(self, msg: can.Message) -> None:
         if msg.is_extended_id:
             for port in self.ports:

@@ -3,8 +3,8 @@
 What it is: :class:`CanopenDrive`, which puts a :class:`~.drive.Drive` on a
 connected ``canopen.Network`` (python-can's ``virtual`` bus, or ``vcan``) so
 that any CANopen master -- canopen's own ``RemoteNode`` / ``BaseNode402`` --
-drives it with SDOs, PDOs, SYNC, NMT, heartbeat and EMCY.  It is the only
-module of the drive that imports ``canopen``.
+drives it with SDOs, PDOs, SYNC, NMT, heartbeat and EMCY; or on plcrt's
+in-process bus (:mod:`.can_bus`).
 
 * SDO: the drive answers every request itself (:class:`~.sdo_server.SdoServer`
   over :meth:`Drive.sdo_read` / :meth:`Drive.sdo_write` and the CAN objects of

@@ -47,6 +47,8 @@ import can
 import canopen
 from canopen.network import MessageListener
 
+from ...errors import PlcConfigError
+
 __all__ = ["Frame", "LocalBus", "LocalNetwork", "MAX_CHANNEL"]
 
 #: The longest channel name taken (a name is a key of this process's table).
@@ -74,7 +76,7 @@ class Frame(can.Message):
         self.is_rx = True
         self.bitrate_switch = False
         self.error_state_indicator = False
-        self.data = data = bytearray() if remote else (
+        self.data = data = bytearray() if remote or data is None else (
             data if data.__class__ is bytearray else bytearray(data))
         self.dlc = len(data)
 
@@ -152,8 +154,18 @@ class LocalNetwork(canopen.Network):
     _plain: Any = None          # the one listener seen to hand 11-bit frames to notify
 
     def connect(self, channel: str = "plcrt", **kwargs: Any) -> "LocalNetwork":  # type: ignore[override]
+        """Join in-process channel *channel*.
+
+        Raises:
+            PlcConfigError: connected already, or a python-can argument
+                (``interface=``, ``bitrate=``...), which this bus has not.
+        """
         if self.bus is not None:
-            raise can.CanOperationError(f"already connected to {self.bus.channel_info}")
+            raise PlcConfigError(f"cia402.bus: the network is connected to "
+                                 f"{self.bus.channel_info} already")
+        if kwargs:
+            raise PlcConfigError("cia402.bus: an in-process network takes a channel only, not "
+                                 + ", ".join(sorted(k for k in kwargs if isinstance(k, str))[:8]))
         bus = self.bus = LocalBus(channel)
         self.notifier = _Dispatch(self.listeners)
         bus.listeners = self.listeners

@@ -103,7 +103,7 @@ def trajectory(k: int) -> int:
     return 5 * k * k if k <= 60 else 18_000 + 600 * (k - 60)
 
 
-def run_eight_drives(dev, mst, synchronous: bool):
+def run_eight_drives(dev, mst):
     """Eight HCFA drives remapped and saved by their masters, SYNC at 1 ms
     (1006h = 1000 µs), CSP along :func:`trajectory`; drive 27 is blocked by
     a mechanical end at 20 000.  Returns (every TPDO per node, the EMCY
@@ -156,13 +156,13 @@ def test_eight_drives_give_the_same_positions_over_both_buses(request):
     name = channel(request)
     dev, mst = virtual_pair(name)
     try:
-        by_virtual = run_eight_drives(dev, mst, synchronous=False)
+        by_virtual = run_eight_drives(dev, mst)
     finally:
         mst.disconnect()
         dev.disconnect()
     dev, mst = cia402.bus(name), cia402.bus(name)
     try:
-        by_local = run_eight_drives(dev, mst, synchronous=True)
+        by_local = run_eight_drives(dev, mst)
     finally:
         mst.disconnect()
         dev.disconnect()
@@ -338,3 +338,14 @@ def test_a_periodic_sync_drives_the_drives_from_its_own_thread(local):
 def test_a_bad_channel_is_a_config_error(bad):
     with pytest.raises(PlcConfigError, match="cia402.bus: channel"):
         cia402.bus(bad)
+
+
+def test_connecting_twice_or_with_python_can_arguments_is_a_config_error(request):
+    net = cia402.bus(channel(request))
+    try:
+        with pytest.raises(PlcConfigError, match="connected to .* already"):
+            net.connect("other")
+    finally:
+        net.disconnect()
+    with pytest.raises(PlcConfigError, match="channel only, not bitrate, interface"):
+        type(net)().connect("x", interface="virtual", bitrate=500_000)

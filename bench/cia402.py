@@ -25,7 +25,12 @@ Run ``python bench/cia402.py`` (``--json`` for one JSON object).  It
    per 1 ms cycle the master sends eight RPDOs and a SYNC and waits for the
    eight TPDOs) and the SDO-only loop (per cycle the master downloads 607Ah
    and uploads 6064h of each drive by SDO, then every drive advances 1 ms on
-   its manual clock).
+   its manual clock);
+6. runs the same two loops with the same canopen master over plcrt's
+   in-process bus (``plcrt.cia402.bus``: each frame delivered in the
+   sender's thread, no copy, no Notifier thread), in the same run as 5, so
+   the ratios of the in-process PDO path to the virtual bus's PDO path and
+   to its SDO-only loop are printed.
 
 Each figure is the best of ``--repeat`` runs (fresh drives, set-up not
 timed).  The CSP figures come twice: per wall second, and per CPU second
@@ -44,6 +49,7 @@ import platform
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout without installing
@@ -192,24 +198,60 @@ class _Tpdos:
                 raise RuntimeError(f"{count - self.count} TPDOs missing")
 
 
-def can_csp(n: int, cycles: int) -> tuple[tuple[float, float], tuple[float, float]]:
-    """Eight (*n*) drives in CSP over the virtual bus: (PDO path, SDO-only
-    loop), each as (drive-seconds per wall second, per CPU second of the
-    process: its threads, the bus's included)."""
+class _TpdosHere:
+    """Counts the TPDOs the master receives on the in-process bus, where
+    they have all arrived when the SYNC's send returns: no thread to wait for."""
+
+    def __init__(self) -> None:
+        self.count = 0
+
+    def __call__(self, can_id: int, data: bytes, timestamp: float) -> None:
+        self.count += 1
+
+    def wait(self, count: int) -> None:
+        if self.count < count:
+            raise RuntimeError(f"{count - self.count} TPDOs missing")
+
+
+def can_networks(local: bool) -> tuple:
+    """A connected (drive, master) pair of ``canopen.Network``: plcrt's
+    in-process bus (``cia402.bus``) or python-can's ``virtual`` bus."""
+    import canopen
+
+    from plcrt import cia402
+
+    channel = f"plcrt-bench-can-{time.monotonic_ns()}"
+    if local:
+        return cia402.bus(channel), cia402.bus(channel)
+    dev, mst = canopen.Network(), canopen.Network()
+    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
+    dev.connect(interface="virtual", channel=channel)
+    mst.connect(interface="virtual", channel=channel)
+    return dev, mst
+
+
+def target_of(k: int) -> int:
+    """The triangle wave of the CAN runs: +-20 000 counts, 400 per cycle at most."""
+    return 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)
+
+
+def can_csp(n: int, cycles: int, local: bool = False, sdo: bool = True,
+            profile: Any = None) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Eight (*n*) drives in CSP over a CAN bus (*local*: plcrt's in-process
+    bus, else python-can's ``virtual`` bus): (PDO path, SDO-only loop), each
+    as (drive-seconds per wall second, per CPU second of the process: its
+    threads, the bus's included); the SDO-only figures are (0, 0) without
+    *sdo*.  *profile*: a ``cProfile.Profile`` enabled around the PDO cycles."""
     import struct
 
     import canopen
 
     from plcrt import cia402
 
-    channel = f"plcrt-bench-can-{time.monotonic_ns()}"
-    dev, mst = canopen.Network(), canopen.Network()
-    dev.NOTIFIER_CYCLE = mst.NOTIFIER_CYCLE = 0.02
-    dev.connect(interface="virtual", channel=channel)
-    mst.connect(interface="virtual", channel=channel)
+    dev, mst = can_networks(local)
     ids = range(1, n + 1)
     sims = [cia402.attach(dev, i, clock="sync") for i in ids]
-    tpdos = _Tpdos()
+    tpdos: Any = _TpdosHere() if local else _Tpdos()
     rx_ids = []
     try:
         nodes = []
@@ -249,18 +291,23 @@ def can_csp(n: int, cycles: int) -> tuple[tuple[float, float], tuple[float, floa
         for cw in (0x06, 0x07, 0x0F, 0x0F):
             cycle(cw, 0)
         gc.collect()
+        if profile is not None:
+            profile.enable()
         start, cpu = time.perf_counter(), time.process_time()
         for k in range(cycles):
-            cycle(0x0F, 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100))
+            cycle(0x0F, target_of(k))
         pdo_x = ratios(n * cycles * CYCLE_US / 1e6, start, cpu)
+        if profile is not None:
+            profile.disable()
         assert all(s.drive.sm.state.name == "OPERATION_ENABLED" for s in sims)
+        if not sdo:
+            return pdo_x, (0.0, 0.0)
         for sim in sims:                      # today's loop: SDO only, manual time
             sim.clock = "manual"
         start, cpu = time.perf_counter(), time.process_time()
         for k in range(cycles):
-            target = 400 * (k % 100) if (k // 100) % 2 == 0 else 400 * (100 - k % 100)
             for node in nodes:
-                node.sdo.download(0x607A, 0, struct.pack("<i", target))
+                node.sdo.download(0x607A, 0, struct.pack("<i", target_of(k)))
                 node.sdo.upload(0x6064, 0)
             for sim in sims:
                 sim.advance(CYCLE_US / 1e6)
@@ -293,6 +340,9 @@ def main(argv: list[str] | None = None) -> int:
     can_runs = [can_csp(8, int(args.seconds * 250)) for _ in range(args.repeat)]
     can_pdo, can_pdo_cpu = best([r[0] for r in can_runs])
     can_sdo, can_sdo_cpu = best([r[1] for r in can_runs])
+    local_runs = [can_csp(8, int(args.seconds * 500), local=True) for _ in range(args.repeat)]
+    in_pdo, in_pdo_cpu = best([r[0] for r in local_runs])
+    in_sdo, in_sdo_cpu = best([r[1] for r in local_runs])
     cal = calibration()
     out = {"machine": f"{platform.python_implementation()} {platform.python_version()} "
                       f"on {platform.machine()}",
@@ -312,7 +362,13 @@ def main(argv: list[str] | None = None) -> int:
            "can_csp_8_drives_sdo_only_x_real_time": round(can_sdo, 2),
            "can_pdo_over_sdo": round(can_pdo / can_sdo, 1),
            "can_per_cpu_second": {"pdo_sync": round(can_pdo_cpu, 2),
-                                  "sdo_only": round(can_sdo_cpu, 2)}}
+                                  "sdo_only": round(can_sdo_cpu, 2)},
+           "inproc_csp_8_drives_pdo_sync_x_real_time": round(in_pdo, 2),
+           "inproc_csp_8_drives_sdo_only_x_real_time": round(in_sdo, 2),
+           "inproc_per_cpu_second": {"pdo_sync": round(in_pdo_cpu, 2),
+                                     "sdo_only": round(in_sdo_cpu, 2)},
+           "inproc_pdo_over_virtual_pdo_per_cpu_second": round(in_pdo_cpu / can_pdo_cpu, 2),
+           "inproc_pdo_over_virtual_sdo_per_cpu_second": round(in_pdo_cpu / can_sdo_cpu, 1)}
     if args.json:
         print(json.dumps(out))
         return 0
@@ -331,6 +387,10 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  CSP over the virtual bus, 8 drives at a 1 ms SYNC: PDOs {can_pdo:6.2f} x real time, "
           f"({can_pdo_cpu:.2f}), SDO-only loop {can_sdo:6.2f} x ({can_sdo_cpu:.2f}); ratio "
           f"{can_pdo / can_sdo:.1f}")
+    print(f"  the same over the in-process bus (cia402.bus): PDOs {in_pdo:6.2f} x real time "
+          f"({in_pdo_cpu:.2f}), SDO-only loop {in_sdo:6.2f} x ({in_sdo_cpu:.2f}); per CPU "
+          f"second {in_pdo_cpu / can_pdo_cpu:.2f} times the virtual bus's PDO path, "
+          f"{in_pdo_cpu / can_sdo_cpu:.1f} times its SDO-only loop")
     return 0
 
 

@@ -5,7 +5,10 @@
 * :func:`eds_text` gives the same dictionary as an EDS file;
 * :func:`models` lists the drive models;
 * :func:`attach` puts a simulated drive on a connected ``canopen.Network``
-  (see :mod:`plcrt.devices.cia402.canopen_node`).
+  (see :mod:`plcrt.devices.cia402.canopen_node`);
+* :func:`bus` gives a ``canopen.Network`` on plcrt's in-process CAN bus,
+  which delivers each frame synchronously (see
+  :mod:`plcrt.devices.cia402.can_bus`).
 
 All three read the model's data file, ``library/cia402/<model>.toml`` (see
 :mod:`plcrt.devices.cia402.od`).  ``canopen`` is imported only when a
@@ -27,10 +30,11 @@ from .safetext import printable
 if TYPE_CHECKING:  # pragma: no cover
     import canopen.objectdictionary
 
+    from .devices.cia402.can_bus import LocalNetwork
     from .devices.cia402.canopen_node import CanopenDrive, Clock
     from .devices.cia402.plant import DrivePlant
 
-__all__ = ["attach", "eds_text", "models", "object_dictionary"]
+__all__ = ["attach", "bus", "eds_text", "models", "object_dictionary"]
 
 
 def object_dictionary(model: str = "hcfa-am0520b", node_id: int | None = None
@@ -96,3 +100,29 @@ def attach(network: Any, node_id: int, model: str = "hcfa-am0520b",
                              + ", ".join(models()))
     return CanopenDrive(network, node_id, model, plant_of(plant, "cia402.attach: plant"),
                         clock=clock)
+
+
+def bus(channel: str = "plcrt") -> "LocalNetwork":
+    """A ``canopen.Network`` connected to in-process CAN channel *channel*.
+
+    Every network connected to the same channel sees the frames the others
+    send, delivered in the sender's thread before its send returns (no copy,
+    no Notifier thread): a master's ``network.sync.transmit()`` runs the
+    SYNC-clocked drives' bus cycles, and their TPDOs have reached the
+    master's maps when it returns.  Use one network for the drives
+    (:func:`attach`) and one for the master, as with python-can's
+    ``virtual`` bus; ``disconnect()`` leaves the channel.  Frames are shared,
+    not copied: a receiver copies what it keeps (see
+    :mod:`plcrt.devices.cia402.can_bus`).
+
+    Raises:
+        PlcConfigError: *channel* is not a text of 1 to 64 printable characters.
+    """
+    from .devices.cia402.can_bus import MAX_CHANNEL, LocalNetwork   # perf: imports canopen
+
+    if (not isinstance(channel, str) or not 1 <= len(channel) <= MAX_CHANNEL
+            or not channel.isprintable()):
+        shown = printable(channel)[:40] if isinstance(channel, str) else type(channel).__name__
+        raise PlcConfigError(f"cia402.bus: channel {shown!r} is not a text of 1 to "
+                             f"{MAX_CHANNEL} printable characters")
+    return LocalNetwork().connect(channel)

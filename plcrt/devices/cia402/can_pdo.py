@@ -40,6 +40,7 @@ port tells :meth:`CanPdos.operational`), no canopen import.
 from __future__ import annotations
 
 import struct
+from operator import itemgetter
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
@@ -117,6 +118,11 @@ class CanPdos:
         self.by_com = {c.com: c for c in self.channels}
         self.by_map = {c.map: c for c in self.channels}
         self.rx_by_id: dict[int, Channel] = {}
+        # perf: the valid channels by role, rebuilt when a COB-ID or a
+        # transmission type changes (_index), so a SYNC visits only its own
+        self.sync_rx: tuple[Channel, ...] = ()
+        self.sync_tx: tuple[Channel, ...] = ()
+        self.event_tx: tuple[Channel, ...] = ()
         self.active = False                  # NMT OPERATIONAL
         self._noted: set[str] = set()
         self._index()
@@ -172,6 +178,7 @@ class CanPdos:
                 raise SdoAbort(0x06090030, f"{where}: transmission type {value} {why} "
                                "(CiA 301 §7.5.2.35 Table 57)")
             ch.trans, ch.syncs, ch.pending = value, 0, None
+            self._index()
         elif sub == 3:
             if ch.tx and ch.valid:
                 raise SdoAbort(0x06090030, f"{where}: the inhibit time of a valid "
@@ -206,7 +213,11 @@ class CanPdos:
         return f"{where}: {ch.name} {'valid' if ch.valid else 'not valid'}"
 
     def _index(self) -> None:
-        self.rx_by_id = {c.can_id: c for c in self.channels if not c.tx and c.valid}
+        valid = [c for c in self.channels if c.valid]
+        self.rx_by_id = {c.can_id: c for c in valid if not c.tx}
+        self.sync_rx = tuple(c for c in valid if not c.tx and c.trans in _SYNCED)
+        self.sync_tx = tuple(c for c in valid if c.tx and c.trans in _SYNCED)
+        self.event_tx = tuple(c for c in valid if c.tx and c.trans >= 254)
 
     def entries(self, ch: Channel) -> tuple[MapEntry, ...]:
         cfg = self.cfg
@@ -214,8 +225,9 @@ class CanPdos:
 
     # ---------------------------------------------------------------- codecs
     def _codec(self, ch: Channel) -> tuple:
-        """(struct or None, keys, entries, size) for the current map (perf:
-        built once per mapping)."""
+        """(struct or None, keys, entries, size, getter) for the current map
+        (perf: built once per mapping); *getter* takes the values of *keys*
+        from the store's live values as a tuple."""
         if ch.codec[1] is not None:
             return ch.codec[1]          # perf: built once per mapping (write() clears it)
         entries = self.entries(ch)
@@ -234,20 +246,22 @@ class CanPdos:
             fmt += code
             keys.append((e.index, e.sub))
         size = (sum(e.bits for e in entries) + 7) // 8
-        codec = (struct.Struct(fmt) if ok else None, tuple(keys), entries, size)
+        keys = tuple(keys)
+        codec = (struct.Struct(fmt) if ok else None, keys, entries, size, _getter(keys))
         ch.codec = (entries, codec)
         return codec
 
     def sample(self, ch: Channel) -> bytes:
         """The TPDO's data now, from the drive's objects."""
-        st, keys, entries, _ = self._codec(ch)
+        codec = ch.codec[1] or self._codec(ch)        # perf: the codec at hand
+        st, keys, entries, _, get = codec
         live = self.drive.store.live
         if st is not None:
-            return st.pack(*[live[k] for k in keys])
+            return st.pack(*get(live))
         return pack(entries, {k: int(live[k]) for k in keys})
 
     def decode(self, ch: Channel, data: bytes) -> dict[tuple[int, int], int]:
-        st, keys, entries, size = self._codec(ch)
+        st, keys, entries, size, _ = ch.codec[1] or self._codec(ch)
         if st is not None:
             return dict(zip(keys, st.unpack_from(data)))
         return unpack(entries, bytes(data[:size]), self.drive._signed)
@@ -270,7 +284,7 @@ class CanPdos:
             self._once(note, "nmt", "CiA 301 §7.3.2.2",
                        f"RPDO ignored ({ch.name}): PDOs act in NMT OPERATIONAL only")
             return None
-        size = self._codec(ch)[3]
+        size = (ch.codec[1] or self._codec(ch))[3]       # perf: the codec at hand
         if len(data) < size:
             self._once(note, f"short{ch.number}", "CiA 301 §7.2.2.3",
                        f"{ch.name} of {len(data)} bytes not processed: its mapping needs "
@@ -288,14 +302,11 @@ class CanPdos:
         values: dict[tuple[int, int], int] = {}
         if not self.active:
             return frames, values
-        for ch in self.channels:
-            if not ch.valid or ch.trans not in _SYNCED:
-                continue
-            if not ch.tx:
-                if ch.pending is not None:
-                    values.update(self.decode(ch, ch.pending))
-                    ch.pending = None
-                continue
+        for ch in self.sync_rx:
+            if ch.pending is not None:
+                values.update(self.decode(ch, ch.pending))
+                ch.pending = None
+        for ch in self.sync_tx:
             if ch.trans == 0:
                 data = self.sample(ch)
                 if data != ch.sent:
@@ -304,7 +315,9 @@ class CanPdos:
             ch.syncs += 1
             if ch.syncs >= ch.trans:
                 ch.syncs = 0
-                frames.append(self._sent(ch, self.sample(ch), t))
+                data = self.sample(ch)
+                ch.sent, ch.sent_at = data, t           # perf: _sent inline
+                frames.append((ch.cob_id & 0x7FF, data))
         return frames, values
 
     def events(self, t: int) -> list[Frame]:
@@ -313,9 +326,7 @@ class CanPdos:
         frames: list[Frame] = []
         if not self.active:
             return frames
-        for ch in self.channels:
-            if not ch.tx or not ch.valid or ch.trans < 254:
-                continue
+        for ch in self.event_tx:
             last = ch.sent_at
             if last is not None and ch.event_ms and t - last >= ch.event_ms * 1000:
                 frames.append(self._sent(ch, self.sample(ch), t))
@@ -327,8 +338,8 @@ class CanPdos:
 
     def next_due(self, t: int) -> Optional[int]:
         """When the next event-timer TPDO falls due after *t* (None: none)."""
-        due = [c.sent_at + c.event_ms * 1000 for c in self.channels
-               if c.tx and c.valid and c.trans >= 254 and c.event_ms and c.sent_at is not None]
+        due = [c.sent_at + c.event_ms * 1000 for c in self.event_tx
+               if c.event_ms and c.sent_at is not None]
         return min(due) if due else None
 
     @staticmethod
@@ -341,3 +352,13 @@ class CanPdos:
         if key not in self._noted:
             self._noted.add(key)
             note(section, text)
+
+
+def _getter(keys: tuple) -> Callable[[Any], tuple]:
+    """A function of a mapping that gives the values of *keys* as a tuple."""
+    if len(keys) > 1:
+        return itemgetter(*keys)              # perf: one C call for the image's values
+    if keys:
+        one = keys[0]
+        return lambda live: (live[one],)
+    return lambda live: ()

@@ -3,8 +3,8 @@
 What it is: :class:`CanopenDrive`, which puts a :class:`~.drive.Drive` on a
 connected ``canopen.Network`` (python-can's ``virtual`` bus, or ``vcan``) so
 that any CANopen master -- canopen's own ``RemoteNode`` / ``BaseNode402`` --
-drives it with SDOs, PDOs, SYNC, NMT, heartbeat and EMCY.  It is the only
-module of the drive that imports ``canopen``.
+drives it with SDOs, PDOs, SYNC, NMT, heartbeat and EMCY; or on plcrt's
+in-process bus (:mod:`.can_bus`).
 
 * SDO: the drive answers every request itself (:class:`~.sdo_server.SdoServer`
   over :meth:`Drive.sdo_read` / :meth:`Drive.sdo_write` and the CAN objects of
@@ -110,6 +110,12 @@ class _Frames(can.Listener):
     def __init__(self, inner: Any) -> None:
         self.inner = inner
         self.ports: list["CanopenDrive"] = []
+
+    @property
+    def passes_base_frames_to(self) -> Any:
+        """The listener an 11-bit frame goes to unchanged (can_bus.py's
+        LocalNetwork hands such frames to the network itself)."""
+        return self.inner
 
     def on_message_received(self, msg: can.Message) -> None:
         if msg.is_extended_id:
@@ -399,22 +405,30 @@ class CanopenDrive:
         frames: list = []
         try:
             with self._lock:
-                drive = self.drive
-                if self.clock == "sync":
-                    t = drive.now + self._sync_period_us()
+                drive, pdos, clock = self.drive, self.pdos, self.clock
+                if clock == "sync":
+                    t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
                     drive.advance(t)
-                elif self.clock == "wall":
+                elif clock == "wall":
                     self._catch_up()
                 t = drive.now
-                frames, values = self.pdos.on_sync(t)
-                if values or self.clock == "sync":
-                    drive.exchange(t, self._rx_values(values))
-                frames += self.pdos.events(t)
-                self._check_emcy()
+                frames, values = pdos.on_sync(t)
+                if values or clock == "sync":
+                    if (0x6060, 0) in values:
+                        values = self._rx_values(values)
+                    drive.exchange(t, values)
+                if pdos.event_tx:                  # perf: no event-driven TPDO, no search
+                    frames += pdos.events(t)
+                if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test
+                    self._check_emcy()
         except Exception:
             log.exception("node %d: SYNC failed", self.drive.node_id)
+        send = self.network.send_message
         for can_id, data in frames:
-            self._send(can_id, data)
+            try:
+                send(can_id, data)                 # perf: _send inline
+            except Exception:                      # the bus went away: the drive goes on
+                self._once(f"send{can_id}", "CiA 301", f"frame 0x{can_id:X} not sent")
 
     @staticmethod
     def _rx_values(values: dict) -> dict:

@@ -334,6 +334,16 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
                                   f"{', '.join(str(d.slot) for d in found)}): name the slot")
         return found[0]
 
+    def machine(self, name: str) -> Any:
+        """The machine *name* of the plant (``[machine.NAME]``), a
+        :class:`plcrt.devices.machines.Machine`: ``state()``, ``fault()``,
+        ``press()`` ... (docs/machines.md)."""
+        found = {d.name: d for d in self.devices if hasattr(d, "view")}
+        if not isinstance(name, str) or name not in found:
+            raise PlcAddressError(f"no machine {shown_value(name)} in the plant (its machines: "
+                                  f"{', '.join(found) or 'none'})")
+        return found[name].view()
+
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""
         self.stop_requested = True

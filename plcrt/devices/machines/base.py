@@ -135,6 +135,7 @@ class MachineDevice:
         self.setup()
         for f in cfg.faults:
             self.set_fault(f, True)
+        self.event(self.t)      # what is due at power-up (a part arriving at 0 s)
         self.levels = self.terminals()
         self.publish()
 

@@ -133,7 +133,7 @@ class Conveyor(MachineDevice):
         best = None
         arrival = self._arrival()
         if arrival is not None and self._entry_clear():
-            best = max(arrival, t + 1)   # (an arrival at 0 s enters at 1 µs)
+            best = max(arrival, t + 1)
         v = self._speed()
         if v and self.parts:
             last = len(self.parts) - 1

@@ -338,11 +338,16 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
         """The machine *name* of the plant (``[machine.NAME]``), a
         :class:`plcrt.devices.machines.Machine`: ``state()``, ``fault()``,
         ``press()`` ... (docs/machines.md)."""
-        found = {d.name: d for d in self.devices if hasattr(d, "view")}
+        found = {m.name: m for m in self.machines()}
         if not isinstance(name, str) or name not in found:
             raise PlcAddressError(f"no machine {shown_value(name)} in the plant (its machines: "
                                   f"{', '.join(found) or 'none'})")
-        return found[name].view()
+        return found[name]
+
+    def machines(self) -> list[Any]:
+        """Every machine of the plant, in the plant file's order (see :meth:`machine`)."""
+        # the machines are the devices that hand out a view (plcrt.devices.machines)
+        return [d.view() for d in self.devices if hasattr(d, "view")]
 
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""

@@ -50,6 +50,10 @@ class Motion:
         ``fault("jam")``, ``press("call_2")`` ..., as :meth:`Plc.machine`."""
         return self.plc.machine(name)
 
+    def machines(self) -> list[Any]:
+        """Every machine of the plant."""
+        return self.plc.machines()
+
     def drive(self, node: int, slot: int | None = None) -> DriveState:
         """State of the bus drive at *node* (needs a plant with a FIELDBUS
         module): ``d.position``, ``d.statusword``, ``d.state``, ``d.flags``,

@@ -311,6 +311,8 @@ _methods("Trace", _trace, {
 CALLS["Plc.machine"] = (lambda **k: _machine_plc().machine(**k), {"name": "conveyor"})
 CALLS["Harness.machine"] = (lambda **k: Harness(_machine_plc()).machine(**k),
                             {"name": "conveyor"})
+CALLS["Plc.machines"] = (lambda **k: _machine_plc().machines(**k), {})
+CALLS["Harness.machines"] = (lambda **k: Harness(_machine_plc()).machines(**k), {})
 CALLS["Machine.__init__"] = (Machine, {"device": Fresh(lambda: _machine()._dev)})
 _methods("Machine", _machine, {
     "state": {}, "wiring": {}, "faults": {}, "fault": {"name": "jam", "on": True},

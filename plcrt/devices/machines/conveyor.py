@@ -47,17 +47,17 @@ class Conveyor(MachineDevice):
     OUTPUTS = {"motor": "Q0.0", "gate": "Q0.1", "divert": "Q0.2"}
     BUTTONS = ("start", "stop")
     PARAMS = {
-        "length": Param(2000, 200, 100_000, doc="belt length, mm"),
+        "length": Param(2000, 200, 20_000, doc="belt length, mm"),
         "speed": Param(250, 1, 10_000, doc="belt speed, mm/s"),
-        "part": Param(100, 10, 1000, doc="part length, mm"),
+        "part": Param(100, 50, 1000, doc="part length, mm"),
         "first": Param(0.5, 0, 3600, integer=False, doc="first part arrives, s"),
         "interval": Param(3.0, 0.01, 3600, integer=False, doc="one part every, s"),
         "count": Param(0, 0, 1_000_000, doc="parts in all (0: no end)"),
         "pattern": Param("ST", 0, 0, text="[TS]{1,64}", doc="kinds in turn, T tall, S short"),
-        "eye_entry_at": Param(150, 1, 100_000, doc="entry eyes (entry, tall), mm"),
-        "gate_at": Param(1000, 1, 100_000, doc="stopper gate, mm"),
-        "divert_at": Param(1500, 1, 100_000, doc="diverter, mm"),
-        "eye_exit_at": Param(1900, 1, 100_000, doc="exit eye, mm"),
+        "eye_entry_at": Param(150, 1, 20_000, doc="entry eyes (entry, tall), mm"),
+        "gate_at": Param(1000, 1, 20_000, doc="stopper gate, mm"),
+        "divert_at": Param(1500, 1, 20_000, doc="diverter, mm"),
+        "eye_exit_at": Param(1900, 1, 20_000, doc="exit eye, mm"),
     }
     OWN_FAULTS = {"jam": "the front part on the belt (else the next to enter) sticks "
                          "where it is; the parts behind queue against it"}

@@ -125,3 +125,37 @@ def test_the_state_is_plain_json_of_numbers_booleans_and_names(kind: str) -> Non
     check(s)
     assert json.loads(json.dumps(s, allow_nan=False)) == s
     assert s["kind"] == kind and s["t"] == 7.0
+
+
+def test_an_edge_interrupt_on_an_eye_runs_once_per_part() -> None:
+    # INT_0 on event 0 (I0.0 rising: the entry eye) counts parts in VW100
+    # and keeps the scan count it ran in (SMW22 is no clock: VW102 counts scans)
+    program = """ORGANIZATION_BLOCK MAIN:OB1
+BEGIN
+Network 1
+LD     SM0.1
+ATCH   INT_0, 0
+ENI
+Network 2
+LD     SM0.0
+MOVB   VB0, QB0
+INCW   VW102
+END_ORGANIZATION_BLOCK
+INTERRUPT_BLOCK INT_0:INT0
+BEGIN
+Network 1
+LD     SM0.0
+INCW   VW100
+MOVW   VW102, VW104
+END_INTERRUPT_BLOCK
+"""
+    plc = plcrt.load(program, plant={"machine": {"conveyor": {"interval": 1.0}}})
+    m = plc.machine("conveyor")
+    outputs(plc, m, motor=1, gate=1)
+    plc.run(seconds=5.005)
+    rising = [t for t, s, v in m.edges("eye_entry") if v]
+    assert rising == [1.1, 2.1, 3.1, 4.1]
+    assert plc["VW100"] == 4
+    # the last ran at the start of the scan at 4.1 s (after 410 scans, before
+    # OB1 counted this one): the first scan start at or after the edge
+    assert plc["VW104"] == 410

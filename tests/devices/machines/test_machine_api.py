@@ -159,3 +159,19 @@ END_INTERRUPT_BLOCK
     # the last ran at the start of the scan at 4.1 s (after 410 scans, before
     # OB1 counted this one): the first scan start at or after the edge
     assert plc["VW104"] == 410
+
+
+def test_stuck_and_broken_wires_on_outputs_and_inputs() -> None:
+    plc, m = manual("tank", faults=["stuck_on:inlet"])
+    plc.run(seconds=1)                       # a welded contact: the inlet runs, Q0.0 is off
+    assert m.state()["volume"] == 2000 and m.state()["outputs"]["inlet"] == 1
+    assert plc["Q0.0"] == 0
+    m.fault("broken:inlet")                  # a broken wire wins over the welded contact
+    plc.run(seconds=1)
+    assert m.state()["volume"] == 2000
+    m.fault("stuck_on:level")                # an analog input stuck at full scale
+    m.fault("stuck_off:low")
+    plc.run(scans=1)
+    assert plc["AIW0"] == 32000 and m.state()["inputs"]["low"] == 0
+    assert sorted(m.state()["faults"]) == ["broken:inlet", "stuck_off:low", "stuck_on:inlet",
+                                           "stuck_on:level"]

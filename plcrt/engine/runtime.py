@@ -222,6 +222,11 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
         if plant is not None:
             self.devices = parts.build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
+            # I0.0–I0.3 a device drives at exact times (a machine's sensors): their
+            # edges come from the time line too (engine/edges.py)
+            for d in self.devices:
+                for b in getattr(d, "edge_bits", ()):
+                    self._edge_mask &= ~(1 << b)
         with gc_paused():
             self._adopt(_entry, auto_diags)
         a = self.mem.areas

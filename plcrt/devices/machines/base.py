@@ -27,6 +27,7 @@ the device layer's step.
 
 from __future__ import annotations
 
+import copy
 from collections import deque
 from typing import Any, ClassVar
 
@@ -120,6 +121,15 @@ class MachineDevice:
                 raise PlcConfigError(f"{cfg.where}: {sig} = {show_address(addr)} is outside "
                                      f"this CPU's process image")
         self.t: int = getattr(plc, "_t_us", 0)
+        self.scan_us: int = getattr(plc, "scan_us", 10_000)
+        #: I0.0–I0.3 this machine drives: the time line runs their edge
+        #: interrupts at the edges' own instants (engine/edges.py)
+        self.edge_bits = tuple(a[1] for s, a in self.in_map.items()
+                               if a is not None and a[0] == "I" and a[1] < 4)
+        self._bit_signal = {a[1]: s for s, a in self.in_map.items()
+                            if a is not None and a[0] == "I"}
+        #: the edges a copy ran into: (course, until µs, edges) (input_edge_after)
+        self._ahead: tuple[Any, int, list[tuple[int, str, int]]] | None = None
         self.active: set[str] = set()
         #: what the machine sees of each output (after faults)
         self.out = {s: 0 for s in self.OUTPUTS}
@@ -241,6 +251,10 @@ class MachineDevice:
     def step(self, plc: Any, t0: int, t1: int) -> None:
         """Advance from *t0* to *t1* (µs), events in time order, then write the inputs."""
         self.read_outputs()
+        if plc is not None:
+            self.scan_us = plc.scan_us
+            if self._ahead is not None and self._ahead[0] != self._course():
+                self._ahead = None    # another course: the copy's edges no longer hold
         t = max(t0, self.t)
         self.began(t)
         for _ in range(MAX_EVENTS):
@@ -271,6 +285,44 @@ class MachineDevice:
 
     def snapshot(self, t: int) -> list[Any]:
         return []
+
+    def _course(self) -> tuple[Any, ...]:
+        """What the machine's future depends on besides its state: the
+        outputs as the image holds them, the faults, the buttons."""
+        q = self.q
+        outs = tuple(0 if a is None else q[a[1] >> 3] >> (a[1] & 7) & 1
+                     for a in self.out_map.values())
+        return outs, frozenset(self.active), tuple(self.pressed.values()), tuple(self.releases)
+
+    def input_edge_after(self, bit: int, after: int, rising: bool) -> int | None:
+        """The time of the first rising (falling) edge of the input *bit*
+        after *after* µs with the outputs as they are now: one already made
+        (a button pressed between two scans), else one a copy of the machine
+        runs into ahead (the time line asks again at each instant)."""
+        sig, want = self._bit_signal.get(bit), int(rising)
+        found = None
+        for t, s, v in reversed(self.log):
+            if t <= after:
+                break
+            if s == sig and v == want:
+                found = t
+        if found is not None:
+            return found
+        course = self._course()
+        need = max(after, self.t) + self.scan_us
+        ahead = self._ahead
+        if ahead is None or ahead[0] != course or ahead[1] < need:
+            # perf: a copy runs four scans ahead; its edges hold while the
+            # course stays the same (the machine is deterministic), so the
+            # instants of those scans are answered from them
+            memo = {id(self.pi): bytearray(self.pi), id(self.ai): bytearray(self.ai),
+                    id(self.q): self.q, id(self.log): deque(maxlen=EDGE_LOG),
+                    id(self.notes): deque(maxlen=EDGE_LOG), id(self._ahead): None}
+            twin = copy.deepcopy(self, memo)
+            until = need + 3 * self.scan_us
+            twin.step(None, twin.t, until)
+            ahead = self._ahead = (course, until, list(twin.log))
+        return next((t for t, s, v in ahead[2] if t > after and s == sig and v == want), None)
 
     def view(self) -> Machine:
         """What :meth:`plcrt.Plc.machine` hands out."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 import plcrt
 from plcrt.testing import Harness
@@ -127,38 +128,61 @@ def test_the_state_is_plain_json_of_numbers_booleans_and_names(kind: str) -> Non
     assert s["kind"] == kind and s["t"] == 7.0
 
 
-def test_an_edge_interrupt_on_an_eye_runs_once_per_part() -> None:
-    # INT_0 on event 0 (I0.0 rising: the entry eye) counts parts in VW100
-    # and keeps the scan count it ran in (SMW22 is no clock: VW102 counts scans)
-    program = """ORGANIZATION_BLOCK MAIN:OB1
+#: OB1 runs a 1 ms timer T32 from power-up and copies VB0 to the outputs;
+#: INT_0 (I0.0 rising) counts in VW100 and keeps T32 in VW104, INT_1 (I0.0
+#: falling) keeps T32 in VW106
+EDGE_TIMES = """ORGANIZATION_BLOCK MAIN:OB1
 BEGIN
 Network 1
 LD     SM0.1
 ATCH   INT_0, 0
+ATCH   INT_1, 1
 ENI
 Network 2
 LD     SM0.0
+TON    T32, +32000
 MOVB   VB0, QB0
-INCW   VW102
 END_ORGANIZATION_BLOCK
 INTERRUPT_BLOCK INT_0:INT0
 BEGIN
 Network 1
 LD     SM0.0
 INCW   VW100
-MOVW   VW102, VW104
+MOVW   T32, VW104
+END_INTERRUPT_BLOCK
+INTERRUPT_BLOCK INT_1:INT1
+BEGIN
+Network 1
+LD     SM0.0
+MOVW   T32, VW106
 END_INTERRUPT_BLOCK
 """
-    plc = plcrt.load(program, plant={"machine": {"conveyor": {"interval": 1.0}}})
+
+
+def test_an_edge_interrupt_on_an_eye_runs_at_the_edge() -> None:
+    plc = plcrt.load(EDGE_TIMES, plant={"machine": {"conveyor": {"interval": 1.0,
+                                                                 "speed": 333}}})
     m = plc.machine("conveyor")
     outputs(plc, m, motor=1, gate=1)
     plc.run(seconds=5.005)
     rising = [t for t, s, v in m.edges("eye_entry") if v]
-    assert rising == [1.1, 2.1, 3.1, 4.1]
-    assert plc["VW100"] == 4
-    # the last ran at the start of the scan at 4.1 s (after 410 scans, before
-    # OB1 counted this one): the first scan start at or after the edge
-    assert plc["VW104"] == 410
+    # arrivals at 0.5 s + k; 150 mm at 333 mm/s is 450451 µs
+    assert rising == [(k * 10**6 + 950_451) / 1e6 for k in range(5)]
+    assert plc["VW100"] == 5                                # once per part, no scan-start repeat
+    assert plc["VW104"] == 4950                             # T32 at 4.950451 s, inside a scan
+    # the last tail left the beam at 3.5 s + 250 mm / 333 mm/s = 4.250751 s
+    assert m.edges("eye_entry")[-2] == (4.250751, "eye_entry", 0)
+    assert plc["VW106"] == 4250
+
+
+def test_an_edge_interrupt_on_a_button_runs_at_its_press_and_release() -> None:
+    plc = plcrt.load(EDGE_TIMES, plant={"machine": {"traffic": {}}})
+    m = plc.machine("traffic")
+    plc.run(seconds=0.5)
+    m.press("button_a", seconds=0.123456)
+    plc.run(seconds=0.5)
+    assert plc["VW100"] == 1 and plc["VW104"] == 500
+    assert plc["VW106"] == 623                              # released at 0.623456 s
 
 
 def test_stuck_and_broken_wires_on_outputs_and_inputs() -> None:
@@ -175,3 +199,36 @@ def test_stuck_and_broken_wires_on_outputs_and_inputs() -> None:
     assert plc["AIW0"] == 32000 and m.state()["inputs"]["low"] == 0
     assert sorted(m.state()["faults"]) == ["broken:inlet", "stuck_off:low", "stuck_on:inlet",
                                            "stuck_on:level"]
+
+
+def test_a_fork_keeps_the_machines_edge_interrupts() -> None:
+    plc = plcrt.load(EDGE_TIMES, plant={"machine": {"conveyor": {"interval": 1.0,
+                                                                 "speed": 333}}})
+    m = plc.machine("conveyor")
+    outputs(plc, m, motor=1, gate=1)
+    plc.run(seconds=2.0)
+    twin = plc.fork()
+    for p in (plc, twin):
+        p.run(seconds=3.005)
+    assert [twin[a] for a in ("VW100", "VW104", "VW106")] == \
+        [plc[a] for a in ("VW100", "VW104", "VW106")] == [5, 4950, 4250]
+    assert twin.machine("conveyor").edges() == m.edges()
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.lists(st.tuples(st.integers(1, 60), st.integers(0, 3)), min_size=1, max_size=8),
+       st.integers(101, 499))
+def test_edge_interrupts_follow_the_edges_whatever_the_outputs_do(segments, speed):
+    plc = plcrt.load(EDGE_TIMES, plant={"machine": {"conveyor": {
+        "interval": 0.7, "speed": speed, "pattern": "T"}}}, scan_ms=7)
+    m = plc.machine("conveyor")
+    for scans, bits in segments:
+        plc["VB0"] = bits
+        plc.scan(scans)
+    rising = [t for t, s, v in m.edges("eye_entry") if v]
+    falling = [t for t, s, v in m.edges("eye_entry") if not v]
+    assert plc["VW100"] == len(rising)
+    if rising:
+        assert plc["VW104"] == int(round(rising[-1] * 1e6)) // 1000
+    if falling:
+        assert plc["VW106"] == int(round(falling[-1] * 1e6)) // 1000

@@ -315,7 +315,8 @@ CALLS["Plc.machines"] = (lambda **k: _machine_plc().machines(**k), {})
 CALLS["Harness.machines"] = (lambda **k: Harness(_machine_plc()).machines(**k), {})
 CALLS["Machine.__init__"] = (Machine, {"device": Fresh(lambda: _machine()._dev)})
 _methods("Machine", _machine, {
-    "state": {}, "wiring": {}, "faults": {}, "fault": {"name": "jam", "on": True},
+    "state": {}, "wiring": {}, "faults": {}, "buttons": {},
+    "fault": {"name": "jam", "on": True},
     "press": {"name": "start", "seconds": 0.1}, "hold": {"name": "start"},
     "release": {"name": "start"}, "edges": {"signal": "eye_entry"}, "notes": {}})
 for _owner, _make in (("AxisState", lambda: _axis_plc().axis()),

@@ -400,6 +400,11 @@ class Machine:
         d._record(d.t)
         d.publish()
 
+    def buttons(self) -> list[str]:
+        """What a person can press or hold: buttons, key switches, world
+        conditions (the garage's ``obstacle``)."""
+        return list(self._dev.pressed)
+
     def _actor(self, name: Any) -> str:
         d = self._dev
         if not isinstance(name, str) or name not in d.pressed:

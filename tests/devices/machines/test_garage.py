@@ -70,6 +70,11 @@ def test_the_example_program_will_not_close_with_a_broken_edge_wire() -> None:
     assert m.state()["opening"] == 2400
 
 
+def test_the_buttons_include_the_obstacle() -> None:
+    _, m = manual("garage")
+    assert m.buttons() == ["button_open", "button_close", "button_stop", "key", "obstacle"]
+
+
 def test_a_jammed_door_does_not_move() -> None:
     plc, m = manual("garage", start=1000, faults=["jam"])
     outputs(plc, m, motor_close=1)

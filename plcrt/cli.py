@@ -40,7 +40,7 @@ import sys
 from typing import Any, NoReturn
 
 from . import __version__
-from .cli_commands import cmd_check, cmd_dump, cmd_run
+from .cli_commands import add_machine_args, cmd_check, cmd_dump, cmd_run
 from .errors import PlcError, PlcRuntimeError
 from .term.options import (SET_HELP, SetItem, add_long_run_args, add_program_args,
                            add_run_length_args, add_scan_ms_arg, add_set_args, apply_sets,
@@ -144,6 +144,7 @@ def _build_parser() -> _Parser:
                         "progress bar (--json still prints its object)")
     p.add_argument("--verbose", action="store_true",
                    help="also say on stderr which backend ran the program")
+    add_machine_args(p)
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("dump", help="print the generated Python with the STL lines",

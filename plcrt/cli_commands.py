@@ -71,6 +71,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         writes = parse_sets(args.set)
         watches = [_parse_watch(item) for item in args.watch]
         plc = load_for_run(args, writes, report=report)
+        apply_machine_args(plc, args)
         for spec, addr, kind in watches:
             plc.read(addr, kind)  # reject a bad address before running
     except PlcError as e:
@@ -102,6 +103,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         _print_values(program, plc, values)
         if args.plant:
             print_devices(plc)
+            _print_machines(plc)
     if fault is not None:
         print_diagnostics(fault.diagnostics)
         return EXIT_FAULT
@@ -109,6 +111,51 @@ def cmd_run(args: argparse.Namespace) -> int:
         print_diagnostics(stopped.diagnostics)
         return EXIT_WALL
     return EXIT_OK
+
+
+def add_machine_args(p: argparse.ArgumentParser) -> None:
+    """``--press``, ``--hold`` and ``--fault`` of ``plcrt run``: a person's
+    actions on the plant's machines from the start (docs/machines.md)."""
+    p.add_argument("--press", action="append", default=[], metavar="MACHINE.BUTTON",
+                   help="press a machine's button at the start for 0.3 s (conveyor.start)")
+    p.add_argument("--hold", action="append", default=[], metavar="MACHINE.BUTTON",
+                   help="hold a button, key switch or obstacle from the start (garage.key)")
+    p.add_argument("--fault", action="append", default=[], metavar="MACHINE.FAULT",
+                   help="switch a machine's fault on from the start (conveyor.jam, "
+                        "tank.stuck_on:high)")
+
+
+def apply_machine_args(plc: Plc, args: argparse.Namespace) -> None:
+    """Apply ``--fault``, ``--hold`` and ``--press`` (in that order).
+
+    Raises:
+        PlcError: a malformed item, an unknown machine, button or fault.
+    """
+    for opt in ("fault", "hold", "press"):
+        for item in getattr(args, opt, None) or ():
+            name, dot, what = str(item).partition(".")
+            if not dot or not name or not what:
+                raise PlcConfigError(f"--{opt} {printable(str(item))[:60]!r}: write "
+                                     f"MACHINE.{'FAULT' if opt == 'fault' else 'BUTTON'}")
+            getattr(plc.machine(name), opt)(what)
+
+
+def _print_machines(plc: Plc) -> None:
+    """One line per machine: what its terminals show on, its faults and notes."""
+    from .term.tables import table_lines
+    rows = []
+    for m in plc.machines():
+        s = m.state()
+        wiring = m.wiring()
+        on_in = [f"{k}={v}" if wiring[k].startswith("AIW") else k
+                 for k, v in s["inputs"].items() if v or wiring[k].startswith("AIW")]
+        on_out = [k for k, v in s["outputs"].items() if v]
+        rows.append([s["name"], s["kind"], " ".join(on_in) or "-", " ".join(on_out) or "-",
+                     " ".join(s["faults"]) or "-", str(len(m.notes()))])
+    if rows:
+        for line in table_lines(["machine", "kind", "inputs on", "outputs on", "faults",
+                                 "notes"], rows, {0, 1, 2, 3, 4}):
+            print(line)
 
 
 def cmd_dump(args: argparse.Namespace) -> int:
@@ -166,6 +213,9 @@ def _emit_json(args: argparse.Namespace, plc: Plc | None, values: dict[str, int 
         drives = plc.drives()
         if drives:
             obj["drives"] = [d.to_dict() | {"flags": d.flags} for d in drives]
+        machines = plc.machines()
+        if machines:
+            obj["machines"] = [m.state() for m in machines]
     if plc is not None:
         for key, items in (("pulse_outputs", pulse_outputs(plc)),
                            ("counters", counters_in_use(plc)), ("ports", ports_in_use(plc))):

@@ -45,14 +45,18 @@ def is_plant(x: Any) -> bool:
 
 def build_devices(plc: Any, plant: Any) -> list[Device]:
     """The devices a plant describes: its modules by slot (a table of
-    module kinds), then its processes."""
+    module kinds), then its processes, then its machines."""
     # perf: the modules' simulations are imported when a plant is built
     from .devices.cia402.coupler import FieldbusModule
     from .devices.em253.module import EM253Module
     from .devices.process import FirstOrderProcess
     kinds = {"EM253": EM253Module, "FIELDBUS": FieldbusModule}
     devices = [kinds[m.kind](plc, m) for _, m in sorted(plant.modules.items())]
-    return devices + [FirstOrderProcess(plc, p) for p in plant.processes]
+    devices += [FirstOrderProcess(plc, p) for p in plant.processes]
+    if plant.machines:
+        from .devices.machines import build
+        devices += [build(plc, m) for m in plant.machines]
+    return devices
 
 
 def attach_port_devices(ports: list[Any], plant: Any) -> None:

@@ -55,6 +55,10 @@
     [ethernet]                  # GET/PUT
     ip = "192.168.2.10"
 
+    [machine.conveyor]          # a machine (docs/machines.md, plcrt.devices.machines)
+    inputs = { eye_entry = "I1.0" }     # its signals' addresses (others: the defaults)
+    faults = ["jam"]
+
 Only this module reads the format; it returns plain dataclasses that the
 device implementations consume.  Every problem is a PlcConfigError naming
 the file and the key.
@@ -134,6 +138,8 @@ class Plant:
     ports: dict[int, PortConfig] = field(default_factory=dict)
     #: the Ethernet interface for GET/PUT ([ethernet])
     ethernet: EthernetConfig | None = None
+    #: the machines ([machine.NAME], plcrt.devices.machines)
+    machines: list[Any] = field(default_factory=list)
 
 
 def load_plant(source: str | Path | dict, file: str | None = None) -> Plant:
@@ -178,12 +184,12 @@ def _build(data: dict, file: str) -> Plant:
     modules: dict[int, ModuleConfig] = {}
     # A misspelt table ([modules.0]) would otherwise give a plant without
     # modules and only run-time warnings: reject unknown keys at every level.
-    unknown = set(data) - {"module", "cpu", "pto", "pwm", "port", "ethernet"}
+    unknown = set(data) - {"module", "cpu", "pto", "pwm", "port", "ethernet", "machine"}
     if unknown:
         raise PlcConfigError(f"{file}: unknown key(s) {_keys(unknown)} "
                              f"(a plant file has [module.N] tables, a [cpu] table, "
-                             f"[pto.N] / [pwm.N] tables, [port.N] tables and an [ethernet] "
-                             f"table)")
+                             f"[pto.N] / [pwm.N] tables, [port.N] tables, an [ethernet] "
+                             f"table and [machine.NAME] tables)")
     ports = parse_ports(data.get("port", {}), file)
     ethernet = parse_ethernet(data["ethernet"], file) if "ethernet" in data else None
     wiring, encoders = _cpu(data.get("cpu", {}), file)
@@ -229,8 +235,14 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {_keys(unknown)}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    return Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports,
-                 ethernet)
+    plant = Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports, ethernet)
+    if "machine" in data:
+        from .machines import parse as parse_machines   # perf: only for a plant with machines
+        taken = {("I", b): "cpu.wire/encoder" for b in (*wiring, *(
+            x for e in encoders for x in (e["a"], e["b"]) if x is not None))}
+        taken.update({("AIW", p["input"] // 2): "cpu.process" for p in processes})
+        plant.machines = parse_machines(data["machine"], file, taken)
+    return plant
 
 
 _BIT_RE = re.compile(r"\s*([IQ])(\d{1,2})\.([0-7])\s*", re.I)

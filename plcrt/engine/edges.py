@@ -10,7 +10,11 @@ edge runs the routine at its own µs:
 * a PTO pulse rises at the train's pulse times and falls half a cycle later
   (50 % duty, the first half high; :mod:`plcrt.engine.pulse`);
 * an encoder's A signal rises at start + k/hz and falls half a period later;
-  B lags A by a quarter period (leads it when the direction is down).
+  B lags A by a quarter period (leads it when the direction is down);
+* a device that lists the input in ``edge_bits`` (a machine's sensor or
+  button, :mod:`plcrt.devices.machines`) answers ``input_edge_after(bit,
+  after, rising)`` itself; its edges move with the program's outputs, so
+  the source is then asked again at every instant (not cacheable).
 
 What it is not: inputs that change only between scans (``--set``, the
 harness, ordinary outputs wired to inputs) have their edges at the scan
@@ -39,6 +43,8 @@ class SignalEdges:
 
     def __init__(self, plc: Any) -> None:
         self.plc = plc
+        #: False while a device drives an attached input (see the module docstring)
+        self.cacheable = True
         self.last: Optional[int] = None           #: the time of the last edge fired
         self._version = -1                        #: the interrupts' version _inputs is for
         self._inputs: list[tuple[int, int, int, Any, int]] = []
@@ -70,6 +76,10 @@ class SignalEdges:
                     out.append((bit, rise, fall, enc, 0))
                 elif enc.b == bit:
                     out.append((bit, rise, fall, enc, 1 if enc.direction > 0 else 3))
+            for dev in plc.devices:
+                if bit in getattr(dev, "edge_bits", ()):
+                    out.append((bit, rise, fall, dev, bit))    # the phase slot holds the bit
+        self.cacheable = not any(hasattr(src, "input_edge_after") for *_, src, _p in out)
         return out
 
     def live(self) -> bool:
@@ -89,6 +99,8 @@ class SignalEdges:
 
     @staticmethod
     def _edge(src: Any, phase: int, after: int, rising: bool) -> Optional[int]:
+        if hasattr(src, "input_edge_after"):      # a device's input (phase: the bit)
+            return src.input_edge_after(phase, after, rising)
         if hasattr(src, "hz"):                    # an encoder
             if src.stop is not None and after >= src.stop:
                 return None

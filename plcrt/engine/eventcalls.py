@@ -99,7 +99,8 @@ class EventCalls:
 
     def _irq_attach(self, number: int, event: int) -> None:
         self.interrupts.attach(number, event, self._irq_t)
-        if event in (21, 22) or (event < 8 and (self.wiring or self.encoders)):
+        if event in (21, 22) or (event < 8 and (self.wiring or self.encoders
+                                                 or self._edge_mask != 0x0F)):
             self._sources_on = True
         self.scheduler.touch()
         self._replain()   # a timed interrupt

@@ -222,6 +222,11 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
         if plant is not None:
             self.devices = parts.build_devices(self, plant)
             self.modules = {d.slot: d for d in self.devices if d.slot is not None}
+            # I0.0–I0.3 a device drives at exact times (a machine's sensors): their
+            # edges come from the time line too (engine/edges.py)
+            for d in self.devices:
+                for b in getattr(d, "edge_bits", ()):
+                    self._edge_mask &= ~(1 << b)
         with gc_paused():
             self._adopt(_entry, auto_diags)
         a = self.mem.areas
@@ -333,6 +338,21 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
             raise PlcAddressError(f"node {node} is on several fieldbus modules (slots "
                                   f"{', '.join(str(d.slot) for d in found)}): name the slot")
         return found[0]
+
+    def machine(self, name: str) -> Any:
+        """The machine *name* of the plant (``[machine.NAME]``), a
+        :class:`plcrt.devices.machines.Machine`: ``state()``, ``fault()``,
+        ``press()`` ... (docs/machines.md)."""
+        found = {m.name: m for m in self.machines()}
+        if not isinstance(name, str) or name not in found:
+            raise PlcAddressError(f"no machine {shown_value(name)} in the plant (its machines: "
+                                  f"{', '.join(found) or 'none'})")
+        return found[name]
+
+    def machines(self) -> list[Any]:
+        """Every machine of the plant, in the plant file's order (see :meth:`machine`)."""
+        # the machines are the devices that hand out a view (plcrt.devices.machines)
+        return [d.view() for d in self.devices if hasattr(d, "view")]
 
     def request_stop(self) -> None:
         """STOP instruction: finish this scan, then go to STOP mode."""

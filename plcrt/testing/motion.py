@@ -45,6 +45,15 @@ class Motion:
         """The simulated module in expansion slot ``slot``, or None."""
         return self.plc.module(slot)
 
+    def machine(self, name: str) -> Any:
+        """The plant's machine *name* (``[machine.NAME]``): ``state()``,
+        ``fault("jam")``, ``press("call_2")`` ..., as :meth:`Plc.machine`."""
+        return self.plc.machine(name)
+
+    def machines(self) -> list[Any]:
+        """Every machine of the plant."""
+        return self.plc.machines()
+
     def drive(self, node: int, slot: int | None = None) -> DriveState:
         """State of the bus drive at *node* (needs a plant with a FIELDBUS
         module): ``d.position``, ``d.statusword``, ``d.state``, ``d.flags``,

@@ -46,6 +46,7 @@ import plcrt.trace
 from plcrt import PlcError
 from plcrt.devices import DriveState
 from plcrt.devices.cia402.canopen_node import CanopenDrive
+from plcrt.devices.machines import Machine
 from plcrt.engine.runtime import parse_sources
 from plcrt.engine.values import LOAD_OPTIONS, MAX_STEPS
 from plcrt.testing import Harness
@@ -177,6 +178,15 @@ def _marker(**kw: Any) -> Any:
 # ---------------------------------------------------------------------------
 
 Call = Callable[..., Any]
+def _machine_plc() -> plcrt.Plc:
+    return plcrt.load(ROOT / "examples" / "machines" / "conveyor.awl",
+                      plant={"machine": {"conveyor": {}}})
+
+
+def _machine() -> Machine:
+    return _machine_plc().machine("conveyor")
+
+
 _OUT = Path(tempfile.mkdtemp(prefix="plcrt-fuzz-"))
 
 
@@ -297,6 +307,18 @@ _methods("Harness", _h, {
 _methods("Trace", _trace, {
     "array": {"name": "Q0.0"}, "attach": {}, "changes": {"name": "Q0.0"}, "detach": {},
     "kind": {"name": "Q0.0"}, "last": {}, "table": {}, "to_csv": {"path_or_file": _OUT / "t.csv"}})
+# a PLC with a machine: plc.machine(), the harness's, the Machine handed out
+CALLS["Plc.machine"] = (lambda **k: _machine_plc().machine(**k), {"name": "conveyor"})
+CALLS["Harness.machine"] = (lambda **k: Harness(_machine_plc()).machine(**k),
+                            {"name": "conveyor"})
+CALLS["Plc.machines"] = (lambda **k: _machine_plc().machines(**k), {})
+CALLS["Harness.machines"] = (lambda **k: Harness(_machine_plc()).machines(**k), {})
+CALLS["Machine.__init__"] = (Machine, {"device": Fresh(lambda: _machine()._dev)})
+_methods("Machine", _machine, {
+    "state": {}, "wiring": {}, "faults": {}, "buttons": {},
+    "fault": {"name": "jam", "on": True},
+    "press": {"name": "start", "seconds": 0.1}, "hold": {"name": "start"},
+    "release": {"name": "start"}, "edges": {"signal": "eye_entry"}, "notes": {}})
 for _owner, _make in (("AxisState", lambda: _axis_plc().axis()),
                       ("DriveState", lambda: _bus_plc().drive(1))):
     _methods(_owner, _make, {"get": {"key": "speed"}, "items": {}, "keys": {}, "to_dict": {},
@@ -321,7 +343,7 @@ _KIND_OF: dict[tuple[str, str], st.SearchStrategy[Any]] = {
 
 PUBLIC_MODULES = (plcrt, plcrt.testing, plcrt.trace, plcrt.cia402)
 #: classes the public functions hand out, not exported by name
-HANDED_OUT = (CanopenDrive, DriveState)
+HANDED_OUT = (CanopenDrive, DriveState, Machine)
 #: exported names that are not entry points: errors and plain records of a
 #: location or a finding, with nothing to check
 NOT_ENTRIES = {"Diagnostic", "SourceLoc", "PlcError", "PlcSyntaxError", "PlcCompileError",

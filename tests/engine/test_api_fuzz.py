@@ -265,6 +265,7 @@ CALLS: dict[str, tuple[Call, dict[str, Any]]] = {
     "plcrt.cia402.attach": (lambda **k: _with_network(
         lambda net: plcrt.cia402.attach(**{"network": net, **k}).close()),
         {"node_id": 5, "clock": "manual"}),
+    "plcrt.cia402.bus": (lambda **k: plcrt.cia402.bus(**k).disconnect(), {"channel": "fuzz"}),
     "plcrt.cia402.eds_text": (plcrt.cia402.eds_text, {}),
     "plcrt.cia402.models": (plcrt.cia402.models, {}),
     "plcrt.cia402.object_dictionary": (plcrt.cia402.object_dictionary, {}),

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from . import probes  # noqa: F401 - registers the probes' lowerings
+from .fn import DECLARE
 from .lower import Fn, NotLowered, lower_piece
 
 __all__ = ["NativePlan", "NotLowered", "plan_pou"]
@@ -49,7 +50,7 @@ class NativePlan:
 
     @property
     def ir(self) -> str:
-        return "".join(self.functions)
+        return DECLARE + "".join(self.functions)
 
 
 def plan_pou(plan: NativePlan, block: str, flow: bool,

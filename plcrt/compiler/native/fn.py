@@ -32,6 +32,12 @@ AREAS = {"I", "Q", "M", "V", "SM", "S", "T", "C", "AC", "AI", "AQ"}
 PART_LINES = 2000
 
 
+#: what every module declares: the byte swaps of 2- and 4-byte values (the
+#: image is big-endian, see :func:`.values.rd`)
+DECLARE = ("declare i16 @llvm.bswap.i16(i16)\n"
+           "declare i32 @llvm.bswap.i32(i32)\n")
+
+
 class NotLowered(Exception):
     """The piece cannot run natively (the reason is reported by ``plcrt dump``)."""
 
@@ -59,6 +65,21 @@ class Fn:
         name = self.t()
         self.body.append(f"  {name} = {text}")
         return name
+
+    def select(self, cond: str, ty: str, a: str, b: str) -> str:
+        """``cond ? a : b`` of type ``ty``.
+
+        perf: an ``i1`` or ``i8`` select is made in ``i32``: without
+        optimisation LLVM's x86 code generator turns a narrow select into
+        a branch, and every value alive across that branch goes to the
+        stack (about twice the machine code of the whole statement); a
+        32-bit select is one conditional move.
+        """
+        if ty not in ("i1", "i8"):
+            return self.op(f"select i1 {cond}, {ty} {a}, {ty} {b}")
+        wa = self.op(f"zext {ty} {a} to i32")
+        wb = self.op(f"zext {ty} {b} to i32")
+        return self.op(f"trunc i32 {self.op(f'select i1 {cond}, i32 {wa}, i32 {wb}')} to {ty}")
 
     def stmt(self, text: str) -> None:
         self.body.append(f"  {text}")
@@ -139,4 +160,4 @@ def _function(name: str, linkage: str, body: list[str], slots: set[str]) -> str:
     return "\n".join(head + body + ["  ret void", "}", ""])
 
 
-__all__ = ["AREAS", "PART_LINES", "SLOT", "SLOTS", "Fn", "NotLowered"]
+__all__ = ["AREAS", "DECLARE", "PART_LINES", "SLOT", "SLOTS", "Fn", "NotLowered"]

@@ -33,7 +33,7 @@ from ...gen.exprs import VALUE_WIDTH, const_expr
 from ...gen.operands import Addr, Const
 from ...memory.hardware import MAX_CV, resolution_ms
 from .fn import PART_LINES, SLOT, SLOTS, Fn, NotLowered
-from .values import WIDE, get_bit, native_area, put_bit, rbit, rd, set_sm1, wbit, wr, zn_bits
+from .values import WIDE, copy, get_bit, native_area, put_bit, rbit, rd, set_sm1, wbit, wr, zn_bits
 
 
 # -- the table -------------------------------------------------------------------
@@ -205,8 +205,11 @@ for _p in ("LD", "A", "O"):
 
 
 def _move(kind: str) -> Lowering:
+    width = VALUE_WIDTH[kind[0]]
+
     def lower(f: Fn, src: Any, dst: Any) -> None:
-        wr(f, dst, kind, rd(f, src, kind), f.top)
+        if not copy(f, src, dst, width, f.top):
+            wr(f, dst, kind, rd(f, src, kind), f.top)
     return lower
 
 

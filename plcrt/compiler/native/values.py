@@ -119,6 +119,21 @@ def wr(f: Fn, op: Any, kind: str, v: str, cond: str | None) -> None:
     f.stmt(f"store {it} {v}, ptr {where}, align 1")
 
 
+def copy(f: Fn, src: Any, dst: Any, width: int, cond: str) -> bool:
+    """Copy a value of ``width`` bytes from memory ``src`` to ``dst`` where
+    ``cond`` holds, without swapping its bytes twice (perf: a move is a
+    third of a mixed program's statements).  False when ``src`` is not in
+    memory (a constant, a pointer): the caller reads it as a value."""
+    if not isinstance(src, Addr):
+        return False
+    it = _INT[width]
+    v = f.op(f"load {it}, ptr {f.at(*place(src, width))}, align 1")
+    where = f.at(*place(dst, width))
+    old = f.op(f"load {it}, ptr {where}, align 1")
+    f.stmt(f"store {it} {f.select(cond, it, v, old)}, ptr {where}, align 1")
+    return True
+
+
 def _swapped(f: Fn, it: str, width: int, v: str) -> str:
     """``v`` byte-swapped (a constant is swapped here, not in the code)."""
     if v.lstrip("-").isdigit():
@@ -146,5 +161,5 @@ def zn_bits(f: Fn, ty: str, r: str, signed: bool = True) -> str:
     return f.op(f"or i8 {z}, {f.op(f'shl i8 {n}, 2')}")
 
 
-__all__ = ["WIDE", "get_bit", "native_area", "place", "put_bit", "rbit", "rd", "set_sm1", "wbit", "wr",
+__all__ = ["WIDE", "copy", "get_bit", "native_area", "place", "put_bit", "rbit", "rd", "set_sm1", "wbit", "wr",
            "zn_bits"]

@@ -184,7 +184,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                     fnames.append(f"_nw{seg}")
         else:
             # consecutive Python pieces share one function; a native piece
-            # keeps its own, uncalled function for plcrt dump
+            # keeps its own function for plcrt dump, as comments
             assert calls is not None
             group: list[Any] = []
             prev: int | None = None

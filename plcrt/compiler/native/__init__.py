@@ -9,7 +9,10 @@ runner.  An instrumented program's probes (coverage, breakpoints) are
 lowered too (:mod:`.probes`).  Everything else -- a piece with a call, a
 jump, a label or a loop, an instruction outside the table, an L-memory
 operand -- runs as the Python backend's code, which is generated for every
-piece in either case (``plcrt dump`` shows it).  Both backends give the
+piece in either case (``plcrt dump`` shows it; a piece that runs natively
+has it as comments, never compiled).  The IR is written as LLVM modules of
+about :data:`MODULE_CHARS` characters, compressed as each is full; :mod:`.jit`
+compiles them one at a time.  Both backends give the
 same memory image and the same coverage after every scan: the differential
 tests compare them.
 

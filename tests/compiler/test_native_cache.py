@@ -98,14 +98,16 @@ def test_the_limit_comes_from_the_environment(cache, monkeypatch) -> None:
     assert diskcache.load(key) is None and not list(cache.glob("*.native"))
 
 
-def test_a_writers_leftover_is_removed_only_when_stale(cache) -> None:
+def test_a_writers_leftover_is_removed_only_when_stale_and_old_files_go(cache) -> None:
     cache.mkdir(parents=True)
     old, new = cache / "abc.1.2.xyz.tmp", cache / "abd.1.3.xyz.tmp"
     old.write_bytes(b"half")
     new.write_bytes(b"half")
     os.utime(old, (time.time() - 2 * diskcache.STALE_TMP_S,) * 2)
+    legacy = cache / ("ab" * 20 + ".o")             # an older plcrt's entry
+    legacy.write_bytes(b"plcrt-native-1\n")
     diskcache.trim()
-    assert not old.exists() and new.exists()
+    assert not old.exists() and new.exists() and not legacy.exists()
 
 
 def test_a_cache_that_cannot_be_written_keeps_nothing_and_fails_nothing(tmp_path, monkeypatch):

@@ -46,6 +46,8 @@ DEFAULT_LIMIT_MB = 256
 _MAGIC = b"plcrt-native-2\n"
 _SUFFIX = ".native"
 _TMP = ".tmp"
+#: the files of an older plcrt (one object per file), which nothing reads now
+_LEGACY = ".o"
 #: the most objects one file may list (a program's modules are far fewer)
 MAX_OBJECTS = 1 << 16
 #: a temporary file older than this is a writer's leftover (killed mid-write)
@@ -172,8 +174,8 @@ def store(key: str, objects: list[bytes]) -> bool:
 def trim(limit: int | None = None, keep: Path | None = None) -> int:
     """Delete the least recently used files until the folder holds at most
     ``limit`` bytes (:func:`limit_bytes` by default), never ``keep`` (the
-    file just written), and writers' leftovers older than
-    :data:`STALE_TMP_S`.  Returns the bytes left.  Another process may
+    file just written), writers' leftovers older than :data:`STALE_TMP_S`
+    and an older plcrt's files (``*.o``).  Returns the bytes left.  Another process may
     trim at the same time: a file already gone is skipped."""
     if limit is None:
         limit = limit_bytes()
@@ -189,6 +191,9 @@ def trim(limit: int | None = None, keep: Path | None = None) -> int:
                 if e.name.endswith(_TMP):
                     if now - st.st_mtime > STALE_TMP_S:
                         _unlink(e.path)
+                    continue
+                if e.name.endswith(_LEGACY):      # an older plcrt's format: never read
+                    _unlink(e.path)
                     continue
                 if e.name.endswith(_SUFFIX) and e.is_file(follow_symlinks=False):
                     entries.append((st.st_mtime, e.path, st.st_size))

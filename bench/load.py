@@ -29,9 +29,13 @@ Run ``python bench/load.py`` (``--json`` for one JSON document).  It
    environments (``--cache``, as for ``bench/peers.py``); without them
    this part is skipped with a message.
 
-``--backends python,native`` measures instead, per backend, the first load
-(a fresh process and an empty disk cache) and the cached load (a fresh
-process, the machine code on disk) with the RSS growth of each.
+``--backends python,native,auto`` measures instead, per backend, the first
+load (a fresh process and an empty disk cache) and the cached load (a
+fresh process, the machine code on disk) with the RSS growth of each (all
+of it, and the private part: without the pages of the llvmlite library's
+code, which every process maps from one file), the scan cost in CPU
+nanoseconds per statement, the machine code's size, and for ``auto`` the
+growth once the background native build has been switched in.
 
 ``--plcrt DIR`` measures the plcrt package found in DIR instead (another
 checkout: the figures before a change, side by side in the same run with
@@ -68,10 +72,11 @@ TINY = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD     I0.0\n=      Q0.0\
 
 
 def _status() -> dict[str, int]:
-    """VmRSS and VmHWM of this process in KiB."""
+    """VmRSS, VmHWM, RssAnon (private) and RssFile (mapped files: the
+    llvmlite library's code) of this process in KiB."""
     out = {}
     for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith(("VmRSS:", "VmHWM:")):
+        if line.startswith(("VmRSS:", "VmHWM:", "RssAnon:", "RssFile:")):
             out[line.split(":")[0]] = int(line.split()[1])
     return out
 
@@ -116,8 +121,10 @@ def child(path: str, mode: str) -> dict[str, Any]:
     with (contextlib.nullcontext() if mode == "gc-on" else pause()):
         program = parse_sources(text)
     t1 = time.perf_counter()
+    c1 = time.process_time()
     plc = Plc(program, scan_ms=1, **kw)
     t2 = time.perf_counter()
+    c2 = time.process_time()
     if mode == "trace":
         now, peak = tracemalloc.get_traced_memory()
         out.update(traced_live_mib=(now - base) / 2**20, traced_peak_mib=(peak - base) / 2**20)
@@ -127,13 +134,49 @@ def child(path: str, mode: str) -> dict[str, Any]:
     t3 = time.perf_counter()
     plc.fork()
     t4 = time.perf_counter()
-    if backend:
-        out["backend"] = plc.backend["name"]
-        out["native_cached"] = bool(plc.backend.get("cached"))
     out.update(insns=program.instruction_count(), parse_s=t1 - t0, compile_s=t2 - t1,
-               load_s=t2 - t0, fork_s=t4 - t3,
+               load_s=t2 - t0, compile_cpu_s=c2 - c1, fork_s=t4 - t3,
                rss_growth_mib=(after["VmRSS"] - before["VmRSS"]) / 1024,
+               anon_growth_mib=(after.get("RssAnon", 0) - before.get("RssAnon", 0)) / 1024,
                rss_peak_mib=after["VmHWM"] / 1024)
+    if backend:
+        out.update(_backend_figures(plc, before, out["insns"]))
+    return out
+
+
+def _backend_figures(plc: Any, before: dict[str, int], insns: int) -> dict[str, Any]:
+    """A named backend's row: for ``auto``, the native build compiled and
+    switched in (``_tier_up``, what a long run reaches after its first
+    scans) and the RSS growth then; the scan cost in nanoseconds per
+    statement (CPU time: the machine may be loaded), best of 5 runs."""
+    import gc
+    out: dict[str, Any] = {}
+    if plc.backend.get("tiered"):
+        t0, c0 = time.perf_counter(), time.process_time()
+        plc._tier_up()
+        out["native_build_s"] = time.perf_counter() - t0
+        out["native_build_cpu_s"] = time.process_time() - c0
+        plc.scan(2)
+        gc.collect()
+        now = _status()
+        out.update(switched_rss_growth_mib=(now["VmRSS"] - before["VmRSS"]) / 1024,
+                   switched_anon_growth_mib=(now.get("RssAnon", 0)
+                                             - before.get("RssAnon", 0)) / 1024)
+    out["backend"] = plc.backend["name"]
+    out["native_cached"] = bool(plc.backend.get("cached"))
+    code = getattr(plc.compiled.native, "code_bytes", None) if out["backend"] == "native" \
+        else None
+    if code is not None:
+        out["code_mib"] = code / 2**20
+    scans = max(10, int(2e7 // max(insns, 1)) if out["backend"] == "native"
+                else int(2e6 // max(insns, 1)))
+    plc.scan(3)
+    best = float("inf")
+    for _ in range(5):
+        c0 = time.process_time()
+        plc.scan(scans)
+        best = min(best, (time.process_time() - c0) / scans)
+    out["ns_per_statement"] = best / max(insns, 1) * 1e9
     return out
 
 
@@ -368,8 +411,15 @@ def _backend_line(row: dict[str, Any]) -> str:
         if "error" in f or "error" in c:
             parts.append(f"{backend}: error {f.get('error') or c.get('error')}")
             continue
-        parts.append(f"{backend}: first {f['load_s']:.2f} s RSS +{f['rss_growth_mib']:.0f} MiB, "
-                     f"cached {c['load_s']:.2f} s RSS +{c['rss_growth_mib']:.0f} MiB")
+        switched = (f", native after {f['native_build_s']:.1f} s: RSS "
+                    f"+{f['switched_rss_growth_mib']:.0f} MiB "
+                    f"(private +{f['switched_anon_growth_mib']:.0f})"
+                    if "native_build_s" in f else "")
+        parts.append(f"{backend}: first {f['load_s']:.2f} s "
+                     f"(compile CPU {f['compile_cpu_s']:.2f} s) RSS +{f['rss_growth_mib']:.0f} MiB "
+                     f"(private +{f['anon_growth_mib']:.0f}){switched}, "
+                     f"cached {c['load_s']:.2f} s RSS +{c['rss_growth_mib']:.0f} MiB, "
+                     f"{c['ns_per_statement']:.2f} ns/statement")
     return f"{row['shape']:5} {row['size']:>6} seed {row['seed']}: " + "; ".join(parts)
 
 

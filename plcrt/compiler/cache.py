@@ -243,6 +243,18 @@ class ProgramCache:
             while len(self._entries) > self.max_entries:
                 self._entries.popitem(last=False)
 
+    def drop(self, entry: Any) -> bool:
+        """Forget ``entry`` (the compiled program itself, whatever its key):
+        the Python build of a program whose native build has taken over
+        (:mod:`plcrt.engine.tiering`), so that its memory goes with the
+        last PLC running it.  True when it was kept."""
+        with self._lock:
+            for key, value in self._entries.items():
+                if value is entry:
+                    del self._entries[key]
+                    return True
+        return False
+
     def clear(self) -> None:
         """Forget every compiled program (the next load compiles)."""
         with self._lock:

@@ -93,21 +93,25 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
         resolver = Resolver(unit.model, unit.symbols, unit.system_symbols, info.local_vars,
                             codepage)
 
-        def emit_def(name: str, parts: list[tuple[str, list[str], list[str], list]]) -> None:
-            """One function holding the bodies of ``parts`` in order."""
+        def emit_def(name: str, parts: list[tuple[str, list[str], list[str], list]],
+                     shown: bool = False) -> None:
+            """One function holding the bodies of ``parts`` in order (only
+            shown, as comments, for a piece that runs as machine code)."""
             used = sorted({n for part in parts for n in part[1]})
             maybe_cut()
-            out.append(f"def {name}({', '.join(['L'] + [f'{n}={n}' for n in used])}):")
+            mark = "# " if shown else ""   # perf: no code object for a native piece
+            out.append(f"{mark}def {name}({', '.join(['L'] + [f'{n}={n}' for n in used])}):")
             for _f, _u, body, line_map in parts:
                 base = line0 + len(out)
-                out.extend(body)
+                out.extend([mark + ln.replace("\n", "\n" + mark) for ln in body] if shown
+                           else body)
                 for rel, insn_id, indent in line_map:
                     assert insn_id == len(line_locs.starts)   # ids follow the text
                     line_locs.add(base + 1 + rel, indent)
             if all(not part[2] for part in parts):
                 # only instructions without code (LBL, SCRE, NOP ...): a
                 # def needs at least one statement
-                out.append("    pass")
+                out.append(f"{mark}    pass")
             out.append("")
 
         records: list[tuple[str, list[str], list[str], list[tuple[int, int, int]]]] = []
@@ -180,7 +184,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                     fnames.append(f"_nw{seg}")
         else:
             # consecutive Python pieces share one function; a native piece
-            # keeps its own, uncalled function for plcrt dump
+            # keeps its own function for plcrt dump, as comments
             assert calls is not None
             group: list[Any] = []
             prev: int | None = None
@@ -190,7 +194,7 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
                     if group:
                         emit_group(group)
                         group = []
-                    emit_def(rec[0], [rec])
+                    emit_def(rec[0], [rec], shown=True)
                     if seg != prev:
                         calls.append(f"_nseg{seg}()")
                 else:

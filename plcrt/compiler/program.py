@@ -56,8 +56,8 @@ class CompiledProgram:
     source: bytes                       #: the generated module, zlib-compressed
     line_locs: dict[int, Any]
     codes: tuple[types.CodeType, ...]
-    #: the native segments' LLVM IR (zlib-compressed), or None
-    native_ir: bytes | None = None
+    #: the native segments' LLVM modules (IR text, each zlib-compressed), or None
+    native_ir: tuple[bytes, ...] | None = None
     #: the machine code of the native segments (made again after unpickling)
     _native: Any = field(default=None, repr=False)
 
@@ -77,8 +77,8 @@ class CompiledProgram:
         """The machine code of the native segments, or None (compiled at
         first use after unpickling; the disk cache makes that cheap)."""
         if self._native is None and self.native_ir is not None:
-            object.__setattr__(self, "_native", _native_code(
-                zlib.decompress(self.native_ir).decode("utf-8"), self.unit.native.names))
+            object.__setattr__(self, "_native", _native_code(self.native_ir,
+                                                             self.unit.native.names))
         return self._native
 
     def __getstate__(self) -> dict[str, Any]:
@@ -134,10 +134,9 @@ def compile_to_program(program: ir.Program, model: CpuModel, options: Mapping[st
     native = native_ir = None
     plan = unit.native
     if plan is not None and plan.names:
-        text = plan.ir
-        native = _native_code(text, plan.names)
-        native_ir = zlib.compress(text.encode("utf-8"), 1)
-        plan.functions = []      # the IR text is compiled (and cached on disk)
+        plan.finish()
+        native_ir, plan.modules = tuple(plan.modules), []
+        native = _native_code(native_ir, plan.names)
     return CompiledProgram(program, dict(options), unit, packed, line_locs, tuple(codes),
                            native_ir, native)
 
@@ -164,11 +163,11 @@ def _as_data(bindings: dict[str, Any], constants: set[str]) -> dict[str, Any]:
     return table
 
 
-def _native_code(text: str, names: list[str]) -> Any:
+def _native_code(modules: tuple[bytes, ...], names: list[str]) -> Any:
     # perf: llvmlite is imported for the native backend only
     from .native.jit import NativeCode
     try:
-        return NativeCode(text, names)
+        return NativeCode(modules, names)
     except Exception as e:  # a plcrt bug or a broken llvmlite, never the user's
         raise PlcConfigError(f"internal error: the native backend cannot compile "
                              f"this program ({type(e).__name__}: {str(e)[:200]}); "

@@ -32,6 +32,8 @@ import weakref
 from concurrent.futures import Future
 from typing import Any, Callable
 
+from ..compiler.cache import programs
+
 __all__ = ["Tiering", "START_AFTER_S"]
 
 #: the least wall time a PLC scans in Python before its native build starts
@@ -177,4 +179,8 @@ class Tiering:
                          "running on the Python backend", type(e).__name__)
             return
         if native is not None:       # None: LLVM does not work here (said once)
+            python = self._entry
             self._rebind(native)
+            # the next load of this program finds the native build first:
+            # the Python one is kept only by the PLCs still running it
+            programs.drop(python)

@@ -237,7 +237,7 @@ def test_machine_code_is_cached_on_disk_and_a_bad_file_is_compiled_again(
     program_cache.clear()
     first = plcrt.load(text, backend="native")
     assert first.backend["cached"] is False
-    files = list((tmp_path / "native").glob("*.o"))
+    files = list((tmp_path / "native").glob("*.native"))
     assert len(files) == 1
     program_cache.clear()
     second = plcrt.load(text, backend="native")

@@ -144,6 +144,26 @@ def test_snapshot_fork_and_pickle_across_the_switch() -> None:
     assert pickle.loads(pickle.dumps(auto.compiled)).native is not None
 
 
+def test_the_python_build_leaves_the_cache_when_the_native_one_takes_over() -> None:
+    """After the switch the program cache holds the native build only (the
+    Python build's memory goes with the last PLC on it): a PLC still on
+    it runs on, and the next auto load is native at once."""
+    auto = plcrt.load(TIMERS, backend="auto")
+    sibling = plcrt.load(TIMERS, backend="auto")       # the same Python build
+    python = auto.compiled
+    assert sibling.compiled is python and python in programs._entries.values()
+    auto._tier_up()
+    assert auto.backend["name"] == "native"
+    assert python not in programs._entries.values()
+    assert auto.compiled in programs._entries.values()
+    assert plcrt.load(TIMERS, backend="auto").backend["name"] == "native"
+    ref = plcrt.load(TIMERS, backend="python")
+    for plc in (sibling, ref):
+        plc["I0.0"] = 1
+        plc.scan(30)
+    assert _image(sibling) == _image(ref)
+
+
 def test_python_and_native_keep_their_meaning() -> None:
     """python never switches, native is native from the first scan, and
     auto with the native build already made uses it at once."""

@@ -11,6 +11,8 @@ writing operands :mod:`.values`'.
 
 from __future__ import annotations
 
+from typing import Callable
+
 from ...gen.limits import MAX_STACK
 
 #: the buffers a segment can reach, in the order of the context table
@@ -32,6 +34,12 @@ AREAS = {"I", "Q", "M", "V", "SM", "S", "T", "C", "AC", "AI", "AQ"}
 PART_LINES = 2000
 
 
+#: what every module declares: the byte swaps of 2- and 4-byte values (the
+#: image is big-endian, see :func:`.values.rd`)
+DECLARE = ("declare i16 @llvm.bswap.i16(i16)\n"
+           "declare i32 @llvm.bswap.i32(i32)\n")
+
+
 class NotLowered(Exception):
     """The piece cannot run natively (the reason is reported by ``plcrt dump``)."""
 
@@ -40,13 +48,19 @@ class Fn:
     """One LLVM function under construction: SSA names, the logic stack as a
     list of ``i1`` values, and the buffer pointers it loads at its entry."""
 
-    def __init__(self) -> None:
+    def __init__(self, sink: Callable[[list[str], set[str]], str] | None = None) -> None:
         self.body: list[str] = []
         self.stack: list[str] = []
         self.slots: set[str] = set()
         self._n = 0
-        #: finished parts (body, slots): see :data:`PART_LINES`
-        self.parts: list[tuple[list[str], set[str]]] = []
+        #: the names of the finished parts (see :data:`PART_LINES`)
+        self.parts: list[str] = []
+        #: where a finished part goes: ``sink(body, slots)`` names it, writes
+        #: its function and returns the name (a program's module stream,
+        #: :meth:`plcrt.compiler.native.NativePlan.part`); without one,
+        #: :meth:`emit` returns the parts (``part0``, ...) with the function
+        self.sink = sink
+        self._texts: list[str] = []
         self.site = -1    #: the instruction's EU/ED edge memory byte
 
     # -- SSA -------------------------------------------------------------
@@ -59,6 +73,21 @@ class Fn:
         name = self.t()
         self.body.append(f"  {name} = {text}")
         return name
+
+    def select(self, cond: str, ty: str, a: str, b: str) -> str:
+        """``cond ? a : b`` of type ``ty``.
+
+        perf: an ``i1`` or ``i8`` select is made in ``i32``: without
+        optimisation LLVM's x86 code generator turns a narrow select into
+        a branch, and every value alive across that branch goes to the
+        stack (about twice the machine code of the whole statement); a
+        32-bit select is one conditional move.
+        """
+        if ty not in ("i1", "i8"):
+            return self.op(f"select i1 {cond}, {ty} {a}, {ty} {b}")
+        wa = self.op(f"zext {ty} {a} to i32")
+        wb = self.op(f"zext {ty} {b} to i32")
+        return self.op(f"trunc i32 {self.op(f'select i1 {cond}, i32 {wa}, i32 {wb}')} to {ty}")
 
     def stmt(self, text: str) -> None:
         self.body.append(f"  {text}")
@@ -112,26 +141,39 @@ class Fn:
         self.stmt(f"store i8 {v}, ptr {self.at(slot, off)}, align 1")
 
     def split(self) -> None:
-        """Close the current part once it is long enough (between pieces)."""
+        """Close the current part once it is long enough (between pieces):
+        its text goes to the sink at once, so a long segment's lines are
+        never all held."""
         if len(self.body) >= PART_LINES:
-            self.parts.append((self.body, self.slots))
-            self.body, self.slots = [], set()
+            self._part()
+
+    def _part(self) -> None:
+        body, slots = self.body, self.slots
+        self.body, self.slots = [], set()
+        if self.sink is not None:
+            self.parts.append(self.sink(body, slots))
+            return
+        name = f"part{len(self.parts)}"
+        self.parts.append(name)
+        self._texts.append(function(name, body, slots))
 
     def emit(self, name: str) -> str:
-        """The text of function ``name`` (and of its parts, if it has any)."""
-        parts = self.parts + [(self.body, self.slots)]
-        if len(parts) == 1:
-            return _function(name, "", *parts[0])
-        out = [_function(f"{name}_{i}", "internal ", body, slots)
-               for i, (body, slots) in enumerate(parts)]
-        calls = [f"  call void @{name}_{i}(ptr %ctx)" for i in range(len(parts))]
-        out.append("\n".join([f"define void @{name}(ptr %ctx) {{", "entry:", *calls,
-                              "  ret void", "}", ""]))
-        return "".join(out)
+        """The text of function ``name``: the segment's code, or, when it
+        was split, calls of its parts in turn (whose texts went to the
+        sink, or come first in the returned text without one)."""
+        if not self.parts:
+            return function(name, self.body, self.slots)
+        self._part()
+        calls = [f"  call void @{part}(ptr %ctx)" for part in self.parts]
+        texts, self._texts = self._texts, []
+        return "".join(texts) + "\n".join([f"define void @{name}(ptr %ctx) {{", "entry:",
+                                             *calls, "  ret void", "}", ""])
 
 
-def _function(name: str, linkage: str, body: list[str], slots: set[str]) -> str:
-    head = [f"define {linkage}void @{name}(ptr %ctx) noinline {{", "entry:"]
+def function(name: str, body: list[str], slots: set[str]) -> str:
+    """The text of function ``name`` with ``body``, loading the buffer
+    pointers of ``slots`` from the context table at its entry."""
+    head = [f"define void @{name}(ptr %ctx) noinline {{", "entry:"]
     for slot in sorted(slots, key=SLOT.__getitem__):
         k = SLOT[slot]
         head.append(f"  %c{k} = getelementptr ptr, ptr %ctx, i64 {k}")
@@ -139,4 +181,4 @@ def _function(name: str, linkage: str, body: list[str], slots: set[str]) -> str:
     return "\n".join(head + body + ["  ret void", "}", ""])
 
 
-__all__ = ["AREAS", "PART_LINES", "SLOT", "SLOTS", "Fn", "NotLowered"]
+__all__ = ["AREAS", "DECLARE", "PART_LINES", "SLOT", "SLOTS", "Fn", "NotLowered", "function"]

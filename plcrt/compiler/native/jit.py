@@ -1,16 +1,14 @@
 """Compile lowered segments to machine code with llvmlite, cached on disk.
 
-This is the only module that imports llvmlite (the ``native`` extra).  A
-:class:`NativeCode` holds one compiled module (every segment of a program)
-and is shared by every PLC built from the same cache entry; each PLC gets
-its own context table of buffer addresses from :meth:`NativeCode.bind`.
+This is the only module that imports llvmlite.  A :class:`NativeCode`
+holds the machine code of a program (every segment, compiled module by
+module) and is shared by every PLC built from the same cache entry; each
+PLC gets its own context table of buffer addresses from
+:meth:`NativeCode.bind`.
 
-The machine code of a module is cached in ``$PLCRT_CACHE_DIR/native`` (else
-``~/.cache/plcrt/native``), keyed by a hash of the IR text, the llvmlite
-version and the host CPU.  A cached file carries a hash of its own bytes and
-is used only when that hash matches: a torn or foreign file is compiled
-again, never loaded.  A cache that cannot be written is skipped silently:
-the code is still compiled, only not kept.
+The machine code is kept on disk (:mod:`.diskcache`: atomic writes, a
+checksum, bounded in size), keyed by the modules' IR, the llvmlite version
+and the host (triple, CPU name and features).
 
 Code generation runs without optimisation passes: on straight-line code of
 byte loads and stores the optimiser costs more time at load than it saves
@@ -21,17 +19,14 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import hashlib
 import logging
-import os
 import time
-from pathlib import Path
+import zlib
 from typing import Any, Callable
 
+from ..cache import release_free_memory
+from . import diskcache
 from .fn import SLOTS
-
-_MAGIC = b"plcrt-native-1\n"
-
 
 def available() -> bool:
     """Whether llvmlite can be imported (the ``native`` extra is installed)."""
@@ -114,78 +109,49 @@ def _llvm() -> Any:
     return llvm
 
 
-def cache_dir() -> Path:
-    """Where machine code is kept: ``$PLCRT_CACHE_DIR/native``, else
-    ``~/.cache/plcrt/native`` (the temporary folder without a home)."""
-    base = os.environ.get("PLCRT_CACHE_DIR")
-    if base:
-        return Path(base) / "native"
-    try:
-        home = Path.home()
-    except RuntimeError:          # no HOME and no password entry (a bare container)
-        import tempfile
-        home = Path(tempfile.gettempdir())
-    return home / ".cache" / "plcrt" / "native"
-
-
-class _ObjectCache:
-    """llvmlite's object cache callbacks, on files with a checksum."""
-
-    def __init__(self, key: str) -> None:
-        self.path = cache_dir() / f"{key}.o"
-        self.hit = False
-
-    def load(self, _module: Any) -> bytes | None:
-        try:
-            data = self.path.read_bytes()
-        except OSError:
-            return None
-        head = len(_MAGIC) + 64
-        if len(data) < head or not data.startswith(_MAGIC):
-            return None
-        digest, body = data[len(_MAGIC):head], data[head:]
-        if hashlib.sha256(body).hexdigest().encode() != digest:
-            return None
-        self.hit = True
-        return body
-
-    def store(self, _module: Any, body: bytes) -> None:
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = self.path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_bytes(_MAGIC + hashlib.sha256(body).hexdigest().encode() + body)
-            os.replace(tmp, self.path)
-        except OSError:
-            pass
-
-
 class NativeCode:
-    """One compiled module: the segment functions' addresses.
+    """A program's machine code: the segment functions' addresses.
+
+    The modules (:attr:`plcrt.compiler.native.NativePlan.modules`) are
+    compiled one at a time to object code, each module's LLVM memory
+    released before the next is parsed (perf: a 100 000-statement program
+    as one module held 400 MiB of LLVM memory for good; module by module
+    the peak stays at one module's); then one engine loads the objects and
+    links them (a segment may call parts in other modules).  The objects
+    come from the disk cache (:mod:`.diskcache`) when it has them.
 
     Attributes:
         names: segment function names, in segment order.
-        compile_s: seconds spent parsing and generating (or loading) code.
+        compile_s: seconds spent generating (or loading) code.
         cached: the machine code came from the disk cache.
+        code_bytes: the size of the object code.
     """
 
-    def __init__(self, ir_text: str, names: list[str]) -> None:
+    def __init__(self, modules: tuple[bytes, ...] | list[bytes], names: list[str]) -> None:
         llvm = _llvm()
         t0 = time.perf_counter()
         self.names = names
         target = llvm.Target.from_default_triple()
         cpu = llvm.get_host_cpu_name()
-        key = hashlib.sha256("\0".join((ir_text, llvm_version(), target.triple, cpu))
-                             .encode()).hexdigest()[:40]
-        mod = llvm.parse_assembly(ir_text)
-        mod.name = key
         tm = target.create_target_machine(cpu=cpu, opt=0, codemodel="jitdefault")
-        self._engine = llvm.create_mcjit_compiler(mod, tm)
-        cache = _ObjectCache(key)
-        self._engine.set_object_cache(cache.store, cache.load)
+        key = diskcache.make_key([llvm_version(), target.triple, cpu,
+                                  llvm.get_host_cpu_features().flatten(),
+                                  zlib.ZLIB_VERSION, *modules])
+        objects = diskcache.load(key)
+        self.cached = objects is not None
+        if objects is None:
+            objects = [_object(llvm, tm, m) for m in modules]
+            diskcache.store(key, objects)
+        self.code_bytes = sum(len(o) for o in objects)
+        empty = llvm.parse_assembly("")
+        self._engine = llvm.create_mcjit_compiler(empty, tm)
+        while objects:                  # LLVM copies an object: drop ours at once
+            self._engine.add_object_file(llvm.ObjectFileRef.from_data(objects.pop(0)))
         self._engine.finalize_object()
         proto = ctypes.CFUNCTYPE(None, ctypes.c_void_p)
         self._fns = [proto(self._engine.get_function_address(n)) for n in names]
-        self.cached = cache.hit
+        if not self.cached and len(modules) > 1:
+            release_free_memory()       # the modules' freed LLVM memory
         self.compile_s = time.perf_counter() - t0
 
     def bind(self, buffers: dict[str, Any]) -> "NativeContext":
@@ -244,6 +210,16 @@ def probe_buffers(coverage: Any) -> dict[str, Any]:
                 "BP": bytearray(1), "BRK": bytearray(1)}
     return {"NC": coverage.hits, "OC": coverage.power, "CC": coverage.closed,
             "BP": coverage.breakpoints, "BRK": _BREAK(coverage.hit)}
+
+
+def _object(llvm: Any, tm: Any, module: bytes) -> bytes:
+    """Object code of one compressed module; its LLVM module is disposed
+    at once (the text and the parsed module are the large part)."""
+    mod = llvm.parse_assembly(zlib.decompress(module).decode("utf-8"))
+    try:
+        return bytes(tm.emit_object(mod))
+    finally:
+        mod.close()
 
 
 def llvm_version() -> str:

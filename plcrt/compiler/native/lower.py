@@ -33,7 +33,7 @@ from ...gen.exprs import VALUE_WIDTH, const_expr
 from ...gen.operands import Addr, Const
 from ...memory.hardware import MAX_CV, resolution_ms
 from .fn import PART_LINES, SLOT, SLOTS, Fn, NotLowered
-from .values import WIDE, get_bit, native_area, put_bit, rbit, rd, set_sm1, wbit, wr, zn_bits
+from .values import WIDE, copy, get_bit, native_area, put_bit, rbit, rd, set_sm1, wbit, wr, zn_bits
 
 
 # -- the table -------------------------------------------------------------------
@@ -135,7 +135,7 @@ def _range(value: int) -> Lowering:
             mask = ((1 << span) - 1) << b
             old = f.load8(area, byte)
             new = f.op(f"or i8 {old}, {mask}" if value else f"and i8 {old}, {~mask & 0xFF}")
-            f.store8(area, byte, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+            f.store8(area, byte, f.select(top, "i8", new, old))
             bit += span
     return lower
 
@@ -154,11 +154,11 @@ def _reset_timers(f: Fn, first: int, count: int) -> None:
     for n in range(first, first + count):
         for slot in ("T_RUN", "T_PREV"):
             old = f.load8(slot, n)
-            f.store8(slot, n, f.op(f"select i1 {top}, i8 0, i8 {old}"))
+            f.store8(slot, n, f.select(top, "i8", "0", old))
         wr(f, Addr("T", n, 0, 0), "W", "0", top)
         old = f.load8("TB", n >> 3)
         new = f.op(f"and i8 {old}, {~(1 << (n & 7)) & 0xFF}")
-        f.store8("TB", n >> 3, f.op(f"select i1 {top}, i8 {new}, i8 {old}"))
+        f.store8("TB", n >> 3, f.select(top, "i8", new, old))
 
 
 def _edge(rising: bool) -> Lowering:
@@ -205,8 +205,11 @@ for _p in ("LD", "A", "O"):
 
 
 def _move(kind: str) -> Lowering:
+    width = VALUE_WIDTH[kind[0]]
+
     def lower(f: Fn, src: Any, dst: Any) -> None:
-        wr(f, dst, kind, rd(f, src, kind), f.top)
+        if not copy(f, src, dst, width, f.top):
+            wr(f, dst, kind, rd(f, src, kind), f.top)
     return lower
 
 
@@ -242,7 +245,7 @@ def _binop(kind: str, op: str, rng: tuple[int, int]) -> Lowering:
         hi = f.op(f"icmp sle {ty} {r}, {rng[1]}")
         ok = f.op(f"and i1 {lo}, {hi}")
         wr(f, out, kind, r, f.op(f"and i1 {top}, {ok}"))
-        bits = f.op(f"select i1 {ok}, i8 {zn_bits(f, ty, r)}, i8 2")
+        bits = f.select(ok, "i8", zn_bits(f, ty, r), "2")
         set_sm1(f, top, 248, bits)
     return lower
 
@@ -272,7 +275,7 @@ def _incdec(kind: str, delta: int, lo: int, hi: int) -> Lowering:
         ext = "sext" if signed else "zext"
         wrapped = f.op(f"{ext} i{width_bits} {low} to {ty}")
         zn = zn_bits(f, ty, wrapped, signed)
-        bits = f.op(f"select i1 {ok}, i8 {zn}, i8 {f.op(f'or i8 {zn}, 2')}")
+        bits = f.select(ok, "i8", zn, f.op(f"or i8 {zn}, 2"))
         set_sm1(f, top, 248, bits)
         wr(f, out, kind, wrapped, top)
     return lower
@@ -373,7 +376,7 @@ def _narrow(kin: str, kout: str, lo: int, hi: int) -> Lowering:
                   f"{f.op(f'icmp sle {ty} {v}, {hi}')}")
         val = v if WIDE[kout] == ty else f.op(f"trunc {ty} {v} to {WIDE[kout]}")
         wr(f, out, kout, val, f.op(f"and i1 {top}, {ok}"))
-        set_sm1(f, top, 253, f.op(f"select i1 {ok}, i8 0, i8 2"))
+        set_sm1(f, top, 253, f.select(ok, "i8", "0", "2"))
     return lower
 
 
@@ -428,8 +431,8 @@ def _ton(f: Fn, t: Any, pt: Any) -> None:
     are advanced by the engine at the scan start: they stay in Python.
     """
     n, en, p, run, cv, capped = _timer_state(f, t, pt)
-    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
-    cvn = f.op(f"select i1 {en}, i32 {on}, i32 0")
+    on = f.select(run, "i32", capped, cv)
+    cvn = f.select(en, "i32", on, "0")
     bit = f.op(f"and i1 {en}, {f.op(f'icmp sge i32 {cvn}, {p}')}")
     _timer_store(f, t, n, en, cvn, bit)
 
@@ -439,11 +442,11 @@ def _tonr(f: Fn, t: Any, pt: Any) -> None:
     """TONR of a 100 ms timer (TimerBank.tonr): IN = 0 stops it and keeps
     value and bit; IN = 1 starts it from its value or adds the ticks."""
     n, en, p, run, cv, capped = _timer_state(f, t, pt)
-    on = f.op(f"select i1 {run}, i32 {capped}, i32 {cv}")
-    cvn = f.op(f"select i1 {en}, i32 {on}, i32 {cv}")
+    on = f.select(run, "i32", capped, cv)
+    cvn = f.select(en, "i32", on, cv)
     old_bit = get_bit(f, "TB", n >> 3, n & 7)
     reached = f.op(f"icmp sge i32 {on}, {p}")
-    bit = f.op(f"select i1 {en}, i1 {reached}, i1 {old_bit}")
+    bit = f.select(en, "i1", reached, old_bit)
     _timer_store(f, t, n, en, cvn, bit)
 
 
@@ -462,15 +465,15 @@ def _tof(f: Fn, t: Any, pt: Any) -> None:
     timing = f.op(f"and i1 {not_en}, {f.op(f'and i1 {not_prev}, {run}')}")
     starting = f.op(f"or i1 {en}, {prev}")   # IN on, or its falling edge: value 0, bit 1
     # running on: the ticks added; the bit stays on until PT
-    cv_t = f.op(f"select i1 {timing}, i32 {capped}, i32 {cv}")
-    cvn = f.op(f"select i1 {starting}, i32 0, i32 {cv_t}")
+    cv_t = f.select(timing, "i32", capped, cv)
+    cvn = f.select(starting, "i32", "0", cv_t)
     going = f.op(f"xor i1 {done}, true")
-    bit_t = f.op(f"select i1 {timing}, i1 {going}, i1 {old_bit}")
-    bit = f.op(f"select i1 {starting}, i1 true, i1 {bit_t}")
+    bit_t = f.select(timing, "i1", going, old_bit)
+    bit = f.select(starting, "i1", "true", bit_t)
     # running: stopped by IN, started by the falling edge, stopped at PT
-    run_t = f.op(f"select i1 {timing}, i1 {going}, i1 {run}")
-    run_e = f.op(f"select i1 {prev}, i1 true, i1 {run_t}")
-    run_n = f.op(f"select i1 {en}, i1 false, i1 {run_e}")
+    run_t = f.select(timing, "i1", going, run)
+    run_e = f.select(prev, "i1", "true", run_t)
+    run_n = f.select(en, "i1", "false", run_e)
     _timer_store(f, t, n, run_n, cvn, bit)
 
 

@@ -191,3 +191,46 @@ def test_a_page_of_another_origin_cannot_draw(serve, page, tmp_path) -> None:
     finally:
         other.shutdown()
         other.server_close()
+
+
+def test_change_move_and_add_a_box_with_the_keyboard(serve, page, tmp_path) -> None:
+    panel, path = _panel(tmp_path)
+    path.write_text(PROGRAM.replace("Network 1 // Seal-in\n",
+                                    "Network 1 // Seal-in\nLD     Start\nA      Stop\n"
+                                    "=      Motor\n"))
+    served = serve(panel=panel)
+    _open_drawing(page, served, "OB1/1")
+    _wait_stl(page, "LD     Start\nA      Stop\n=      Motor\n")
+    page.locator("#draw-rung .lad-el[aria-label='NO Stop']").click()
+    page.keyboard.press("Shift+?")          # Shift with a palette key: change the kind
+    _wait_stl(page, "LD     Start\nAN     Stop\n=      Motor\n")
+    assert _selected(page) == "NC Stop"
+    page.keyboard.press("Alt+ArrowLeft")    # move it before Start
+    _wait_stl(page, "LDN    Stop\nA      Start\n=      Motor\n")
+    assert _selected(page) == "NC Stop"
+    page.keyboard.press("ArrowRight")
+    page.keyboard.press("ArrowRight")
+    assert _selected(page) == "= Motor"
+    page.keyboard.press("Shift+S")          # the coil becomes a set coil, one bit
+    _wait_stl(page, "LDN    Stop\nA      Start\nS      Motor, 1\n")
+    page.select_option("#draw-box", "TON")
+    page.focus("#draw-rung")
+    page.keyboard.press("b")
+    _type_in_place(page, "T37, +50")
+    _wait_stl(page, "LDN    Stop\nA      Start\nS      Motor, 1\nTON    T37, +50\n")
+    assert page.locator("#draw-rung .lad-el.box .lad-pin").all_text_contents() == [
+        "T37", "PT +50"]
+    # a refused operand says why and changes nothing
+    page.keyboard.press("Enter")
+    page.wait_for_selector("#draw-rung input.lad-input")
+    page.keyboard.press("Control+a")
+    page.keyboard.type("T37, VW1, VW2")
+    page.keyboard.press("Enter")
+    page.wait_for_function("() => document.querySelector('#draw-status').className === 'error'")
+    assert "TON    T37, +50" in _text(page)
+    page.focus("#draw-rung")
+    for _ in range(4):
+        page.keyboard.press("Control+z")
+    _wait_stl(page, "LD     Start\nA      Stop\n=      Motor\n")
+    assert page.locator("#draw-undo").is_disabled()
+    assert page.errors == []

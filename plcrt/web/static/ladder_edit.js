@@ -12,7 +12,7 @@
   const $ = (id) => document.getElementById(id);
   const L = {
     id: null, block: null, number: null, model: null, sel: null, pending: null,
-    busy: false, asking: null,
+    busy: false, asking: null, queue: Promise.resolve(),
   };
   window.plcrtLadder = L;   // for the tests and the curious
 
@@ -35,7 +35,7 @@
   };
   const COUNTERS = new Set(["CTU", "CTD"]);
   // the keys of the palette (also on its buttons' titles)
-  const KEYS = { c: "NO", "/": "NC", p: "P", n: "N", t: "NOT", m: "CMP", o: "BRANCH",
+  const KEYS = { c: "NO", "/": "NC", "?": "NC", "=": "=", "+": "=", p: "P", n: "N", t: "NOT", m: "CMP", o: "BRANCH",
     q: "=", s: "S", r: "R", i: "=I", b: "BOX" };
   const SYMBOL = { NO: "\u2524 \u251c", NC: "\u2524/\u251c", NOI: "\u2524I\u251c",
     NCI: "\u2524/I\u251c", P: "\u2524P\u251c", N: "\u2524N\u251c", NOT: "\u2524NOT\u251c" };
@@ -117,8 +117,16 @@
     render();
   }
 
-  async function send(route, extra, select) {
-    if (L.busy || !L.id) return false;
+  // one request at a time, in the order asked (keys pressed quickly, such
+  // as Ctrl+Z Ctrl+Z, all count)
+  function send(route, extra, select) {
+    const next = L.queue.then(() => sendNow(route, extra, select));
+    L.queue = next.catch(() => false);
+    return next;
+  }
+
+  async function sendNow(route, extra, select) {
+    if (!L.id) return false;
     L.busy = true;
     const before = sigs();
     const ans = await api(route, Object.assign({ id: L.id, text: editorText() }, extra));
@@ -371,9 +379,72 @@
     });
   }
 
-  function add(what) {
-    if (!L.id || L.busy) return;
-    if (CONTACTS[what]) addContact(what);
+  // Shift with a palette entry: the selected element becomes that kind,
+  // keeping its operands where it has as many (NO -> NC, = -> S)
+  function change(what) {
+    const e = selected();
+    if (!e) { status("select the element to change", "warning"); return; }
+    const x = JSON.parse(e.dataset.sig);
+    const at = JSON.parse(L.sel);
+    let el = null;
+    if (CONTACTS[what] && e.dataset.kind === "logic") {
+      const spec = CONTACTS[what];
+      el = { el: spec.el };
+      if (spec.cmp) el.cmp = spec.cmp;
+      if (spec.ops) {
+        const want = opsOf(spec.ops);
+        el.ops = x.ops && x.ops.length === want.length ? x.ops : want;
+      }
+    } else if (COILS[what] && x.el === "coil") {
+      const want = opsOf(COILS[what].ops);
+      el = { el: "coil", insn: what, ops: want.map((d, k) => (x.ops[k] === undefined ? d : x.ops[k])) };
+    }
+    if (!el) { status("a contact changes into a contact, a coil into a coil", "warning"); return; }
+    edit({ op: "replace", at, element: el }).then((ok) => { if (ok) { L.sel = JSON.stringify(at); mark(); } });
+  }
+
+  // Alt with left or right: the selected element moves one place in its
+  // series (a contact) or among its node's outputs
+  function shift(dir) {
+    if (!L.sel) return;
+    const at = JSON.parse(L.sel);
+    const k = at[at.length - 1];
+    if (typeof k !== "number") { status("this element has no neighbour to swap with", "warning"); return; }
+    const parentPath = at.slice(0, -1);
+    let parent = L.model;
+    for (const step of parentPath) parent = typeof step === "number" ? (parent.items || parent)[step] : parent[step];
+    const items = Array.isArray(parent) ? parent : parent.items;
+    const j = k + dir;
+    if (!items || j < 0 || j >= items.length) return;
+    let op;
+    if (parentPath[parentPath.length - 1] === "outs") {
+      op = { op: "move", from: at, to: parentPath.slice(0, -1), index: j };
+    } else if (parent.el === "series") {
+      // after the deletion the series is one shorter (or, of two, the one left)
+      const to = items.length === 2 ? parentPath : parentPath.concat(Math.min(j, k));
+      op = { op: "move", from: at, to, side: dir > 0 ? "after" : "before" };
+    } else {
+      status("a parallel branch's elements are moved with Delete and adding", "warning");
+      return;
+    }
+    const els = elements();
+    const sig = selected().dataset.sig;
+    const before = els.indexOf(selected());
+    edit(op).then((ok) => {
+      if (!ok) return;
+      // the moved element: the nearest one that is it, in the direction moved
+      const now = elements();
+      const same = now.filter((e) => e.dataset.sig === sig);
+      const pick = same.sort((a, b) => Math.abs(now.indexOf(a) - before - dir) -
+        Math.abs(now.indexOf(b) - before - dir))[0];
+      if (pick) { L.sel = pick.dataset.path; mark(); }
+    });
+  }
+
+  function add(what, shiftKey) {
+    if (!L.id) return;
+    if (shiftKey && (CONTACTS[what] || COILS[what])) change(what);
+    else if (CONTACTS[what]) addContact(what);
     else if (what === "BRANCH") addBranch();
     else if (COILS[what]) addOutput(what, false);
     else if (what === "BOX") addOutput($("draw-box").value, true);
@@ -426,6 +497,9 @@
     } else if (ctrl && (e.key === "y" || e.key === "Y")) {
       e.preventDefault();
       send("/ladder/redo", {});
+    } else if (e.altKey && (e.key === "ArrowLeft" || e.key === "ArrowRight")) {
+      e.preventDefault();
+      shift(e.key === "ArrowRight" ? 1 : -1);
     } else if (ctrl || e.altKey) {
       return;
     } else if (e.key.startsWith("Arrow")) {
@@ -437,9 +511,9 @@
     } else if (e.key === "Delete" || e.key === "Backspace") {
       e.preventDefault();
       remove();
-    } else if (KEYS[e.key] || e.key === "=") {
+    } else if (KEYS[e.key.toLowerCase()]) {
       e.preventDefault();
-      add(e.key === "=" ? "=" : KEYS[e.key]);
+      add(KEYS[e.key.toLowerCase()], e.shiftKey);
     }
   }
 
@@ -456,7 +530,7 @@
     $("draw-undo").addEventListener("click", () => send("/ladder/undo", {}));
     $("draw-redo").addEventListener("click", () => send("/ladder/redo", {}));
     for (const b of $("draw-palette").querySelectorAll("button[data-add]")) {
-      b.addEventListener("click", () => add(b.dataset.add));
+      b.addEventListener("click", (e) => add(b.dataset.add, e.shiftKey));
     }
     const rung = $("draw-rung");
     rung.addEventListener("keydown", onKey);

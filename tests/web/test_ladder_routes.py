@@ -10,6 +10,7 @@ import pytest
 
 from plcrt.errors import PlcConfigError
 from plcrt.web import ladderroutes
+from plcrt.web.editor import MAX_TEXT
 from plcrt.web.editroutes import MAX_BODY
 
 from .test_editor import _post, _run
@@ -136,11 +137,17 @@ def test_bad_json_big_bodies_and_other_origins_are_refused(tmp_path) -> None:
                    {"op": "explode"}, "delete", None):
             status, ans = await _post(client, "/ladder/edit", id=key, text=TEXT, op=op)
             assert status == 400 and not ans["ok"], op
-        # another page's origin gets nothing
+        # a text over the editor's bound
+        status, ans = await _post(client, "/ladder/networks", text="x" * (MAX_TEXT + 1))
+        assert status == 400 and not ans["ok"]
+        # another page's origin, or another host name (DNS rebinding), gets nothing
         for route in ("networks", "open", "edit", "undo", "redo"):
             r = await client.post(f"/ladder/{route}", json={"text": TEXT},
                                   headers={"Origin": "http://evil.example"})
             assert r.status == 403
+            r = await client.post(f"/ladder/{route}", json={"text": TEXT},
+                                  headers={"Host": f"evil.example:{client.port}"})
+            assert r.status == 403 and "not this server's name" in await r.text()
         # the drawing is as it was: nothing was applied
         status, ans = await _post(client, "/ladder/undo", id=key, text=TEXT)
         assert status == 400 and "nothing to undo" in ans["message"]

@@ -234,3 +234,29 @@ def test_change_move_and_add_a_box_with_the_keyboard(serve, page, tmp_path) -> N
     _wait_stl(page, "LD     Start\nA      Stop\n=      Motor\n")
     assert page.locator("#draw-undo").is_disabled()
     assert page.errors == []
+
+
+def test_elements_are_moved_with_the_mouse(serve, page, tmp_path) -> None:
+    panel, path = _panel(tmp_path)
+    path.write_text(PROGRAM.replace("Network 1 // Seal-in\n",
+                                    "Network 1 // Seal-in\nLD     Start\nA      Stop\n"
+                                    "A      I0.2\n=      Motor\nS      Q0.3, 1\n"))
+    served = serve(panel=panel)
+    _open_drawing(page, served, "OB1/1")
+    _wait_stl(page, "LD     Start\nA      Stop\nA      I0.2\n=      Motor\nS      Q0.3, 1\n")
+    el = "#draw-rung .lad-el[aria-label='{}']"
+    # Start onto the right half of I0.2: after it
+    box = page.locator(el.format("NO I0.2")).bounding_box()
+    page.drag_and_drop(el.format("NO Start"), el.format("NO I0.2"),
+                       target_position={"x": box["width"] - 3, "y": box["height"] / 2})
+    _wait_stl(page, "LD     Stop\nA      I0.2\nA      Start\n=      Motor\nS      Q0.3, 1\n")
+    # the set coil onto the left half of the output coil: before it
+    page.drag_and_drop(el.format("S Q0.3, 1"), el.format("= Motor"),
+                       target_position={"x": 3, "y": 5})
+    _wait_stl(page, "LD     Stop\nA      I0.2\nA      Start\nS      Q0.3, 1\n=      Motor\n")
+    assert _selected(page) == "S Q0.3, 1"
+    # a coil dropped among contacts is refused, nothing changes
+    page.drag_and_drop(el.format("= Motor"), el.format("NO Stop"))
+    page.wait_for_function("() => document.querySelector('#draw-status').className === 'warning'")
+    assert "S      Q0.3, 1\n=      Motor" in _text(page)
+    assert page.errors == []

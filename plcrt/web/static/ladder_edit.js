@@ -166,6 +166,7 @@
     d.dataset.sig = JSON.stringify(x);
     d.append(div("lad-op", top || "\u00a0"), div("lad-sym", sym), div("lad-op", bottom || "\u00a0"));
     d.setAttribute("role", "button");
+    d.draggable = true;
     d.setAttribute("aria-label", (x.insn || x.el) + " " + (x.ops || []).join(", "));
     return d;
   }
@@ -441,6 +442,58 @@
     });
   }
 
+  // the mouse: an element dragged onto another goes before or after it
+  // (the side of the target it is dropped on); a contact among contacts,
+  // a coil or box among outputs.  The target's path is given as it is
+  // after the dragged element is deleted (the model's move operation).
+  function valueAt(path) {
+    let x = L.model;
+    for (const step of path) x = typeof step === "number" ? (x.items || x)[step] : x[step];
+    return x;
+  }
+
+  function afterDelete(from, path) {
+    const p = from.slice(0, -1);
+    const k = from[from.length - 1];
+    const parent = valueAt(p);
+    const same = path.length > p.length && p.every((s, i) => s === path[i]);
+    if (!same || typeof path[p.length] !== "number") return path;
+    const j = path[p.length];
+    if (parent && parent.items && parent.items.length === 2) {
+      // a series or parallel of two is left as the other element alone
+      return p.concat(path.slice(p.length + 1));
+    }
+    return j > k ? p.concat(j - 1, path.slice(p.length + 1)) : path;
+  }
+
+  function drop(fromEl, ontoEl, right) {
+    const from = JSON.parse(fromEl.dataset.path);
+    const onto = JSON.parse(ontoEl.dataset.path);
+    if (fromEl === ontoEl || onto[0] === "pending") return;
+    if (fromEl.dataset.kind !== ontoEl.dataset.kind) {
+      status("a contact goes among contacts, a coil or box among outputs", "warning");
+      return;
+    }
+    const sig = fromEl.dataset.sig;
+    let op;
+    if (fromEl.dataset.kind === "logic") {
+      op = { op: "move", from, to: afterDelete(from, onto), side: right ? "after" : "before" };
+    } else {
+      const k = onto.lastIndexOf("outs");
+      const node = onto.slice(0, k);
+      let index = onto[k + 1] + (right ? 1 : 0);
+      const fk = from.lastIndexOf("outs");
+      const sameNode = fk === k && from.slice(0, fk).every((s, i) => s === node[i]);
+      if (sameNode && from[fk + 1] < index) index -= 1;
+      op = { op: "move", from, to: afterDelete(from, node), index };
+    }
+    edit(op).then((ok) => {
+      if (!ok) return;
+      const e = elements().find((x) => x.dataset.sig === sig);
+      if (e) { L.sel = e.dataset.path; mark(); }
+    });
+  }
+
   function add(what, shiftKey) {
     if (!L.id) return;
     if (shiftKey && (CONTACTS[what] || COILS[what])) change(what);
@@ -541,6 +594,26 @@
       mark();
       rung.focus();
     });
+    let dragged = null;
+    rung.addEventListener("dragstart", (e) => {
+      const el = e.target.closest && e.target.closest(".lad-el");
+      if (!el || el.dataset.path === "[\"pending\"]") { e.preventDefault(); return; }
+      dragged = el;
+      e.dataTransfer.effectAllowed = "move";
+      e.dataTransfer.setData("text/plain", "");
+    });
+    rung.addEventListener("dragover", (e) => {
+      if (dragged && e.target.closest(".lad-el")) e.preventDefault();
+    });
+    rung.addEventListener("drop", (e) => {
+      const onto = e.target.closest(".lad-el");
+      if (!dragged || !onto) return;
+      e.preventDefault();
+      const r = onto.getBoundingClientRect();
+      drop(dragged, onto, e.clientX > r.left + r.width / 2);
+      dragged = null;
+    });
+    rung.addEventListener("dragend", () => { dragged = null; });
     rung.addEventListener("dblclick", (e) => { if (e.target.closest(".lad-el")) editOperands(); });
   });
 })();

@@ -45,7 +45,7 @@ from ..lang.stl import parse_program
 from ..safetext import excerpt, printable
 from ..view.ladder_check import replace_network
 from ..view.ladder_edit import History, model_json
-from ..view.ladder_model import Model, model_to_json
+from ..view.ladder_model import model_to_json
 from ..view.ladder_stl import NoLadder, model_to_stl, network_to_model
 from .editroutes import json_answer, read_body, text_of
 
@@ -106,11 +106,10 @@ class Drawings:
         page = model_json(net, program=prog)
         answer: dict[str, Any] = {"ok": True, "block": block, "number": number,
                                   "stl": page["stl"]}
-        if page["ladder"] is None:
-            answer.update(ladder=None, reason=printable(page["reason"]))
-            return answer
         model = network_to_model(net)
-        assert isinstance(model, Model)
+        if isinstance(model, NoLadder):
+            answer.update(ladder=None, reason=printable(model.reason))
+            return answer
         key = secrets.token_urlsafe(12)
         self._by_id[key] = Drawing(block, number, History(model))
         while len(self._by_id) > MAX_DRAWINGS:

@@ -12,7 +12,7 @@
   const $ = (id) => document.getElementById(id);
   const L = {
     id: null, block: null, number: null, model: null, sel: null, pending: null,
-    busy: false, asking: null, queue: Promise.resolve(),
+    busy: false, asking: null, queue: Promise.resolve(),   // busy: a change is on its way
   };
   window.plcrtLadder = L;   // for the tests and the curious
 
@@ -119,13 +119,13 @@
 
   // one request at a time, in the order asked (keys pressed quickly, such
   // as Ctrl+Z Ctrl+Z, all count)
-  function send(route, extra, select) {
-    const next = L.queue.then(() => sendNow(route, extra, select));
+  function send(route, extra) {
+    const next = L.queue.then(() => sendNow(route, extra));
     L.queue = next.catch(() => false);
     return next;
   }
 
-  async function sendNow(route, extra, select) {
+  async function sendNow(route, extra) {
     if (!L.id) return false;
     L.busy = true;
     const before = sigs();
@@ -141,7 +141,7 @@
     let k = 0;
     while (k < after.length && k < before.length && after[k] === before[k]) k += 1;
     const els = elements();
-    const pick = select !== undefined ? select : (els[Math.min(k, els.length - 1)] || null);
+    const pick = els[Math.min(k, els.length - 1)] || null;
     L.sel = pick ? pick.dataset.path : null;
     mark();
     status(route === "/ladder/edit" ? "done" : route.slice(8) + " done", "ok");

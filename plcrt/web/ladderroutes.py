@@ -1,5 +1,5 @@
 """The ladder drawing's HTTP endpoints: ``/ladder/networks``, ``/ladder/open``,
-``/ladder/edit``, ``/ladder/undo`` and ``/ladder/redo``.
+``/ladder/new``, ``/ladder/edit``, ``/ladder/undo`` and ``/ladder/redo``.
 
 The page draws one network of the editor's current text at a time.
 ``open`` gives the network's editable model
@@ -95,6 +95,28 @@ def networks(text: str) -> list[dict[str, Any]]:
     return out
 
 
+def new_network(text: str, block: str) -> dict[str, Any]:
+    """The text with an empty network after the last one of ``block``,
+    numbered after the block's highest; the other lines stay as they are."""
+    prog = parse_program(text, "<editor>")
+    pou = next((p for p in prog.pous if block.upper() in (p.ident.upper(), p.name.upper())), None)
+    if pou is None:
+        raise PlcConfigError(f"no block {excerpt(block, 40)} in the program")
+    if not pou.networks:
+        raise PlcConfigError(f"block {excerpt(block, 40)} has no network to add one after: "
+                             "type the first one in the text")
+    lines = text.splitlines(keepends=True)
+    start = pou.networks[-1].loc.line - 1
+    end = next((k for k in range(start + 1, len(lines))
+                if lines[k].strip().upper().startswith("END_")), len(lines))
+    number = max(n.number for n in pou.networks) + 1
+    eol = "\r\n" if lines[start].endswith("\r\n") else "\n"
+    if end > 0 and not lines[end - 1].endswith(("\n", "\r")):
+        lines[end - 1] += eol
+    lines.insert(end, f"Network {number}{eol}")
+    return {"ok": True, "block": pou.ident, "number": number, "text": "".join(lines)}
+
+
 class Drawings:
     """The open drawings by id (bounded; see :data:`MAX_DRAWINGS`)."""
 
@@ -170,6 +192,8 @@ def add_routes(app: web.Application, origin_ok: Callable[[web.Request], bool]) -
 
     app.router.add_post("/ladder/networks", guarded(
         ("text",), lambda b: {"ok": True, "networks": networks(text_of(b))}))
+    app.router.add_post("/ladder/new", guarded(
+        ("text", "block"), lambda b: new_network(text_of(b), where(dict(b, number=0))[0])))
     app.router.add_post("/ladder/open", guarded(
         ("text", "block", "number"), lambda b: drawings.open(text_of(b), *where(b))))
     app.router.add_post("/ladder/edit", guarded(
@@ -180,4 +204,4 @@ def add_routes(app: web.Application, origin_ok: Callable[[web.Request], bool]) -
             ("id", "text"), lambda b, w=what: drawings.step(b.get("id"), text_of(b), w)))
 
 
-__all__ = ["Drawing", "Drawings", "MAX_DRAWINGS", "add_routes", "networks"]
+__all__ = ["Drawing", "Drawings", "MAX_DRAWINGS", "add_routes", "networks", "new_network"]

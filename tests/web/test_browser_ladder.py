@@ -1,7 +1,7 @@
 """Drawing ladder in a real headless browser: a seal-in rung drawn into an
 empty network with the mouse and the keyboard, written into the editor's
 text and saved to the file; undo and redo; a network without ladder form
-shown as STL with its reason; operands with markup stay text; a page of
+shown as STL with its reason; a new network drawn; operands with markup stay text; a page of
 another origin refused on the drawing's endpoints."""
 
 from __future__ import annotations
@@ -143,7 +143,7 @@ def test_draw_a_seal_in_rung_with_mouse_and_keyboard_and_save(serve, page, tmp_p
     assert page.errors == []
 
 
-def test_a_network_without_ladder_form_stays_stl_and_says_why(serve, page, tmp_path) -> None:
+def test_a_network_without_ladder_form_stays_stl_and_a_new_one_is_drawn(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
     _open_drawing(page, served, "OB1/2")
@@ -153,6 +153,17 @@ def test_a_network_without_ladder_form_stays_stl_and_says_why(serve, page, tmp_p
     assert page.locator("#draw-stl").text_content() == ("LD     I0.2\n=      Q0.1\n"
                                                          "LD     I0.3\n=      Q0.2\n")
     assert page.locator("#draw-palette").is_hidden()
+    # New network: an empty network 3 after it, drawn at once
+    page.click("#draw-new")
+    page.wait_for_function("() => document.querySelector('#draw-status').textContent "
+                           "=== 'drawing OB1 network 3'")
+    page.click("#draw-palette [data-add=NO]")
+    _type_in_place(page, "I0.5")
+    page.click("#draw-palette [data-add='=']")
+    _type_in_place(page, "Q0.5")
+    _wait_stl(page, "LD     I0.5\n=      Q0.5\n")
+    assert _text(page).endswith("=      Q0.2\nNetwork 3\nLD     I0.5\n=      Q0.5\n"
+                                "END_ORGANIZATION_BLOCK\n")
     assert page.errors == []
 
 

@@ -163,3 +163,15 @@ def test_drawings_are_bounded() -> None:
             d.step(k, TEXT, "edit", op)
     assert d.step(keys[3], TEXT, "edit", {
         "op": "operands", "at": ["rung", "logic"], "ops": ["I0.7"]})["ok"]
+
+
+def test_new_network_is_added_after_the_blocks_last(tmp_path) -> None:
+    async def body(client, panel, path):
+        status, ans = await _post(client, "/ladder/new", text=TEXT.replace("\n", "\r\n"),
+                                  block="OB1")
+        assert status == 200 and ans["number"] == 4
+        assert ans["text"] == TEXT.replace("\n", "\r\n").replace(
+            "END_ORGANIZATION_BLOCK", "Network 4\r\nEND_ORGANIZATION_BLOCK")
+        status, ans = await _post(client, "/ladder/new", text=TEXT, block="SBR0")
+        assert status == 400 and "SBR0" in ans["message"]
+    _run(tmp_path, body)

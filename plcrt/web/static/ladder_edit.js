@@ -109,6 +109,19 @@
     }
   }
 
+  // an empty network after the last one of the chosen network's block,
+  // drawn at once
+  async function newNetwork() {
+    await listNetworks();
+    const block = ($("draw-net").value || "OB1/").split("/")[0];
+    const ans = await api("/ladder/new", { text: editorText(), block });
+    if (!ans.ok) { status(ans.message || "refused", "error"); $("draw").hidden = false; return; }
+    setEditorText(ans.text);
+    await listNetworks();
+    $("draw-net").value = ans.block + "/" + ans.number;
+    await open();
+  }
+
   function show(ans) {
     $("draw-stl").textContent = ans.stl;
     $("draw-palette").hidden = ans.ladder === null;
@@ -580,6 +593,7 @@
     });
     $("draw-net").addEventListener("focus", listNetworks);
     $("draw-open").addEventListener("click", async () => { await listNetworks(); await open(); });
+    $("draw-new").addEventListener("click", newNetwork);
     $("draw-undo").addEventListener("click", () => send("/ladder/undo", {}));
     $("draw-redo").addEventListener("click", () => send("/ladder/redo", {}));
     for (const b of $("draw-palette").querySelectorAll("button[data-add]")) {

@@ -232,4 +232,8 @@ def _json(answer: dict[str, Any], status: int = 200) -> web.Response:
                         text=json.dumps(answer, ensure_ascii=True, allow_nan=False))
 
 
-__all__ = ["MAX_BODY", "add_routes"]
+#: the body, text and answer helpers, for the panel's other endpoints
+#: (:mod:`plcrt.web.ladderroutes`)
+read_body, text_of, json_answer = _body, _text, _json
+
+__all__ = ["MAX_BODY", "add_routes", "json_answer", "read_body", "text_of"]

@@ -30,6 +30,7 @@ from ..safetext import excerpt, printable
 from . import course as course_mod
 from .editor import ProgramSource, SourceOf
 from .editroutes import add_routes as add_editor_routes
+from .ladderroutes import add_routes as add_ladder_routes
 from .protocol import MAX_MESSAGE, ProtocolError, dumps, parse
 from .session import Client, PanelSession
 
@@ -248,6 +249,7 @@ def make_app(panel: Panel) -> web.Application:
     app.router.add_get("/lesson/{name}", lesson_file)
     app.router.add_static("/static/", STATIC, show_index=False)
     add_editor_routes(app, panel, replace_session, origin_ok)
+    add_ladder_routes(app, origin_ok)
     app.on_startup.append(on_startup)
     app.on_shutdown.append(on_shutdown)
     app.on_response_prepare.append(_headers)

@@ -266,7 +266,7 @@ function press(addr, down) {
 }
 
 document.addEventListener("keydown", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host, #draw")) return;
   if (e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) { press(P.hello.inputs[n].addr, true); return; }
@@ -275,7 +275,7 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "n") send({ type: "step" });
 });
 document.addEventListener("keyup", (e) => {
-  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host")) return;
+  if (e.target.closest && e.target.closest("input, select, textarea, button, [contenteditable], #editor-host, #draw")) return;
   const n = "123456789".indexOf(e.key);
   if (n >= 0 && P.hello && P.hello.inputs[n]) press(P.hello.inputs[n].addr, false);
 });

@@ -408,11 +408,13 @@ class CanopenDrive:
                 drive, pdos, clock = self.drive, self.pdos, self.clock
                 if clock == "sync":
                     t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
-                    drive.advance(t)
+                    # perf: the objects at the SYNC held for its TPDOs, not
+                    # written: exchange() below writes the cycle's
+                    drive.advance(t, hold=True)
                 elif clock == "wall":
                     self._catch_up()
                 t = drive.now
-                frames, values = pdos.on_sync(t)
+                frames, values = pdos.on_sync(t, drive.deferred)
                 if values or clock == "sync":
                     if (0x6060, 0) in values:
                         values = self._rx_values(values)
@@ -423,6 +425,7 @@ class CanopenDrive:
                     self._check_emcy()
         except Exception:
             log.exception("node %d: SYNC failed", self.drive.node_id)
+            self.drive.flush()
         send = self.network.send_message
         for can_id, data in frames:
             try:

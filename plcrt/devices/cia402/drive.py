@@ -121,6 +121,7 @@ class Drive(Service, ProcessData, Timeline):
         self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, _tx_fast_codec of it)
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
+        self.deferred: Optional[tuple[int, ...]] = None   # perf: publish_deferred's values
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write
@@ -240,6 +241,9 @@ class Drive(Service, ProcessData, Timeline):
     # ---------------------------------------------------------------- master side
     def sdo_read(self, index: int, sub: int = 0) -> bytes:
         """SDO upload (the store's rules)."""
+        if self.deferred is not None:
+            with self.store.lock:
+                self.flush()           # the values held at a SYNC, if a read comes between
         if index in self.pdo.entries:
             return self.od.entry(index, sub).encode(self.pdo.read(index, sub))
         if index == 0x2012:

@@ -29,7 +29,8 @@ from .plant import DrivePlant
 from .statemachine import State
 from .store import key
 
-__all__ = ["ProcessData", "CW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS", "STATE_KEYS"]
+__all__ = ["ProcessData", "CW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS", "OWN_KEYS",
+           "STATE_KEYS"]
 
 #: The drive's own objects, written by :meth:`ProcessData.publish`.
 #: 6063h (position actual internal value) reads as 6064h: neither model has a
@@ -42,6 +43,8 @@ MOTION_KEYS = _K6062, _K6064, _K606C, _K60F4, _K6063, _K606B = tuple(
     key(i, 0) for i in (0x6062, 0x6064, 0x606C, 0x60F4, 0x6063, 0x606B))
 STATE_KEYS = _K6041, _K6061, _K603F, _K1001, _K60FD = tuple(
     key(i, 0) for i in (0x6041, 0x6061, 0x603F, 0x1001, 0x60FD))
+#: The order of the values :meth:`ProcessData.publish_deferred` holds.
+OWN_KEYS = MOTION_KEYS + STATE_KEYS
 #: Objects whose write the drive's hook acts on whatever the mode (6040h
 #: controlword, 6060h mode, 605Ah/6084h/6085h read by the state machine).
 _HOOK_INDEXES = frozenset({0x6040, 0x6060, 0x605A, 0x6084, 0x6085})
@@ -91,6 +94,7 @@ class ProcessData:
     stops: Any
     probe: Any
     _live: dict[tuple[int, int], Any]
+    deferred: Optional[tuple[int, ...]]
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
@@ -129,6 +133,17 @@ class ProcessData:
         before 6040h); the caller reads what it transmits from
         :attr:`store`."""
         with self.store.lock:
+            if self.deferred is not None:
+                # perf: the values held at the SYNC stay unwritten when the
+                # fast cycle writes its own and reads none of them
+                if values.keys().isdisjoint(self._own):
+                    if self._csp_fast(t_us, None, values):
+                        self.deferred = None
+                        return
+                    self.flush()
+                    self._step(t_us, None, values)
+                    return
+                self.flush()
             if not self._csp_fast(t_us, None, values):
                 self._step(t_us, None, values)   # the same cycle as cycle()
 
@@ -372,6 +387,42 @@ class ProcessData:
     # ---------------------------------------------------------------- outputs
     def publish(self) -> None:
         """Write the drive's own objects for the present time."""
+        self._publish_values(*self._outputs())
+
+    def publish_deferred(self) -> None:
+        """:meth:`publish` for a SYNC whose bus cycle follows at once: the
+        values are computed now (the statusword's mode bits and the touch
+        probe as publish sets them) and held in :attr:`deferred`, in the
+        order of OWN_KEYS, for the synchronous TPDOs sampled before the
+        cycle; the cycle (:meth:`exchange`) writes its own values, or first
+        these (:meth:`flush`) where it takes the general path.  Written at
+        once when the model lacks one of its own objects or a value does
+        not fit its object (publish's other path)."""
+        # perf: the SYNC's two publishes (at the SYNC, after the cycle's
+        # set-points) write the store once; a group equal to the one written
+        # last was checked when written
+        motion, state = self._outputs()
+        last_motion, last_state = self._published
+        store = self.store
+        if len(self._own) == len(OUTPUTS) \
+                and (motion == last_motion or store.fits_group(MOTION_KEYS, motion)) \
+                and (state == last_state or store.fits_group(STATE_KEYS, state)):
+            self.deferred = motion + state
+        else:
+            self._publish_values(motion, state)
+
+    def flush(self) -> None:
+        """Write the values :meth:`publish_deferred` holds, if any."""
+        held = self.deferred
+        if held is not None:
+            self.deferred = None
+            self._publish_values(held[:6], held[6:])
+
+    def _outputs(self) -> tuple[tuple[int, int, int, int, int, int],
+                                tuple[int, int, int, int, int]]:
+        """The drive's own objects for the present time: (motion, state) as
+        :meth:`_publish_values` takes them.  Sets the statusword's mode
+        bits and updates the touch probe."""
         t = self.now
         ax, sm = self.axis, self.sm
         if sm.state is OE:
@@ -393,11 +444,10 @@ class ProcessData:
             demand = ax.demand_position(t)      # past a mechanical end (stops.py)
             fe = demand - pos
         vel = ax.velocity(t)
-        self._publish_values(
-            (demand, pos, vel, fe, pos,
-             vel if self.stops is None else int(ax.demand(t)[1])),
-            (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
-             self.plant.inputs(mech)))
+        return ((demand, pos, vel, fe, pos,
+                 vel if self.stops is None else int(ax.demand(t)[1])),
+                (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
+                 self.plant.inputs(mech)))
 
     def _publish_values(self, motion: tuple[int, int, int, int],
                         state: tuple[int, int, int, int, int]) -> None:

@@ -122,6 +122,7 @@ class Drive(Service, ProcessData, Timeline):
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, _tx_fast_codec of it)
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
         self.deferred: Optional[tuple[int, ...]] = None   # perf: publish_deferred's values
+        self._held_state: Optional[tuple[int, ...]] = None   # perf: a state group in range
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write

@@ -60,6 +60,7 @@ _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
+_B8, _B13 = 0x100, 0x2000      # 6041h: limit stop, following error (CyclicPosition.bits)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
 _PLAIN_PLANT = {f.name for f in fields(DrivePlant)} == {
@@ -95,6 +96,7 @@ class ProcessData:
     probe: Any
     _live: dict[tuple[int, int], Any]
     deferred: Optional[tuple[int, ...]]
+    _held_state: Optional[tuple[int, ...]]
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
@@ -406,7 +408,9 @@ class ProcessData:
         store = self.store
         if len(self._own) == len(OUTPUTS) \
                 and (motion == last_motion or store.fits_group(MOTION_KEYS, motion)) \
-                and (state == last_state or store.fits_group(STATE_KEYS, state)):
+                and (state == last_state or state == self._held_state
+                     or store.fits_group(STATE_KEYS, state)):
+            self._held_state = state   # perf: found in range: the same state is again
             self.deferred = motion + state
         else:
             self._publish_values(motion, state)
@@ -425,6 +429,34 @@ class ProcessData:
         bits and updates the touch probe."""
         t = self.now
         ax, sm = self.axis, self.sm
+        line, plant = ax._line, self.plant
+        if (line is not None and sm.state is OE and self.mode_number == 8 and self.stops is None
+                and plant.pos_limit is None and plant.neg_limit is None and ax.bounds is None):
+            csp = self.engines[8]
+            if csp.__class__ is CyclicPosition:
+                # perf: the CSP line written out: CyclicPosition.bits with no
+                # limit switch, Axis.moving, mechanical and velocity on a line
+                t1 = line.t1
+                sm.set_mode_bits((_B8 if csp.limit_stop else 0) | _B12 | (0 if t < t1 else _B10)
+                                 | (_B13 if csp._fe_since is not None else 0))
+                if t >= t1:
+                    mech, vel = line.x1, 0
+                else:
+                    t0 = line.t0
+                    span, den = line.x1 - line.x0, t1 - t0
+                    mech = line.x0 + span * ((t0 if t < t0 else t) - t0) // den
+                    if t < t0:
+                        vel = 0
+                    else:
+                        num = span * US
+                        vel = num // den if num >= 0 else -(-num // den)
+                pos = mech + ax.shift
+                if self.probe.function or self._live.get(_K60B8):
+                    self._probe_update(t, mech)            # touch probe armed (drive_service.py)
+                inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
+                    and plant.home_switch is None else plant.inputs(mech)
+                return ((csp.demand, pos, vel, csp.following_error, pos, vel),
+                        (sm.statusword, 8, sm.error_code, sm.error_register, inputs))
         if sm.state is OE:
             bits = self.engines[self.mode_number].bits(t)    # perf: self.mode, inline
             if bits is not None:

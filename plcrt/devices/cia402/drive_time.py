@@ -110,6 +110,10 @@ class Timeline:
         *hold*: the drive's own objects at *t_us* are held for the SYNC's
         TPDOs and the bus cycle that follows (:meth:`publish_deferred`)."""
         with self.store.lock:          # a canopen port writes from its Notifier thread
+            if hold and t_us >= self.now and not self._batch and self._eventless():
+                self.now = t_us        # perf: what _advance does when no event can come
+                self.publish_deferred()
+                return
             self._advance(t_us, hold)
 
     def _advance(self, t_us: int, hold: bool = False) -> None:

@@ -418,7 +418,7 @@ class CanopenDrive:
                 if values or clock == "sync":
                     if (0x6060, 0) in values:
                         values = self._rx_values(values)
-                    drive.exchange(t, values)
+                    drive.exchange(t, values, True)     # decoded by the RPDOs' maps
                 if pdos.event_tx:                  # perf: no event-driven TPDO, no search
                     frames += pdos.events(t)
                 if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test

@@ -127,30 +127,32 @@ class ProcessData:
                       else int(get(e.index, e.sub)) for e in tx if e.index}
             return pack(tx, values)
 
-    def exchange(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
+    def exchange(self, t_us: int, values: dict[tuple[int, int], int],
+                 decoded: bool = False) -> None:
         """One bus cycle at *t_us* whose received process data are given
         by object, ``{(index, sub): value}``, instead of as a packed RxPDO
         image: the path of a master module that owns its mapping (the PLC
         coupler).  The objects act as from an RxPDO (in OP only, objects
         before 6040h); the caller reads what it transmits from
-        :attr:`store`."""
+        :attr:`store`.  *decoded*: the values were unpacked from a PDO at
+        each object's own width and signedness, so they fit their types."""
         with self.store.lock:
             if self.deferred is not None:
                 # perf: the values held at the SYNC stay unwritten when the
                 # fast cycle writes its own and reads none of them
                 if values.keys().isdisjoint(self._own):
-                    if self._csp_fast(t_us, None, values):
+                    if self._csp_fast(t_us, None, values, decoded):
                         self.deferred = None
                         return
                     self.flush()
                     self._step(t_us, None, values)
                     return
                 self.flush()
-            if not self._csp_fast(t_us, None, values):
+            if not self._csp_fast(t_us, None, values, decoded):
                 self._step(t_us, None, values)   # the same cycle as cycle()
 
     def _csp_fast(self, t: int, rx: Optional[bytes],
-                  values: Optional[dict[tuple[int, int], int]]) -> bool:
+                  values: Optional[dict[tuple[int, int], int]], fit: bool = False) -> bool:
         """The bus cycle of a drive following CSP set-points, written out:
         what :meth:`_step` does (advance, received objects, the mode's
         cycle, publish) when no event can come, no object the drive acts on
@@ -219,7 +221,7 @@ class ProcessData:
         self.now = t
         store = self.store
         for key, v in changed:
-            if known:
+            if known or fit:           # perf: unpacked at the object's width: it fits
                 store.set_known(key, v)
             else:
                 store.set(key[0], key[1], v)

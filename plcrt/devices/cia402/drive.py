@@ -123,6 +123,7 @@ class Drive(Service, ProcessData, Timeline):
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
         self.deferred: Optional[tuple[int, ...]] = None   # perf: publish_deferred's values
         self._held_state: Optional[tuple[int, ...]] = None   # perf: a state group in range
+        self._fit = False                     # perf: exchange's values fit their types
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write

@@ -97,6 +97,7 @@ class ProcessData:
     _live: dict[tuple[int, int], Any]
     deferred: Optional[tuple[int, ...]]
     _held_state: Optional[tuple[int, ...]]
+    _fit: bool
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
@@ -137,22 +138,23 @@ class ProcessData:
         :attr:`store`.  *decoded*: the values were unpacked from a PDO at
         each object's own width and signedness, so they fit their types."""
         with self.store.lock:
+            self._fit = decoded
             if self.deferred is not None:
                 # perf: the values held at the SYNC stay unwritten when the
                 # fast cycle writes its own and reads none of them
                 if values.keys().isdisjoint(self._own):
-                    if self._csp_fast(t_us, None, values, decoded):
+                    if self._csp_fast(t_us, None, values):
                         self.deferred = None
                         return
                     self.flush()
                     self._step(t_us, None, values)
                     return
                 self.flush()
-            if not self._csp_fast(t_us, None, values, decoded):
+            if not self._csp_fast(t_us, None, values):
                 self._step(t_us, None, values)   # the same cycle as cycle()
 
     def _csp_fast(self, t: int, rx: Optional[bytes],
-                  values: Optional[dict[tuple[int, int], int]], fit: bool = False) -> bool:
+                  values: Optional[dict[tuple[int, int], int]]) -> bool:
         """The bus cycle of a drive following CSP set-points, written out:
         what :meth:`_step` does (advance, received objects, the mode's
         cycle, publish) when no event can come, no object the drive acts on
@@ -183,8 +185,13 @@ class ProcessData:
         window, v_max = live.get(_K6065), live.get(_K6080)
         if window.__class__ is not int or v_max.__class__ is not int:
             return False
-        mech = ax.mechanical(t)
-        pos = mech + ax.shift
+        held = self.deferred
+        if held is None:
+            mech = ax.mechanical(t)
+            pos = mech + ax.shift
+        else:
+            pos = held[1]               # perf: 6064h at t, as publish_deferred found it
+            mech = pos - ax.shift
         fe = csp.demand - pos
         if fe > window or -fe > window:
             return False
@@ -220,8 +227,9 @@ class ProcessData:
         # from here on as _step: the time, then the objects (no hook acts on them)
         self.now = t
         store = self.store
+        fit = known or self._fit       # perf: unpacked at the object's width: it fits
         for key, v in changed:
-            if known or fit:           # perf: unpacked at the object's width: it fits
+            if fit:
                 store.set_known(key, v)
             else:
                 store.set(key[0], key[1], v)
@@ -245,7 +253,7 @@ class ProcessData:
         else:
             num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
             bits, vel = _B12, num // den if num >= 0 else -(-num // den)
-        sm.set_mode_bits(bits)
+        sm._mode_bits = bits     # perf: set_mode_bits of bits that are mode bits (8, 10-15)
         if self.probe.function or live.get(_K60B8):
             self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         # a plant without switches gives 60FDh = 0 wherever the axis is
@@ -439,7 +447,8 @@ class ProcessData:
                 # perf: the CSP line written out: CyclicPosition.bits with no
                 # limit switch, Axis.moving, mechanical and velocity on a line
                 t1 = line.t1
-                sm.set_mode_bits((_B8 if csp.limit_stop else 0) | _B12 | (0 if t < t1 else _B10)
+                # perf: set_mode_bits of bits that are mode bits (8, 10-15)
+                sm._mode_bits = ((_B8 if csp.limit_stop else 0) | _B12 | (0 if t < t1 else _B10)
                                  | (_B13 if csp._fe_since is not None else 0))
                 if t >= t1:
                     mech, vel = line.x1, 0

@@ -259,7 +259,7 @@ class CanPdos:
         holds them (in the order of OWN_KEYS), over the store's values."""
         codec = ch.codec[1] or self._codec(ch)        # perf: the codec at hand
         st, keys, entries, _, get, get_held = codec
-        live = self.drive.store.live
+        live = self.drive._live            # perf: the store's live dict, no property call
         values = get(live) if held is None else get_held(live, held)
         if st is not None:
             return st.pack(*values)

@@ -124,6 +124,11 @@ class Drive(Service, ProcessData, Timeline):
         self.deferred: Optional[tuple[int, ...]] = None   # perf: publish_deferred's values
         self._held_state: Optional[tuple[int, ...]] = None   # perf: a state group in range
         self._fit = False                     # perf: exchange's values fit their types
+        # perf: the motion group is six I32 objects of the type's whole range
+        # (then its range check is a min and a max)
+        self._motion_i32 = all(
+            e is not None and e.dtype == "I32" and (e.low, e.high) == (-2**31, 2**31 - 1)
+            for e in (self.od.find(*k) for k in MOTION_KEYS))
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write

@@ -60,6 +60,7 @@ _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
+_I32_LOW, _I32_HIGH = -0x80000000, 0x7FFFFFFF
 _B8, _B13 = 0x100, 0x2000      # 6041h: limit stop, following error (CyclicPosition.bits)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
@@ -98,6 +99,7 @@ class ProcessData:
     deferred: Optional[tuple[int, ...]]
     _held_state: Optional[tuple[int, ...]]
     _fit: bool
+    _motion_i32: bool
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
@@ -417,7 +419,9 @@ class ProcessData:
         last_motion, last_state = self._published
         store = self.store
         if len(self._own) == len(OUTPUTS) \
-                and (motion == last_motion or store.fits_group(MOTION_KEYS, motion)) \
+                and (motion == last_motion
+                     or (_I32_LOW <= min(motion) and max(motion) <= _I32_HIGH
+                         if self._motion_i32 else store.fits_group(MOTION_KEYS, motion))) \
                 and (state == last_state or state == self._held_state
                      or store.fits_group(STATE_KEYS, state)):
             self._held_state = state   # perf: found in range: the same state is again
@@ -505,7 +509,10 @@ class ProcessData:
             return
         store, out = self.store, self._out
         if len(self._own) == len(OUTPUTS) \
-                and (not new_motion or store.fits_group(MOTION_KEYS, motion)) \
+                and (not new_motion or (
+                    # perf: six I32 objects of the type's range: min and max tell
+                    _I32_LOW <= min(motion) and max(motion) <= _I32_HIGH if self._motion_i32
+                    else store.fits_group(MOTION_KEYS, motion))) \
                 and (not new_state or store.fits_group(STATE_KEYS, state)):
             # perf: each group's dict is kept and refilled, then merged whole
             if new_motion:

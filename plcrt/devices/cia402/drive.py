@@ -39,7 +39,8 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from .axis import Axis
-from .drive_io import CW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS, ProcessData
+from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS,
+                       ProcessData)
 from .drive_service import Service, TouchProbe, cite
 from .drive_time import Timeline
 from .esm import AlResult, Esm, EsmState
@@ -434,6 +435,39 @@ class Drive(Service, ProcessData, Timeline):
         finally:
             self._batch = False
         self.publish()
+
+    def publish_deferred(self) -> None:
+        """:meth:`publish` for a SYNC whose bus cycle follows at once: the
+        values are computed now (the statusword's mode bits and the touch
+        probe as publish sets them) and held in :attr:`deferred`, in the
+        order of OWN_KEYS, for the synchronous TPDOs sampled before the
+        cycle; the cycle (:meth:`exchange`) writes its own values, or first
+        these (:meth:`flush`) where it takes the general path.  Written at
+        once when the model lacks one of its own objects or a value does
+        not fit its object (publish's other path)."""
+        # perf: the SYNC's two publishes (at the SYNC, after the cycle's
+        # set-points) write the store once; a group equal to the one written
+        # last was checked when written
+        motion, state = self._outputs()
+        last_motion, last_state = self._published
+        store = self.store
+        if len(self._own) == len(OUTPUTS) \
+                and (motion == last_motion
+                     or (I32_LOW <= min(motion) and max(motion) <= I32_HIGH
+                         if self._motion_i32 else store.fits_group(MOTION_KEYS, motion))) \
+                and (state == last_state or state == self._held_state
+                     or store.fits_group(STATE_KEYS, state)):
+            self._held_state = state   # perf: found in range: the same state is again
+            self.deferred = motion + state
+        else:
+            self._publish_values(motion, state)
+
+    def flush(self) -> None:
+        """Write the values :meth:`publish_deferred` holds, if any."""
+        held = self.deferred
+        if held is not None:
+            self.deferred = None
+            self._publish_values(held[:6], held[6:])
 
     @property
     def statusword(self) -> int:

@@ -29,8 +29,8 @@ from .plant import DrivePlant
 from .statemachine import State
 from .store import key
 
-__all__ = ["ProcessData", "CW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS", "OWN_KEYS",
-           "STATE_KEYS"]
+__all__ = ["ProcessData", "CW", "I32_HIGH", "I32_LOW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS",
+           "OWN_KEYS", "STATE_KEYS"]
 
 #: The drive's own objects, written by :meth:`ProcessData.publish`.
 #: 6063h (position actual internal value) reads as 6064h: neither model has a
@@ -60,7 +60,7 @@ _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
-_I32_LOW, _I32_HIGH = -0x80000000, 0x7FFFFFFF
+I32_LOW, I32_HIGH = -0x80000000, 0x7FFFFFFF    # the range of an I32 object
 _B8, _B13 = 0x100, 0x2000      # 6041h: limit stop, following error (CyclicPosition.bits)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
@@ -138,7 +138,9 @@ class ProcessData:
         coupler).  The objects act as from an RxPDO (in OP only, objects
         before 6040h); the caller reads what it transmits from
         :attr:`store`.  *decoded*: the values were unpacked from a PDO at
-        each object's own width and signedness, so they fit their types."""
+        each object's own width and signedness, so they fit their types.
+        After :meth:`~.drive.Drive.publish_deferred` (a SYNC), the values it
+        holds are written first unless the fast CSP cycle writes its own."""
         with self.store.lock:
             self._fit = decoded
             if self.deferred is not None:
@@ -403,39 +405,6 @@ class ProcessData:
         """Write the drive's own objects for the present time."""
         self._publish_values(*self._outputs())
 
-    def publish_deferred(self) -> None:
-        """:meth:`publish` for a SYNC whose bus cycle follows at once: the
-        values are computed now (the statusword's mode bits and the touch
-        probe as publish sets them) and held in :attr:`deferred`, in the
-        order of OWN_KEYS, for the synchronous TPDOs sampled before the
-        cycle; the cycle (:meth:`exchange`) writes its own values, or first
-        these (:meth:`flush`) where it takes the general path.  Written at
-        once when the model lacks one of its own objects or a value does
-        not fit its object (publish's other path)."""
-        # perf: the SYNC's two publishes (at the SYNC, after the cycle's
-        # set-points) write the store once; a group equal to the one written
-        # last was checked when written
-        motion, state = self._outputs()
-        last_motion, last_state = self._published
-        store = self.store
-        if len(self._own) == len(OUTPUTS) \
-                and (motion == last_motion
-                     or (_I32_LOW <= min(motion) and max(motion) <= _I32_HIGH
-                         if self._motion_i32 else store.fits_group(MOTION_KEYS, motion))) \
-                and (state == last_state or state == self._held_state
-                     or store.fits_group(STATE_KEYS, state)):
-            self._held_state = state   # perf: found in range: the same state is again
-            self.deferred = motion + state
-        else:
-            self._publish_values(motion, state)
-
-    def flush(self) -> None:
-        """Write the values :meth:`publish_deferred` holds, if any."""
-        held = self.deferred
-        if held is not None:
-            self.deferred = None
-            self._publish_values(held[:6], held[6:])
-
     def _outputs(self) -> tuple[tuple[int, int, int, int, int, int],
                                 tuple[int, int, int, int, int]]:
         """The drive's own objects for the present time: (motion, state) as
@@ -511,7 +480,7 @@ class ProcessData:
         if len(self._own) == len(OUTPUTS) \
                 and (not new_motion or (
                     # perf: six I32 objects of the type's range: min and max tell
-                    _I32_LOW <= min(motion) and max(motion) <= _I32_HIGH if self._motion_i32
+                    I32_LOW <= min(motion) and max(motion) <= I32_HIGH if self._motion_i32
                     else store.fits_group(MOTION_KEYS, motion))) \
                 and (not new_state or store.fits_group(STATE_KEYS, state)):
             # perf: each group's dict is kept and refilled, then merged whole

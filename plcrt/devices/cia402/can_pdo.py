@@ -44,6 +44,7 @@ from operator import itemgetter
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
+from .drive_io import OWN_KEYS
 from .od import SdoAbort
 from .pdo import MapEntry, MapLayout, PdoConfig, pack, unpack
 
@@ -247,21 +248,25 @@ class CanPdos:
             keys.append((e.index, e.sub))
         size = (sum(e.bits for e in entries) + 7) // 8
         keys = tuple(keys)
-        codec = (struct.Struct(fmt) if ok else None, keys, entries, size, _getter(keys))
+        codec = (struct.Struct(fmt) if ok else None, keys, entries, size, _getter(keys),
+                 _held_getter(keys))
         ch.codec = (entries, codec)
         return codec
 
-    def sample(self, ch: Channel) -> bytes:
-        """The TPDO's data now, from the drive's objects."""
+    def sample(self, ch: Channel, held: Optional[tuple[int, ...]] = None) -> bytes:
+        """The TPDO's data now, from the drive's objects; *held*: the
+        drive's own objects as :meth:`~.drive_io.ProcessData.publish_deferred`
+        holds them (in the order of OWN_KEYS), over the store's values."""
         codec = ch.codec[1] or self._codec(ch)        # perf: the codec at hand
-        st, keys, entries, _, get = codec
-        live = self.drive.store.live
+        st, keys, entries, _, get, get_held = codec
+        live = self.drive._live            # perf: the store's live dict, no property call
+        values = get(live) if held is None else get_held(live, held)
         if st is not None:
-            return st.pack(*get(live))
-        return pack(entries, {k: int(live[k]) for k in keys})
+            return st.pack(*values)
+        return pack(entries, {k: int(v) for k, v in zip(keys, values)})
 
     def decode(self, ch: Channel, data: bytes) -> dict[tuple[int, int], int]:
-        st, keys, entries, size, _ = ch.codec[1] or self._codec(ch)
+        st, keys, entries, size, *_ = ch.codec[1] or self._codec(ch)
         if st is not None:
             return dict(zip(keys, st.unpack_from(data)))
         return unpack(entries, bytes(data[:size]), self.drive._signed)
@@ -295,9 +300,11 @@ class CanPdos:
             return None
         return self.decode(ch, data)
 
-    def on_sync(self, t: int) -> tuple[list[Frame], dict[tuple[int, int], int]]:
-        """A SYNC: the synchronous TPDOs sampled now, and the objects of the
-        RPDOs buffered since the last SYNC (CiA 301 §7.2.2.2)."""
+    def on_sync(self, t: int, held: Optional[tuple[int, ...]] = None
+                ) -> tuple[list[Frame], dict[tuple[int, int], int]]:
+        """A SYNC: the synchronous TPDOs sampled now (*held*: as for
+        :meth:`sample`), and the objects of the RPDOs buffered since the
+        last SYNC (CiA 301 §7.2.2.2)."""
         frames: list[Frame] = []
         values: dict[tuple[int, int], int] = {}
         if not self.active:
@@ -308,14 +315,14 @@ class CanPdos:
                 ch.pending = None
         for ch in self.sync_tx:
             if ch.trans == 0:
-                data = self.sample(ch)
+                data = self.sample(ch, held)
                 if data != ch.sent:
                     frames.append(self._sent(ch, data, t))
                 continue
             ch.syncs += 1
             if ch.syncs >= ch.trans:
                 ch.syncs = 0
-                data = self.sample(ch)
+                data = self.sample(ch, held)
                 ch.sent, ch.sent_at = data, t           # perf: _sent inline
                 frames.append((ch.cob_id & 0x7FF, data))
         return frames, values
@@ -362,3 +369,19 @@ def _getter(keys: tuple) -> Callable[[Any], tuple]:
         one = keys[0]
         return lambda live: (live[one],)
     return lambda live: ()
+
+
+def _held_getter(keys: tuple) -> Callable[[Any, tuple], tuple]:
+    """A function of (a mapping, the drive's held own objects in the order
+    of OWN_KEYS) that gives the values of *keys* as a tuple, an own object
+    from the held values, any other from the mapping."""
+    # perf: the values picked by position from one tuple, no dict built
+    extra = tuple(k for k in keys if k not in OWN_KEYS)
+    at = [OWN_KEYS.index(k) if k in OWN_KEYS else len(OWN_KEYS) + extra.index(k)
+          for k in keys]
+    pick = itemgetter(*at) if len(at) > 1 else (
+        (lambda values, one=at[0]: (values[one],)) if at else (lambda values: ()))
+    if not extra:
+        return lambda live, held: pick(held)
+    get_extra = _getter(extra)
+    return lambda live, held: pick(held + get_extra(live))

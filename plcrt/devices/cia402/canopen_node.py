@@ -408,21 +408,24 @@ class CanopenDrive:
                 drive, pdos, clock = self.drive, self.pdos, self.clock
                 if clock == "sync":
                     t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
-                    drive.advance(t)
+                    # perf: the objects at the SYNC held for its TPDOs, not
+                    # written: exchange() below writes the cycle's
+                    drive.advance(t, hold=True)
                 elif clock == "wall":
                     self._catch_up()
                 t = drive.now
-                frames, values = pdos.on_sync(t)
+                frames, values = pdos.on_sync(t, drive.deferred)
                 if values or clock == "sync":
                     if (0x6060, 0) in values:
                         values = self._rx_values(values)
-                    drive.exchange(t, values)
+                    drive.exchange(t, values, True)     # decoded by the RPDOs' maps
                 if pdos.event_tx:                  # perf: no event-driven TPDO, no search
                     frames += pdos.events(t)
                 if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test
                     self._check_emcy()
         except Exception:
             log.exception("node %d: SYNC failed", self.drive.node_id)
+            self.drive.flush()
         send = self.network.send_message
         for can_id, data in frames:
             try:

@@ -39,7 +39,8 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from .axis import Axis
-from .drive_io import CW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS, ProcessData
+from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS,
+                       ProcessData)
 from .drive_service import Service, TouchProbe, cite
 from .drive_time import Timeline
 from .esm import AlResult, Esm, EsmState
@@ -121,6 +122,14 @@ class Drive(Service, ProcessData, Timeline):
         self._csp_codec: tuple = ((), None)   # perf: the same for the CSP fast cycle
         self._tx_codec: tuple = ((), None)    # perf: (active_tx, _tx_fast_codec of it)
         self._published: tuple = (None, None)  # perf: the groups publish wrote last
+        self.deferred: Optional[tuple[int, ...]] = None   # perf: publish_deferred's values
+        self._held_state: Optional[tuple[int, ...]] = None   # perf: a state group in range
+        self._fit = False                     # perf: exchange's values fit their types
+        # perf: the motion group is six I32 objects of the type's whole range
+        # (then its range check is a min and a max)
+        self._motion_i32 = all(
+            e is not None and e.dtype == "I32" and (e.low, e.high) == (-2**31, 2**31 - 1)
+            for e in (self.od.find(*k) for k in MOTION_KEYS))
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write
@@ -240,6 +249,9 @@ class Drive(Service, ProcessData, Timeline):
     # ---------------------------------------------------------------- master side
     def sdo_read(self, index: int, sub: int = 0) -> bytes:
         """SDO upload (the store's rules)."""
+        if self.deferred is not None:
+            with self.store.lock:
+                self.flush()           # the values held at a SYNC, if a read comes between
         if index in self.pdo.entries:
             return self.od.entry(index, sub).encode(self.pdo.read(index, sub))
         if index == 0x2012:
@@ -423,6 +435,39 @@ class Drive(Service, ProcessData, Timeline):
         finally:
             self._batch = False
         self.publish()
+
+    def publish_deferred(self) -> None:
+        """:meth:`publish` for a SYNC whose bus cycle follows at once: the
+        values are computed now (the statusword's mode bits and the touch
+        probe as publish sets them) and held in :attr:`deferred`, in the
+        order of OWN_KEYS, for the synchronous TPDOs sampled before the
+        cycle; the cycle (:meth:`exchange`) writes its own values, or first
+        these (:meth:`flush`) where it takes the general path.  Written at
+        once when the model lacks one of its own objects or a value does
+        not fit its object (publish's other path)."""
+        # perf: the SYNC's two publishes (at the SYNC, after the cycle's
+        # set-points) write the store once; a group equal to the one written
+        # last was checked when written
+        motion, state = self._outputs()
+        last_motion, last_state = self._published
+        store = self.store
+        if len(self._own) == len(OUTPUTS) \
+                and (motion == last_motion
+                     or (I32_LOW <= min(motion) and max(motion) <= I32_HIGH
+                         if self._motion_i32 else store.fits_group(MOTION_KEYS, motion))) \
+                and (state == last_state or state == self._held_state
+                     or store.fits_group(STATE_KEYS, state)):
+            self._held_state = state   # perf: found in range: the same state is again
+            self.deferred = motion + state
+        else:
+            self._publish_values(motion, state)
+
+    def flush(self) -> None:
+        """Write the values :meth:`publish_deferred` holds, if any."""
+        held = self.deferred
+        if held is not None:
+            self.deferred = None
+            self._publish_values(held[:6], held[6:])
 
     @property
     def statusword(self) -> int:

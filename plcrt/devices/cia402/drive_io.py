@@ -29,7 +29,8 @@ from .plant import DrivePlant
 from .statemachine import State
 from .store import key
 
-__all__ = ["ProcessData", "CW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS", "STATE_KEYS"]
+__all__ = ["ProcessData", "CW", "I32_HIGH", "I32_LOW", "MISSING", "MOTION_KEYS", "OE", "OUTPUTS",
+           "OWN_KEYS", "STATE_KEYS"]
 
 #: The drive's own objects, written by :meth:`ProcessData.publish`.
 #: 6063h (position actual internal value) reads as 6064h: neither model has a
@@ -42,6 +43,8 @@ MOTION_KEYS = _K6062, _K6064, _K606C, _K60F4, _K6063, _K606B = tuple(
     key(i, 0) for i in (0x6062, 0x6064, 0x606C, 0x60F4, 0x6063, 0x606B))
 STATE_KEYS = _K6041, _K6061, _K603F, _K1001, _K60FD = tuple(
     key(i, 0) for i in (0x6041, 0x6061, 0x603F, 0x1001, 0x60FD))
+#: The order of the values :meth:`ProcessData.publish_deferred` holds.
+OWN_KEYS = MOTION_KEYS + STATE_KEYS
 #: Objects whose write the drive's hook acts on whatever the mode (6040h
 #: controlword, 6060h mode, 605Ah/6084h/6085h read by the state machine).
 _HOOK_INDEXES = frozenset({0x6040, 0x6060, 0x605A, 0x6084, 0x6085})
@@ -57,6 +60,8 @@ _CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
 _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
+I32_LOW, I32_HIGH = -0x80000000, 0x7FFFFFFF    # the range of an I32 object
+_B8, _B13 = 0x100, 0x2000      # 6041h: limit stop, following error (CyclicPosition.bits)
 # perf: a DrivePlant with these fields only reads 60FDh from its switches
 # (plant.py as written with this module); other fields turn the shortcut off
 _PLAIN_PLANT = {f.name for f in fields(DrivePlant)} == {
@@ -91,6 +96,10 @@ class ProcessData:
     stops: Any
     probe: Any
     _live: dict[tuple[int, int], Any]
+    deferred: Optional[tuple[int, ...]]
+    _held_state: Optional[tuple[int, ...]]
+    _fit: bool
+    _motion_i32: bool
     _out: dict[tuple[int, int], int]
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
@@ -121,14 +130,30 @@ class ProcessData:
                       else int(get(e.index, e.sub)) for e in tx if e.index}
             return pack(tx, values)
 
-    def exchange(self, t_us: int, values: dict[tuple[int, int], int]) -> None:
+    def exchange(self, t_us: int, values: dict[tuple[int, int], int],
+                 decoded: bool = False) -> None:
         """One bus cycle at *t_us* whose received process data are given
         by object, ``{(index, sub): value}``, instead of as a packed RxPDO
         image: the path of a master module that owns its mapping (the PLC
         coupler).  The objects act as from an RxPDO (in OP only, objects
         before 6040h); the caller reads what it transmits from
-        :attr:`store`."""
+        :attr:`store`.  *decoded*: the values were unpacked from a PDO at
+        each object's own width and signedness, so they fit their types.
+        After :meth:`~.drive.Drive.publish_deferred` (a SYNC), the values it
+        holds are written first unless the fast CSP cycle writes its own."""
         with self.store.lock:
+            self._fit = decoded
+            if self.deferred is not None:
+                # perf: the values held at the SYNC stay unwritten when the
+                # fast cycle writes its own and reads none of them
+                if values.keys().isdisjoint(self._own):
+                    if self._csp_fast(t_us, None, values):
+                        self.deferred = None
+                        return
+                    self.flush()
+                    self._step(t_us, None, values)
+                    return
+                self.flush()
             if not self._csp_fast(t_us, None, values):
                 self._step(t_us, None, values)   # the same cycle as cycle()
 
@@ -164,8 +189,13 @@ class ProcessData:
         window, v_max = live.get(_K6065), live.get(_K6080)
         if window.__class__ is not int or v_max.__class__ is not int:
             return False
-        mech = ax.mechanical(t)
-        pos = mech + ax.shift
+        held = self.deferred
+        if held is None:
+            mech = ax.mechanical(t)
+            pos = mech + ax.shift
+        else:
+            pos = held[1]               # perf: 6064h at t, as publish_deferred found it
+            mech = pos - ax.shift
         fe = csp.demand - pos
         if fe > window or -fe > window:
             return False
@@ -201,8 +231,9 @@ class ProcessData:
         # from here on as _step: the time, then the objects (no hook acts on them)
         self.now = t
         store = self.store
+        fit = known or self._fit       # perf: unpacked at the object's width: it fits
         for key, v in changed:
-            if known:
+            if fit:
                 store.set_known(key, v)
             else:
                 store.set(key[0], key[1], v)
@@ -226,7 +257,7 @@ class ProcessData:
         else:
             num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
             bits, vel = _B12, num // den if num >= 0 else -(-num // den)
-        sm.set_mode_bits(bits)
+        sm._mode_bits = bits     # perf: set_mode_bits of bits that are mode bits (8, 10-15)
         if self.probe.function or live.get(_K60B8):
             self._probe_update(t, mech)            # touch probe armed (drive_service.py)
         # a plant without switches gives 60FDh = 0 wherever the axis is
@@ -372,8 +403,44 @@ class ProcessData:
     # ---------------------------------------------------------------- outputs
     def publish(self) -> None:
         """Write the drive's own objects for the present time."""
+        self._publish_values(*self._outputs())
+
+    def _outputs(self) -> tuple[tuple[int, int, int, int, int, int],
+                                tuple[int, int, int, int, int]]:
+        """The drive's own objects for the present time: (motion, state) as
+        :meth:`_publish_values` takes them.  Sets the statusword's mode
+        bits and updates the touch probe."""
         t = self.now
         ax, sm = self.axis, self.sm
+        line, plant = ax._line, self.plant
+        if (line is not None and sm.state is OE and self.mode_number == 8 and self.stops is None
+                and plant.pos_limit is None and plant.neg_limit is None and ax.bounds is None):
+            csp = self.engines[8]
+            if csp.__class__ is CyclicPosition:
+                # perf: the CSP line written out: CyclicPosition.bits with no
+                # limit switch, Axis.moving, mechanical and velocity on a line
+                t1 = line.t1
+                # perf: set_mode_bits of bits that are mode bits (8, 10-15)
+                sm._mode_bits = ((_B8 if csp.limit_stop else 0) | _B12 | (0 if t < t1 else _B10)
+                                 | (_B13 if csp._fe_since is not None else 0))
+                if t >= t1:
+                    mech, vel = line.x1, 0
+                else:
+                    t0 = line.t0
+                    span, den = line.x1 - line.x0, t1 - t0
+                    mech = line.x0 + span * ((t0 if t < t0 else t) - t0) // den
+                    if t < t0:
+                        vel = 0
+                    else:
+                        num = span * US
+                        vel = num // den if num >= 0 else -(-num // den)
+                pos = mech + ax.shift
+                if self.probe.function or self._live.get(_K60B8):
+                    self._probe_update(t, mech)            # touch probe armed (drive_service.py)
+                inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
+                    and plant.home_switch is None else plant.inputs(mech)
+                return ((csp.demand, pos, vel, csp.following_error, pos, vel),
+                        (sm.statusword, 8, sm.error_code, sm.error_register, inputs))
         if sm.state is OE:
             bits = self.engines[self.mode_number].bits(t)    # perf: self.mode, inline
             if bits is not None:
@@ -393,11 +460,10 @@ class ProcessData:
             demand = ax.demand_position(t)      # past a mechanical end (stops.py)
             fe = demand - pos
         vel = ax.velocity(t)
-        self._publish_values(
-            (demand, pos, vel, fe, pos,
-             vel if self.stops is None else int(ax.demand(t)[1])),
-            (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
-             self.plant.inputs(mech)))
+        return ((demand, pos, vel, fe, pos,
+                 vel if self.stops is None else int(ax.demand(t)[1])),
+                (sm.statusword, self.mode_number, sm.error_code, sm.error_register,
+                 self.plant.inputs(mech)))
 
     def _publish_values(self, motion: tuple[int, int, int, int],
                         state: tuple[int, int, int, int, int]) -> None:
@@ -412,7 +478,10 @@ class ProcessData:
             return
         store, out = self.store, self._out
         if len(self._own) == len(OUTPUTS) \
-                and (not new_motion or store.fits_group(MOTION_KEYS, motion)) \
+                and (not new_motion or (
+                    # perf: six I32 objects of the type's range: min and max tell
+                    I32_LOW <= min(motion) and max(motion) <= I32_HIGH if self._motion_i32
+                    else store.fits_group(MOTION_KEYS, motion))) \
                 and (not new_state or store.fits_group(STATE_KEYS, state)):
             # perf: each group's dict is kept and refilled, then merged whole
             if new_motion:

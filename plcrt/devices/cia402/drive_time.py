@@ -105,12 +105,18 @@ class Timeline:
                 offer(te, "stop", ev)
         return best
 
-    def advance(self, t_us: int) -> None:
-        """Move simulated time forward to *t_us* (integer µs), exactly."""
+    def advance(self, t_us: int, hold: bool = False) -> None:
+        """Move simulated time forward to *t_us* (integer µs), exactly.
+        *hold*: the drive's own objects at *t_us* are held for the SYNC's
+        TPDOs and the bus cycle that follows (:meth:`publish_deferred`)."""
         with self.store.lock:          # a canopen port writes from its Notifier thread
-            self._advance(t_us)
+            if hold and t_us >= self.now and not self._batch and self._eventless():
+                self.now = t_us        # perf: what _advance does when no event can come
+                self.publish_deferred()
+                return
+            self._advance(t_us, hold)
 
-    def _advance(self, t_us: int) -> None:
+    def _advance(self, t_us: int, hold: bool = False) -> None:
         if t_us < self.now:
             raise PlcError(f"drive time cannot go back: now {self.now} µs, asked {t_us} µs")
         for _ in range(_MAX_EVENTS):
@@ -154,4 +160,7 @@ class Timeline:
                            "(a homing plan that does not move on?)")
         self.now = t_us
         if not self._batch:
-            self.publish()
+            if hold:
+                self.publish_deferred()
+            else:
+                self.publish()

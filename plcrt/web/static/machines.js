@@ -64,9 +64,11 @@
         if (!r) { r = s(parts, "rect", { "data-part": p.id }); byId.set(p.id, r); }
         const tall = p.kind === "tall";
         const hgt = tall ? 44 : 24;
-        r.setAttribute("x", X(num(p.x) - num(st.part, 100)).toFixed(2));
+        // the part still in the feeder (x < part) shows only what is on the belt
+        const left = Math.max(0, num(p.x) - num(st.part, 100));
+        r.setAttribute("x", X(left).toFixed(2));
         r.setAttribute("y", String(100 - hgt));
-        r.setAttribute("width", (num(st.part, 100) * k).toFixed(2));
+        r.setAttribute("width", (Math.max(0, num(p.x) - left) * k).toFixed(2));
         r.setAttribute("height", String(hgt));
         r.setAttribute("class", "part " + (tall ? "tall" : "short") + (p.jammed ? " jammed" : ""));
       }

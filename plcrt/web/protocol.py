@@ -101,15 +101,22 @@ CLIENT: dict[str, tuple[dict[str, Field], str]] = {
     "lesson": ({"id": Field("str", doc="a lesson folder name of the course")},
                "load that lesson's program (every client gets a new hello)"),
     "check": ({}, "run the current lesson's tests ('check my program')"),
+    "machine": ({"machine": Field("str", doc="a machine's name in the plant"),
+                 "action": Field("enum", choices=("press", "hold", "release", "fault_on",
+                                                  "fault_off")),
+                 "name": Field("str", doc="a button of the machine (press, hold, release) "
+                                          "or one of its faults (fault_on, fault_off)")},
+                "press (for 0.3 s), hold or release a machine's button; switch a fault"),
 }
 
 #: server -> client: type -> what it carries
 SERVER: dict[str, str] = {
     "hello": "the program: blocks with their networks (SVG or STL), symbols, inputs and "
-             "outputs, axes and drives with their plant marks, lessons, the current lesson",
+             "outputs, axes and drives with their plant marks, lessons, the current lesson, "
+             "the machines with their buttons and faults",
     "frame": "the newest state: time, scans, run state, speed, per-network status of the "
              "viewed blocks, inputs, outputs, watch table, forces, breakpoints, axes, drives, "
-             "new trend samples",
+             "new trend samples, each machine's state",
     "trend": "the whole trend buffer (answer to history, or after trend)",
     "error": "a request that failed: message, and the request's id and type",
     "notice": "something the user should read: a breakpoint reached, a condition met, "

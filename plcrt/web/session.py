@@ -51,6 +51,8 @@ from ..safetext import printable
 from ..testing.harness import Harness, condition
 from .builds import Builds
 from .diagnostics import DiagnosticLog
+from .machines import apply as machine_apply
+from .machines import machine_info, machine_states
 from .mailbox import Client, Mailbox
 from .present import INPUT_KINDS, input_kinds, io_bits
 from .program import ProgramView
@@ -172,7 +174,8 @@ class PanelSession:
         if self._hello is None:
             self._hello = self.program.hello(self.plc, self.inputs, self.outputs, self.kinds,
                                              self.builds.breakable)
-        return {**self._hello, "diagnostics": self.diagnostics.shown}
+        return {**self._hello, "diagnostics": self.diagnostics.shown,
+                "machines": machine_info(self.plc)}
 
     # ------------------------------------------------------------------
     # The runner thread
@@ -317,6 +320,9 @@ class PanelSession:
     def _do_unforce(self, client: Client | None, msg: dict[str, Any]) -> None:
         self.plc.unforce(msg.get("addr"))
 
+    def _do_machine(self, client: Client | None, msg: dict[str, Any]) -> None:
+        machine_apply(self.plc, msg)
+
     def _do_watch(self, client: Client | None, msg: dict[str, Any]) -> None:
         self.watch_table.add(self.plc, msg["spec"], msg.get("format", "auto"))
 
@@ -459,7 +465,7 @@ class PanelSession:
             "breaks": self.builds.names(plc),
             "axes": [dict(a.to_dict()) for a in plc.axes()],
             "drives": [dict(d.to_dict()) for d in plc.drives()],
-            "trend": trend,
+            "trend": trend, "machines": machine_states(plc),
             "until": control.until[1] if control.until else None,
         }
 

@@ -41,10 +41,10 @@ def test_program_text_cannot_run_script_or_inject_elements(serve, page) -> None:
     page.wait_for_function("() => window.plcrtPanel.frame.scans === 1")
     page.wait_for_timeout(300)
     assert page.evaluate("() => window.__pwned") is None
-    # the page's own scripts only: the panel, the editor and its CodeMirror
-    # bundle, the ladder drawing
+    # the page's own scripts only: the panel, the machines, the editor and
+    # its CodeMirror bundle, the ladder drawing
     assert page.evaluate("() => [...document.scripts].map(s => new URL(s.src).pathname)") == [
-        "/static/panel.js", "/static/vendor/codemirror.min.js", "/static/editor.js",
+        "/static/panel.js", "/static/machines.js", "/static/vendor/codemirror.min.js", "/static/editor.js",
         "/static/ladder_edit.js"]
     assert page.locator("img, iframe").count() == 0
     assert page.locator("#networks svg svg, #networks foreignObject").count() == 0

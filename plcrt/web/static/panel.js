@@ -100,6 +100,7 @@ function onHello(h) {
   onDiagnostics(h.diagnostics || { items: [], more: null });
   ariaIO(P.frame);
   if (window.plcrtEditor) window.plcrtEditor.onHello(h);   // editor.js
+  if (window.plcrtMachines) window.plcrtMachines.onHello(h);   // machines.js
 }
 
 function buildTabs(h) {
@@ -323,6 +324,7 @@ function onFrame(f) {
   renderWatch(f);
   trendFrame(f.trend);
   axesFrame(f);
+  if (window.plcrtMachines) window.plcrtMachines.onFrame(f);   // machines.js
 }
 
 // ---------------------------------------------------------------- watch table

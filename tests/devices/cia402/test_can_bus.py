@@ -349,3 +349,32 @@ def test_connecting_twice_or_with_python_can_arguments_is_a_config_error(request
         net.disconnect()
     with pytest.raises(PlcConfigError, match="channel only, not bitrate, interface"):
         type(net)().connect("x", interface="virtual", bitrate=500_000)
+
+
+def test_sdo_reads_between_syncs_see_the_drives_current_objects(local):
+    """A SYNC samples the TPDOs from values the drive holds for its bus cycle
+    and writes its store once; an SDO read that comes between two SYNCs
+    still answers the drive's current objects (6064h and 6041h as the axis
+    and the state machine give them at the drive's time)."""
+    dev, mst = local
+    sim = cia402.attach(dev, 9, clock="sync")
+    try:
+        n = master(mst, 9)
+        n.sdo[0x1006].raw = 1000
+        tpdo, rpdo = remap_sync(n, sim)
+        n.nmt.state = "OPERATIONAL"
+        assert wait_for(lambda: sim.drive.esm.state is EsmState.OP)
+        d = sim.drive
+        steps = [(cw, 0) for cw in (0x06, 0x07, 0x0F, 0x0F)]
+        steps += [(0x0F, trajectory(j)) for j in range(40)]
+        for k, (cw, target) in enumerate(steps):
+            if k % 4 != 3:          # every fourth cycle: a SYNC without a new RPDO
+                rpdo[0x6040].raw, rpdo[0x607A].raw = cw, target
+                rpdo.transmit()
+            mst.sync.transmit()
+            if k % 2 == 1:
+                assert struct.unpack("<i", n.sdo.upload(0x6064, 0))[0] == d.position, k
+                assert struct.unpack("<H", n.sdo.upload(0x6041, 0))[0] == d.statusword, k
+        assert d.position == trajectory(39 if 39 % 4 != 3 else 38)
+    finally:
+        sim.close()

@@ -218,7 +218,7 @@ def _docs(files: list[Path]) -> dict[str, str]:
     for f in files:
         try:
             tree = ast.parse(_read(f))
-        except (OSError, SyntaxError, ValueError):
+        except (OSError, SyntaxError, ValueError, RecursionError, MemoryError):
             continue
         for node in tree.body:
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and \

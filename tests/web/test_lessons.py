@@ -105,3 +105,21 @@ def test_a_huge_text_is_cut() -> None:
     doc = markdown.parse("word " * (markdown.MAX_CHARS // 2))
     assert "cut after" in doc[-1]["p"][0]["t"]
     assert sum(len(s["t"]) for b in doc for s in b["p"]) < markdown.MAX_CHARS + 100
+
+
+def test_check_lists_requirements_and_keeps_the_first_failure(tmp_path) -> None:
+    """A test is listed by its docstring's first paragraph (by its name in
+    words without one, with its parameters); a failure by its assertion's
+    own message; a long output keeps its start and its end."""
+    from plcrt.web.course import OUTPUT_CHARS, _clip, _docs, _message
+    f = tmp_path / "test_x.py"
+    f.write_text('def test_a():\n    """The lamp is lit\n    at 1 s.\n\n    More."""\n\n'
+                 'def test_b_no_doc():\n    pass\n')
+    assert _docs([f]) == {"test_a": "The lamp is lit at 1 s."}
+    assert _message("AssertionError: the lamp was dark at 1.00 s\nassert 0 == 1") == \
+        "the lamp was dark at 1.00 s"
+    assert _message("AssertionError: assert 0 == 1\n +  where 0 = f()") == \
+        "assert 0 == 1\n +  where 0 = f()"
+    out = _clip("FIRST failure" + "x" * (3 * OUTPUT_CHARS) + "summary")
+    assert out.startswith("FIRST failure") and out.endswith("summary")
+    assert len(out) < OUTPUT_CHARS + 100

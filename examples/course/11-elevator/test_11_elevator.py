@@ -110,3 +110,25 @@ def test_without_calls_the_car_stands(plc, car):
     assert st["car"] == 0 and st["door"] == 0, (
         f"with no call, after 10 s the car was at {st['car']:.0f} mm with its door "
         f"{st['door']:.0%} open")
+
+
+def test_a_jammed_door_keeps_the_car_at_its_floor(plc, car):
+    """With its door jammed open at floor 3 the car stays there, whatever is called."""
+    visits, _ = ride(plc, car, {0.0: 3}, 30)
+    if not any(f == 3 for _, f in visits):
+        pytest.fail(f"the door never opened at floor 3 in 30 s (doors opened at: {shown(visits)}), "
+                    f"so it could not jam there")
+    # open the door again at floor 3 and jam it while it is open
+    ride(plc, car, {plc.time: 3}, plc.time + 0.5)
+    for _ in range(1000):
+        if car.state()["door"] > 0.5:
+            break
+        plc.run(scans=1)
+    car.fault("door_jam")
+    at, height = plc.time, car.state()["car"]
+    ride(plc, car, {plc.time: 1, plc.time + 5: 2}, plc.time + 30)
+    st = car.state()
+    assert st["car"] == height and st["unsafe_moves"] == 0, (
+        f"the door jammed {st['door']:.0%} open at {at:.2f} s with the car at {height:.0f} mm "
+        f"(floor 3); at {plc.time:.2f} s the car was at {st['car']:.0f} mm after "
+        f"{st['unsafe_moves']} move(s) with the door open")

@@ -95,3 +95,34 @@ def test_a_run_of_the_whole_course_leaves_the_exercises_out() -> None:
     assert "01-seal-in/test_01_seal_in.py" in whole and "test_07_" not in whole
     one = collected("examples/course/07-traffic-blink")
     assert "test_07_traffic_blink.py::test_the_yellow_light_blinks_at_1_hz" in one
+
+
+BLINK = """ORGANIZATION_BLOCK MAIN:OB1
+TITLE=a blink built from a timer
+BEGIN
+Network 1
+LDN    T37
+TON    T37, +{period}
+Network 2
+LDW<   T37, +{half}
+=      Q0.1
+END_ORGANIZATION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("period, half, ok", [(10, 5, True), (20, 10, False), (10, 2, False)])
+def test_the_blink_grader_judges_the_light_not_the_program(period, half, ok, tmp_path,
+                                                           monkeypatch) -> None:
+    """Another right program (a timer that restarts itself, 1 Hz) passes;
+    0.5 Hz, or 1 Hz with 0.2 s on, fails the 1 Hz requirement with the
+    times it saw."""
+    prog = tmp_path / "blink.awl"
+    prog.write_text(BLINK.format(period=period, half=half), encoding="utf-8")
+    monkeypatch.setenv("PLCRT_EXERCISE_PROGRAM", str(prog))
+    r = course.check(course.lesson(COURSE / "07-traffic-blink"))
+    failed = {t["name"]: t["message"] for t in r["tests"] if t["outcome"] != "passed"}
+    if ok:
+        assert r["ok"] and not failed, failed
+    else:
+        assert list(failed) == ["test_the_yellow_light_blinks_at_1_hz"]
+        assert "(off at 0.00 s, on at 0.01 s, off at " in failed["test_the_yellow_light_blinks_at_1_hz"]

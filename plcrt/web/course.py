@@ -18,6 +18,7 @@ This module neither serves nor draws anything.
 
 from __future__ import annotations
 
+import ast
 import os
 import re
 import subprocess
@@ -200,16 +201,39 @@ def check(les: Lesson, timeout: float = CHECK_TIMEOUT) -> dict[str, Any]:
             return {"type": "check", "lesson": les.id, "ok": False, "passed": 0,
                     "failed": 0, "tests": [],
                     "output": f"the tests did not finish within {timeout:g} s"}
-        tests = _junit(report) if report.is_file() else []
-    output = (proc.stdout + proc.stderr)[-OUTPUT_CHARS:]
+        tests = _junit(report, _docs(files)) if report.is_file() else []
+    output = _clip(proc.stdout + proc.stderr)
     passed = sum(t["outcome"] == "passed" for t in tests)
     failed = sum(t["outcome"] in ("failed", "error") for t in tests)
     return {"type": "check", "lesson": les.id, "ok": proc.returncode == 0 and failed == 0,
             "passed": passed, "failed": failed, "tests": tests, "output": output}
 
 
-def _junit(path: Path) -> list[dict[str, str]]:
-    """Each test case of a JUnit XML report (written by our own pytest)."""
+def _docs(files: list[Path]) -> dict[str, str]:
+    """Test name -> the first paragraph of its docstring, read from the
+    test files' syntax trees (nothing runs): an exercise states each
+    requirement there, and the page lists the requirement rather than the
+    function's name."""
+    out: dict[str, str] = {}
+    for f in files:
+        try:
+            tree = ast.parse(_read(f))
+        except (OSError, SyntaxError, ValueError, RecursionError, MemoryError):
+            continue
+        for node in tree.body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and \
+                    node.name.startswith("test"):
+                doc = ast.get_docstring(node) or ""
+                first = " ".join(doc.split("\n\n")[0].split())
+                if first:
+                    out[node.name] = first[:300]
+    return out
+
+
+def _junit(path: Path, docs: dict[str, str] | None = None) -> list[dict[str, str]]:
+    """Each test case of a JUnit XML report (written by our own pytest);
+    ``doc`` is the test's docstring (:func:`_docs`), else its name in
+    words."""
     out = []
     for case in ET.parse(path).getroot().iter("testcase"):
         outcome, text = "passed", ""
@@ -217,11 +241,35 @@ def _junit(path: Path) -> list[dict[str, str]]:
             el = case.find(tag)
             if el is not None:
                 outcome = {"failure": "failed", "error": "error", "skipped": "skipped"}[tag]
-                text = (el.get("message") or "")[:500]
+                text = _message(el.get("message") or "")
                 break
         name = case.get("name", "")
-        out.append({"name": name, "doc": _words(name), "outcome": outcome, "message": text})
+        doc = (docs or {}).get(name.split("[")[0]) or _words(name)
+        if "[" in name:
+            doc += " [" + name.split("[", 1)[1]
+        out.append({"name": name, "doc": doc, "outcome": outcome, "message": text})
     return out
+
+
+def _message(text: str) -> str:
+    """A failure's message for the page: an assertion's own message
+    without pytest's ``assert ...`` explanation after it (which is kept
+    when the assertion has no message of its own), at most 500
+    characters."""
+    if text.startswith("AssertionError: "):
+        text = text[len("AssertionError: "):]
+        if not text.startswith("assert "):
+            text = text.split("\nassert ")[0]
+    return text[:500]
+
+
+def _clip(output: str) -> str:
+    """pytest's output, at most :data:`OUTPUT_CHARS`: its start (the first
+    failure with its PLC trace) and its end (the summary), the middle cut."""
+    if len(output) <= OUTPUT_CHARS:
+        return output
+    half = OUTPUT_CHARS // 2
+    return output[:half] + "\n[... output cut ...]\n" + output[-half:]
 
 
 def _words(name: str) -> str:

@@ -14,15 +14,16 @@ from .conftest import REPO
 LESSONS = course.lessons(REPO / "examples/course")
 
 
-def test_the_course_has_its_six_lessons() -> None:
-    assert [le.id[:2] for le in LESSONS] == ["01", "02", "03", "04", "05", "06"]
+def test_the_course_has_its_six_lessons_and_five_exercises() -> None:
+    assert [le.id[:2] for le in LESSONS] == [f"{n:02d}" for n in range(1, 12)]
 
 
 @pytest.mark.parametrize("les", LESSONS, ids=lambda le: le.id)
 def test_every_lesson_has_steps_for_the_page_and_kinds_for_its_inputs(les) -> None:
     """The page shows panel.md, not the terminal README: steps with the
     page's controls, no shell commands; its input table names a kind for
-    every input the program uses."""
+    every input the program uses, but those a machine of the plant drives
+    (its sensors, and its buttons on its drawing)."""
     import plcrt
     from plcrt.web.present import io_bits
     assert (les.dir / "panel.md").is_file()
@@ -35,7 +36,8 @@ def test_every_lesson_has_steps_for_the_page_and_kinds_for_its_inputs(les) -> No
     assert set(kinds.values()) <= set(INPUT_KINDS)
     plc = plcrt.load(str(les.program), symbols=str(les.symbols) if les.symbols else None,
                      plant=str(les.plant) if les.plant else None)
-    assert set(io_bits(plc)[0]) == set(kinds)
+    wired = {a for m in plc.machines() for a in m.wiring().values() if a}
+    assert set(io_bits(plc)[0]) - wired == set(kinds)
 
 
 def test_lesson_1_declares_the_normally_closed_stop_button() -> None:
@@ -103,3 +105,21 @@ def test_a_huge_text_is_cut() -> None:
     doc = markdown.parse("word " * (markdown.MAX_CHARS // 2))
     assert "cut after" in doc[-1]["p"][0]["t"]
     assert sum(len(s["t"]) for b in doc for s in b["p"]) < markdown.MAX_CHARS + 100
+
+
+def test_check_lists_requirements_and_keeps_the_first_failure(tmp_path) -> None:
+    """A test is listed by its docstring's first paragraph (by its name in
+    words without one, with its parameters); a failure by its assertion's
+    own message; a long output keeps its start and its end."""
+    from plcrt.web.course import OUTPUT_CHARS, _clip, _docs, _message
+    f = tmp_path / "test_x.py"
+    f.write_text('def test_a():\n    """The lamp is lit\n    at 1 s.\n\n    More."""\n\n'
+                 'def test_b_no_doc():\n    pass\n')
+    assert _docs([f]) == {"test_a": "The lamp is lit at 1 s."}
+    assert _message("AssertionError: the lamp was dark at 1.00 s\nassert 0 == 1") == \
+        "the lamp was dark at 1.00 s"
+    assert _message("AssertionError: assert 0 == 1\n +  where 0 = f()") == \
+        "assert 0 == 1\n +  where 0 = f()"
+    out = _clip("FIRST failure" + "x" * (3 * OUTPUT_CHARS) + "summary")
+    assert out.startswith("FIRST failure") and out.endswith("summary")
+    assert len(out) < OUTPUT_CHARS + 100

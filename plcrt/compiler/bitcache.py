@@ -52,22 +52,45 @@ AREAS = frozenset({"I", "Q", "M", "V", "S"})
 class BitCache:
     """The bits of the current region kept in locals (see the module doc)."""
 
-    def __init__(self, reads: Counter[str]) -> None:
-        #: operand text -> how often a contact of the block reads it: a bit
-        #: read once is read from memory where it is used (a local would
-        #: cost a store and a load more)
+    def __init__(self, reads: dict[int, int]) -> None:
+        #: id of a contact -> how many contacts of its run read the same
+        #: operand: a bit read once in its run is read from memory where it
+        #: is used (a local would cost a store and a load more)
         self.reads = reads
+        #: that count for the instruction being emitted (:meth:`at`)
+        self.here = 0
         self.names: dict[tuple[str, int, int], str] = {}
         #: bits written in the region, in the order of their first write
         self.dirty: dict[tuple[str, int, int], Addr] = {}
 
     @classmethod
     def for_block(cls, pieces: list[Any]) -> "BitCache":
-        """A cache for the pieces of one block (counts its contacts' operands)."""
-        reads: Counter[str] = Counter(
-            insn.operands[0].text for pc in pieces for insn in pc.insns
-            if insn.mnemonic in _CONTACTS and insn.operands)
+        """A cache for the pieces of one block: counts the operands of the
+        contacts of each run (consecutive :data:`REGION_INSNS`; a run may
+        still be cut where a function ends, which only makes a count high)."""
+        reads: dict[int, int] = {}
+        run: Counter[str] = Counter()
+        members: list[tuple[int, str]] = []
+
+        def close() -> None:
+            for key, text in members:
+                reads[key] = run[text]
+            run.clear()
+            members.clear()
+        for pc in pieces:
+            for insn in pc.insns:
+                if insn.mnemonic not in REGION_INSNS:
+                    close()
+                elif insn.mnemonic in _CONTACTS and insn.operands:
+                    text = insn.operands[0].text
+                    run[text] += 1
+                    members.append((id(insn), text))
+        close()
         return cls(reads)
+
+    def at(self, insn: Any) -> None:
+        """The instruction of a run about to be emitted."""
+        self.here = self.reads.get(id(insn), 0)
 
     @staticmethod
     def _key(op: Addr) -> tuple[str, int, int]:
@@ -85,7 +108,7 @@ class BitCache:
         name = self.names.get(key)
         if name is not None:
             return name
-        if g.indent != 1 or self.reads.get(op.text, 0) < 2:
+        if g.indent != 1 or self.here < 2:
             return plain
         name = self._name(op)
         # perf: the load goes before the statement that stores the pending
@@ -124,6 +147,13 @@ class BitCache:
                 # testing first whether a bit changed: measured with the
                 # peer benchmark's boolean program)
                 buf = g.use(area)
+                if len(bits) == 1:
+                    # one bit of the byte: a test and one in-place store
+                    # (cheaper than reading, masking and or-ing the byte)
+                    b = bits[0]
+                    g.lines.append(f"{pad}if b{area}{offset}_{b}: {buf}[{offset}] |= {1 << b}")
+                    g.lines.append(f"{pad}else: {buf}[{offset}] &= {~(1 << b) & 0xFF}")
+                    continue
                 parts = " | ".join(f"b{area}{offset}_{b}" + (f" << {b}" if b else "")
                                    for b in bits)
                 keep = ~sum(1 << b for b in bits) & 0xFF

@@ -150,6 +150,7 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
             # other instruction sees the image as the straight code leaves it
             if insn.mnemonic in REGION_INSNS:
                 gen.bits = cache
+                cache.at(insn)
             else:
                 gen.bits = None
                 cache.end(gen)

@@ -70,26 +70,42 @@ class BitCache:
         still be cut where a function ends, which only makes a count high)."""
         reads: dict[int, int] = {}
         run: Counter[str] = Counter()
-        members: list[tuple[int, str]] = []
+        members: list[tuple[int, str, bool]] = []     # (id, operand, is a contact)
 
         def close() -> None:
-            for key, text in members:
-                reads[key] = run[text]
+            later: set[str] = set()     # operands read after a point of the run
+            # coils per byte as written ("Q0.1" -> "Q0"; a symbol counts
+            # as a byte of its own): only a guess, it decides speed only
+            coils = Counter(text.rpartition(".")[0] or text
+                            for _k, text, contact in members if not contact)
+            for key, text, contact in reversed(members):
+                if contact:
+                    reads[key] = run[text]
+                    later.add(text)
+                else:
+                    # a coil: kept in a local if a contact after it reads
+                    # the bit or another coil of the run writes its byte
+                    shared = coils[text.rpartition(".")[0] or text] > 1
+                    reads[key] = 1 if text in later or shared else 0
             run.clear()
             members.clear()
         for pc in pieces:
             for insn in pc.insns:
                 if insn.mnemonic not in REGION_INSNS:
                     close()
-                elif insn.mnemonic in _CONTACTS and insn.operands:
+                elif insn.operands and (insn.mnemonic in _CONTACTS or insn.mnemonic == "="):
                     text = insn.operands[0].text
-                    run[text] += 1
-                    members.append((id(insn), text))
+                    contact = insn.mnemonic in _CONTACTS
+                    if contact:
+                        run[text] += 1
+                    members.append((id(insn), text, contact))
         close()
         return cls(reads)
 
     def at(self, insn: Any) -> None:
-        """The instruction of a run about to be emitted."""
+        """The instruction of a run about to be emitted: for a contact the
+        reads of its operand in the run, for ``=`` 1 to keep the bit in a
+        local, 0 to write the image at once."""
         self.here = self.reads.get(id(insn), 0)
 
     @staticmethod
@@ -125,6 +141,13 @@ class BitCache:
         if op.area not in AREAS:
             return False
         key = self._key(op)
+        if key not in self.dirty and not self.here:
+            # perf: no contact after it reads the bit and no other coil of
+            # the run writes its byte: the image is written at once, as
+            # without a run (a test and one in-place store); a local
+            # loaded from the bit is out of date now
+            self.names.pop(key, None)
+            return False
         name = self._name(op)
         g.line(f"{name} = {expr}")
         self.names[key] = name

@@ -35,7 +35,9 @@ fresh process, the machine code on disk) with the RSS growth of each (all
 of it, and the private part: without the pages of the llvmlite library's
 code, which every process maps from one file), the scan cost in CPU
 nanoseconds per statement, the machine code's size, and for ``auto`` the
-growth once the background native build has been switched in.
+growth once the background native build has been switched in; and the
+same load again in the first process ("cached (in process)": a hit of
+the program cache, what a test session's later loads cost).
 
 ``--plcrt DIR`` measures the plcrt package found in DIR instead (another
 checkout: the figures before a change, side by side in the same run with
@@ -117,6 +119,7 @@ def child(path: str, mode: str) -> dict[str, Any]:
         base = tracemalloc.get_traced_memory()[0]
     before = _status()
     pause = getattr(runtime, "gc_paused", contextlib.nullcontext)
+    c0 = time.process_time()
     t0 = time.perf_counter()
     with (contextlib.nullcontext() if mode == "gc-on" else pause()):
         program = parse_sources(text)
@@ -125,6 +128,8 @@ def child(path: str, mode: str) -> dict[str, Any]:
     plc = Plc(program, scan_ms=1, **kw)
     t2 = time.perf_counter()
     c2 = time.process_time()
+    # CPU time too: on a loaded machine the wall time says little
+    out["load_cpu_s"] = time.process_time() - c0
     if mode == "trace":
         now, peak = tracemalloc.get_traced_memory()
         out.update(traced_live_mib=(now - base) / 2**20, traced_peak_mib=(peak - base) / 2**20)
@@ -134,6 +139,11 @@ def child(path: str, mode: str) -> dict[str, Any]:
     t3 = time.perf_counter()
     plc.fork()
     t4 = time.perf_counter()
+    # the same load again in this process: a hit of the program cache
+    # (plcrt.compiler.cache.programs), the cached load of a test session
+    t5 = time.perf_counter()
+    Plc(program, scan_ms=1, **kw)
+    out["load_again_s"] = time.perf_counter() - t5
     out.update(insns=program.instruction_count(), parse_s=t1 - t0, compile_s=t2 - t1,
                load_s=t2 - t0, compile_cpu_s=c2 - c1, fork_s=t4 - t3,
                rss_growth_mib=(after["VmRSS"] - before["VmRSS"]) / 1024,
@@ -415,10 +425,12 @@ def _backend_line(row: dict[str, Any]) -> str:
                     f"+{f['switched_rss_growth_mib']:.0f} MiB "
                     f"(private +{f['switched_anon_growth_mib']:.0f})"
                     if "native_build_s" in f else "")
-        parts.append(f"{backend}: first {f['load_s']:.2f} s "
-                     f"(compile CPU {f['compile_cpu_s']:.2f} s) RSS +{f['rss_growth_mib']:.0f} MiB "
+        parts.append(f"{backend}: first {f['load_s']:.2f} s ({f.get('load_cpu_s', 0):.2f} s CPU, "
+                     f"compile {f['compile_cpu_s']:.2f} s) RSS +{f['rss_growth_mib']:.0f} MiB "
                      f"(private +{f['anon_growth_mib']:.0f}){switched}, "
-                     f"cached {c['load_s']:.2f} s RSS +{c['rss_growth_mib']:.0f} MiB, "
+                     f"cached (disk) {c['load_s']:.2f} s ({c.get('load_cpu_s', 0):.2f} s CPU) "
+                     f"RSS +{c['rss_growth_mib']:.0f} MiB, "
+                     f"cached (in process) {f['load_again_s'] * 1e3:.1f} ms, "
                      f"{c['ns_per_statement']:.2f} ns/statement")
     return f"{row['shape']:5} {row['size']:>6} seed {row['seed']}: " + "; ".join(parts)
 

@@ -14,10 +14,13 @@ against a Python reference before timing it.  This script
 2. generates the programs for every seed of ``--seeds`` and every size of
    ``--sizes`` (boolean and mixed statements), so that no figure rests on
    one program;
-3. times plcrt (this checkout, this interpreter; ``plcrt`` is the default
-   Python backend, ``plcrt-native`` the optional native one, chosen through
-   ``PLCRT_BACKEND``) and each awlsim core alternately, ``--rounds`` times,
-   and keeps each engine's best time per scan;
+3. times plcrt (this checkout, this interpreter; ``plcrt-auto`` is the
+   default backend, ``auto``: the Python build at once, the native one
+   compiled in the background and switched to between two scans, so its
+   best time is the native build's; ``plcrt`` is the Python backend and
+   ``plcrt-native`` the native one, chosen through ``PLCRT_BACKEND``) and
+   each awlsim core alternately, ``--rounds`` times, and keeps each
+   engine's best time per scan;
 4. reports µs per scan and the ratio awlsim / plcrt per program (above 1:
    plcrt is faster), with the straight-line Python functions of the
    boolean program that the plcrt driver times in the same process.
@@ -38,7 +41,7 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
-ENGINES = ("plcrt", "plcrt-native", "awlsim-cy", "awlsim-py")
+ENGINES = ("plcrt", "plcrt-auto", "plcrt-native", "awlsim-cy", "awlsim-py")
 
 
 def _cache_dir(arg: str | None) -> Path:
@@ -50,7 +53,7 @@ def _cache_dir(arg: str | None) -> Path:
 
 def _pythons(cache: Path) -> dict[str, Path]:
     """The interpreters of each engine that exist in the cache."""
-    found = {"plcrt": Path(sys.executable), "plcrt-native": Path(sys.executable)}
+    found = {e: Path(sys.executable) for e in ENGINES if e.startswith("plcrt")}
     for engine, venv in (("awlsim-cy", "venv-awlsim-cy"), ("awlsim-py", "venv-awlsim")):
         py = cache / venv / "bin" / "python"
         if py.exists():
@@ -76,8 +79,11 @@ def _run(engine: str, py: Path, peers: Path, progdir: Path, repeats: int) -> dic
     if engine.startswith("plcrt"):
         env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
         # the driver loads programs without a backend option: the
-        # environment chooses it (plcrt.load's default)
-        env["PLCRT_BACKEND"] = "native" if engine == "plcrt-native" else "python"
+        # environment chooses it (plcrt.load's default); plcrt-auto leaves
+        # it unset, the default backend
+        env.pop("PLCRT_BACKEND", None)
+        if engine != "plcrt-auto":
+            env["PLCRT_BACKEND"] = "native" if engine == "plcrt-native" else "python"
     out = subprocess.run([str(py), str(peers / script), "speed", str(progdir),
                           "--repeats", str(repeats)], env=env, capture_output=True, text=True)
     if out.returncode != 0:
@@ -118,7 +124,7 @@ def measure(peers: Path, cache: Path, seeds: list[int], sizes: list[tuple[int, i
                                                        for k, v in sorted(best.items())},
                                        "checks": checks, "errors": errors, "ratios": {}}
                 for prog in ("bool", "mixed"):
-                    for me in ("plcrt", "plcrt-native"):
+                    for me in ("plcrt", "plcrt-auto", "plcrt-native"):
                         mine = best.get(f"{me}:{prog}")
                         for peer in ("awlsim-cy", "awlsim-py"):
                             theirs = best.get(f"{peer}:{prog}")
@@ -149,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="BOOL/MIXED statement counts, comma-separated (e.g. 2000/1000,500/4000)")
     ap.add_argument("--rounds", type=int, default=3, help="alternating rounds per program")
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per run")
-    ap.add_argument("--engines", default="plcrt,plcrt-native,awlsim-cy",
+    ap.add_argument("--engines", default="plcrt,plcrt-auto,plcrt-native,awlsim-cy",
                     help=f"engines to time, of {', '.join(ENGINES)}")
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     args = ap.parse_args(argv)

@@ -7,7 +7,8 @@ Run ``python bench/run.py`` (or ``make bench``).  It
    and a mixed one (moves, INT/DINT math, compares, 100 ms timers), each of
    at least 1000 instructions;
 2. loads each with :func:`plcrt.load`, warms it up, then times many scans
-   with ``time.perf_counter`` and keeps the best of several repeats;
+   in CPU time (``time.process_time``: on a shared machine wall time moves
+   several-fold with the load) and keeps the best of several repeats;
 3. reports instructions per second = instructions in the program x scans /
    seconds.  Every instruction of the program is counted once per scan, as a
    PLC's instruction timing does, whether or not a box's enable was 1;
@@ -15,11 +16,20 @@ Run ``python bench/run.py`` (or ``make bench``).  It
    ``roundtrip.awl`` with its symbol table (if the shared corpus is
    present): a real export that uses every instruction family.
 
-``--native`` also times the native backend (docs/native.md) on the same
-programs, with and without probes (``+native+probes``: coverage and
-breakpoints as machine code, what ``--plc-coverage`` and ``plcrt debug``
-run), and prints its speed-ups; ``--seeds 5,6``
-adds a boolean and a mixed program per seed.
+Every program runs on each backend of ``--backends`` (default: Python and,
+where llvmlite works, native; docs/native.md) in three builds: plain,
+instrumented (``+probes``: network, output and contact coverage probes, as
+``pytest --plc-coverage`` loads it) and instrumented with a breakpoint
+armed (``+break``: a breakpoint on the program's last network whose handler
+resumes at once, as a debugger's breakpoint whose condition is false; what
+``plcrt debug`` and the panel run while a breakpoint is set).  Rows of the
+native backend are named ``+native``.  ``--seeds 5,6`` adds a boolean and
+a mixed program per seed.
+
+Load figures: every ``load`` printed is a *first* load -- the program cache
+of the process emptied and the native backend's disk cache a fresh empty
+folder (``$PLCRT_CACHE_DIR`` for this run) -- unless it says ``cached``
+(the same load again: a cache hit, the best of several).
 
 This is a measuring tool, not a test: it asserts nothing and never fails on
 slow results (``--check`` makes it exit 1 below the targets).  ``--save DIR``
@@ -37,6 +47,7 @@ import os
 import platform
 import random
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -178,7 +189,10 @@ class ScanResult:
     scans_per_repeat: int
     repeats: int
     best_s: float
+    #: the first load of the program (no cache: see :func:`first_load`)
     load_s: float
+    #: the same load again, a cache hit (best of three)
+    load_cached_s: float
 
     @property
     def scans_per_s(self) -> float:
@@ -207,33 +221,62 @@ def _prepare_inputs(plc: plcrt.Plc) -> None:
         plc[f"VW{word}"] = rnd.randrange(0, 1000)
 
 
-def measure_scans(name: str, text: str, *, repeats: int, target_s: float,
-                  instrument: bool = False, backend: str = "python") -> ScanResult:
+def first_load(fn: Callable[[], Any]) -> tuple[float, Any]:
+    """Time ``fn()`` (a load) as a first load: the process's program cache
+    emptied first; the native disk cache is the run's own empty folder
+    (:func:`main` points ``PLCRT_CACHE_DIR`` at it) and is emptied too."""
+    from plcrt.compiler import cache
+    cache.programs.clear()
+    disk = os.environ.get("PLCRT_CACHE_DIR")
+    if disk and Path(disk, "native").is_dir():
+        for f in Path(disk, "native").iterdir():
+            f.unlink()
     t0 = time.perf_counter()
-    plc = plcrt.load(text, instrument=instrument, backend=backend)
-    load_s = time.perf_counter() - t0
+    result = fn()
+    return time.perf_counter() - t0, result
+
+
+def measure_scans(name: str, text: str, *, repeats: int, target_s: float,
+                  instrument: bool = False, backend: str = "python",
+                  armed: bool = False) -> ScanResult:
+    load_s, plc = first_load(lambda: plcrt.load(text, instrument=instrument, backend=backend))
+    load_cached_s, _ = _best_of(3, lambda: plcrt.load(text, instrument=instrument,
+                                                      backend=backend))
+    if armed:
+        # a breakpoint on the last network whose handler resumes at once
+        cov = plc.coverage
+        hits = [0]
+
+        def resume(_net: Any) -> None:
+            hits[0] += 1
+        cov.on_break = resume
+        cov.breakpoints[len(cov.networks) - 1] = 1
     _prepare_inputs(plc)
     plc.scan(200)  # warm-up: timers started, caches filled
-    # calibrate: scans per repeat so one repeat takes about target_s
-    t0 = time.perf_counter()
+    # calibrate: scans per repeat so one repeat takes about target_s.  CPU
+    # time of the process (time.process_time), not wall time: on a shared
+    # machine the wall time of a repeat moves several-fold with the load
+    t0 = time.process_time()
     plc.scan(100)
-    per_scan = (time.perf_counter() - t0) / 100
+    per_scan = (time.process_time() - t0) / 100
     n = max(100, int(target_s / max(per_scan, 1e-9)))
     best = float("inf")
     gc_was = gc.isenabled()
     gc.disable()  # generated code allocates little; keep collector pauses out
     try:
         for _ in range(repeats):
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             plc.scan(n)
-            best = min(best, time.perf_counter() - t0)
+            best = min(best, time.process_time() - t0)
     finally:
         if gc_was:
             gc.enable()
     if plc.mode != "RUN":
         raise RuntimeError(f"benchmark program {name} left RUN mode: {plc.fault}")
+    if armed and not hits[0]:
+        raise RuntimeError(f"benchmark program {name}: the armed breakpoint never ran")
     return ScanResult(name, plc.program.instruction_count(), plc.program.network_count(),
-                      n, repeats, best, load_s)
+                      n, repeats, best, load_s, load_cached_s)
 
 
 def _best_of(repeats: int, fn: Callable[[], Any]) -> tuple[float, Any]:
@@ -264,7 +307,13 @@ def measure_corpus(repeats: int) -> dict[str, Any] | None:
     first_parse_s = time.perf_counter() - t0
     parse_s, program = _best_of(repeats, lambda: parse_program(text, str(path)))
 
-    load_s, plc = _best_of(repeats, lambda: plcrt.Plc(program, symbols=symbols))
+    # the first load (no cache) on the default backend (auto: the Python
+    # build at once, the native one in the background) and on Python; then
+    # the cached load, a cache hit of the process's program cache
+    load_s, plc = first_load(lambda: plcrt.Plc(program, symbols=symbols))
+    load_python_s, _ = first_load(lambda: plcrt.Plc(program, symbols=symbols,
+                                                    backend="python"))
+    load_cached_s, _ = _best_of(repeats, lambda: plcrt.Plc(program, symbols=symbols))
     plc.scan(100)
     t0 = time.perf_counter()
     plc.scan(1000)
@@ -279,6 +328,8 @@ def measure_corpus(repeats: int) -> dict[str, Any] | None:
         "first_parse_s": first_parse_s,
         "parse_s": parse_s,
         "load_s": load_s,
+        "load_python_s": load_python_s,
+        "load_cached_s": load_cached_s,
         "parse_plus_load_s": parse_s + load_s,
         "us_per_scan": scan_s * 1e6,
         "mode_after_run": plc.mode,
@@ -315,13 +366,26 @@ def main(argv: list[str] | None = None) -> int:
                     help="minimum instructions per generated program")
     ap.add_argument("--save", metavar="DIR", help="write the generated programs to DIR")
     ap.add_argument("--check", action="store_true", help="exit 1 when below a target")
+    ap.add_argument("--backends", default=None, metavar="LIST",
+                    help="backends to time, of python,native (default: both, native where "
+                         "llvmlite works)")
     ap.add_argument("--native", action="store_true",
-                    help="also time the native backend (llvmlite) on the same programs "
-                         "and report its speed-up over the Python backend")
+                    help="time the native backend too (the default where llvmlite works)")
     ap.add_argument("--seeds", default="",
                     help="more generator seeds (comma-separated): each adds a boolean and a "
                          "mixed program of its own, so no figure rests on one program")
     args = ap.parse_args(argv)
+    if args.backends:
+        backends = [b.strip() for b in args.backends.split(",") if b.strip()]
+        bad = [b for b in backends if b not in ("python", "native")]
+        if bad:
+            ap.error(f"unknown backend(s): {', '.join(bad)}; known: python, native")
+    else:
+        from plcrt.compiler.native.jit import usable
+        why = usable()
+        backends = ["python"] + (["native"] if why is None or args.native else [])
+        if why is not None:
+            print(f"native backend skipped: {why}", file=sys.stderr)
 
     programs = {"bool": bool_program(args.insns), "mixed": mixed_program(args.insns)}
     for seed in (int(x) for x in args.seeds.split(",") if x.strip()):
@@ -333,26 +397,28 @@ def main(argv: list[str] | None = None) -> int:
         for name, text in programs.items():
             (out / f"{name}.awl").write_text(text, encoding="utf-8")
 
-    scans = {name: measure_scans(name, text, repeats=args.repeats,
-                                 target_s=args.repeat_seconds)
-             for name, text in programs.items()}
-    # the same programs with coverage/breakpoint probes (pytest --plc-coverage,
-    # plcrt debug): their cost is reported, it has no target
-    for name, text in programs.items():
-        r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
-                          instrument=True)
-        scans[f"{name}+probes"] = dataclasses.replace(r, name=f"{name}+probes")
-    if args.native:
-        for name, text in programs.items():
-            r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
-                              backend="native")
-            scans[f"{name}+native"] = dataclasses.replace(r, name=f"{name}+native")
-            # the instrumented build on the native backend (probes as machine
-            # code): what --plc-coverage, plcrt debug and a panel breakpoint run
-            r = measure_scans(name, text, repeats=args.repeats, target_s=args.repeat_seconds,
-                              backend="native", instrument=True)
-            scans[f"{name}+native+probes"] = dataclasses.replace(r, name=f"{name}+native+probes")
-    corpus = measure_corpus(max(3, args.repeats // 2))
+    # the native backend's disk cache: this run's own folder, emptied before
+    # every first load (first_load), so no figure is a hit of an earlier run
+    saved = os.environ.get("PLCRT_CACHE_DIR")
+    with tempfile.TemporaryDirectory(prefix="plcrt-bench-cache-") as disk:
+        os.environ["PLCRT_CACHE_DIR"] = disk
+        scans: dict[str, ScanResult] = {}
+        for backend in backends:
+            tag = "" if backend == "python" else f"+{backend}"
+            # plain, then with coverage probes (pytest --plc-coverage), then
+            # with probes and an armed breakpoint (plcrt debug, the panel)
+            for build, instrument, armed in (("", False, False), ("+probes", True, False),
+                                             ("+break", True, True)):
+                for name, text in programs.items():
+                    r = measure_scans(name, text, repeats=args.repeats,
+                                      target_s=args.repeat_seconds, backend=backend,
+                                      instrument=instrument, armed=armed)
+                    scans[name + tag + build] = dataclasses.replace(r, name=name + tag + build)
+        corpus = measure_corpus(max(3, args.repeats // 2))
+    if saved is None:
+        os.environ.pop("PLCRT_CACHE_DIR", None)
+    else:
+        os.environ["PLCRT_CACHE_DIR"] = saved
 
     if args.json:
         print(json.dumps({"machine": machine(),
@@ -366,19 +432,25 @@ def main(argv: list[str] | None = None) -> int:
             target = TARGETS.get(r.name)
             verdict = "" if target is None else \
                 f" - {'meets' if r.insns_per_s >= target else 'BELOW'} target {target / 1e6:g} M/s"
-            print(f"{r.name:<19} {r.instructions:>5} instructions, {r.networks:>4} networks: "
-                  f"{r.insns_per_s / 1e6:6.2f} M instructions/s "
+            print(f"{r.name:<24} {r.instructions:>5} instructions, {r.networks:>4} networks: "
+                  f"{r.insns_per_s / 1e6:7.2f} M instructions/s "
                   f"({1e6 / r.scans_per_s:7.1f} us/scan, best of {r.repeats} x "
-                  f"{r.scans_per_repeat} scans; load {r.load_s * 1e3:.0f} ms){verdict}")
+                  f"{r.scans_per_repeat} scans; first load {r.load_s * 1e3:.0f} ms, "
+                  f"cached {r.load_cached_s * 1e3:.1f} ms){verdict}")
         for name in programs:
+            for tag in [t for t in ("", "+native") if name + t in scans]:
+                plain = scans[name + tag]
+                print(f"{name + tag:<19} with probes / plain: "
+                      f"{scans[name + tag + '+probes'].insns_per_s / plain.insns_per_s:.2f}x, "
+                      f"breakpoint armed / plain: "
+                      f"{scans[name + tag + '+break'].insns_per_s / plain.insns_per_s:.2f}x")
             nat = scans.get(f"{name}+native")
             if nat is not None:
-                print(f"{name:<12} native / python: {nat.insns_per_s / scans[name].insns_per_s:.1f}x")
-            probed = scans.get(f"{name}+native+probes")
-            if nat is not None and probed is not None:
-                print(f"{name:<12} native with probes / native: "
-                      f"{probed.insns_per_s / nat.insns_per_s:.2f}x, / python with probes: "
-                      f"{probed.insns_per_s / scans[name + '+probes'].insns_per_s:.1f}x")
+                print(f"{name:<19} native / python: plain "
+                      f"{nat.insns_per_s / scans[name].insns_per_s:.1f}x, with probes "
+                      f"{scans[name + '+native+probes'].insns_per_s / scans[name + '+probes'].insns_per_s:.1f}x, "
+                      f"breakpoint armed "
+                      f"{scans[name + '+native+break'].insns_per_s / scans[name + '+break'].insns_per_s:.1f}x")
         if corpus is None:
             print(f"corpus: {CORPUS_FILE} not found, skipped")
         else:
@@ -387,8 +459,10 @@ def main(argv: list[str] | None = None) -> int:
                   f"{c['networks']} networks, {c['blocks']} blocks"
                   + (f" (symbols {c['symbols']})" if c["symbols"] else ""))
             print(f"  parse {c['parse_s'] * 1e3:.1f} ms (first parse in process "
-                  f"{c['first_parse_s'] * 1e3:.1f} ms), load (compile+bind) "
-                  f"{c['load_s'] * 1e3:.1f} ms -> parse+load "
+                  f"{c['first_parse_s'] * 1e3:.1f} ms); first load (compile+bind, no cache) "
+                  f"{c['load_s'] * 1e3:.1f} ms on the default backend, "
+                  f"{c['load_python_s'] * 1e3:.1f} ms on Python; cached load "
+                  f"{c['load_cached_s'] * 1e3:.1f} ms; parse+first load "
                   f"{c['parse_plus_load_s'] * 1e3:.1f} ms; {c['us_per_scan']:.1f} us/scan "
                   f"(mode {c['mode_after_run']} after 1100 scans)")
     if args.check and any(r.insns_per_s < TARGETS.get(r.name, 0) for r in scans.values()):

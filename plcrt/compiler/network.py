@@ -21,6 +21,7 @@ from ..isa.registry import KNOWN_UNIMPLEMENTED, InsnSpec, lookup
 from ..isa.shape import shape
 from ..lang import ir
 from ..safetext import excerpt
+from .bitcache import REGION_INSNS
 from .constpower import ConstantPower, contact_value
 from .unit import Piece, Unit
 
@@ -143,6 +144,16 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         unit.locs.append(loc)
         gen.loc = loc
         gen.insn_id = insn_id
+        cache = unit.bitcache
+        if cache is not None:
+            # a region of bit logic keeps bits in locals (.bitcache); any
+            # other instruction sees the image as the straight code leaves it
+            if insn.mnemonic in REGION_INSNS:
+                gen.bits = cache
+                cache.at(insn)
+            else:
+                gen.bits = None
+                cache.end(gen)
         # where its code starts (the module has no comment lines: they
         # made it a third longer to compile and keep)
         gen.line_map.append((len(gen.lines), insn_id, gen.indent))
@@ -169,6 +180,8 @@ def emit_piece(unit: Unit, gen: Gen, piece: Piece, resolver: Resolver) -> None:
         except Exception as e:  # noqa: BLE001 - a plcrt bug is reported at its instruction
             del gen.lines[saved[0]:]
             _, gen.depth, gen.indent, gen.pending = saved
+            if cache is not None:
+                cache.forget()      # a local it loaded went with the lines
             if not isinstance(e, (CodegenError, ResolveError)):
                 unit.diag.error(plcrt_bug(insn.mnemonic, e), loc, "plcrt-bug")
             elif not getattr(e, "reported", False) and not (broken and "logic stack" in str(e)):

@@ -116,6 +116,9 @@ class Unit:
         #: the native backend's plan (:mod:`plcrt.compiler.native`), or None
         #: for Python only
         self.native: Any = None
+        #: the bits kept in locals in the function being emitted
+        #: (:class:`plcrt.compiler.bitcache.BitCache`), or None
+        self.bitcache: Any = None
 
     def fresh(self, hint: str) -> str:
         self._counter += 1

@@ -67,6 +67,9 @@ class Gen:
         self._pending_op: tuple[str, str] | None = None
         #: inside a box under SM0.0: statements do not store a pending "1"
         self._hold_one = False
+        #: the bits kept in locals while a bit-logic region is emitted
+        #: (:class:`plcrt.compiler.bitcache.BitCache`), else None
+        self.bits: Any = None
 
     # -- source ---------------------------------------------------------
     def line(self, text: str) -> None:
@@ -229,12 +232,15 @@ class Gen:
             return "1"
         else:
             buf, byte, bit = self._buf(op.area), op.offset, op.bit
-        if bit == 0:
-            return f"({buf}[{byte}] & 1)"
-        return f"({buf}[{byte}] >> {bit} & 1)"
+        plain = f"({buf}[{byte}] & 1)" if bit == 0 else f"({buf}[{byte}] >> {bit} & 1)"
+        if self.bits is not None:
+            return self.bits.read(self, op, plain)
+        return plain
 
     def wbit(self, op: Addr, expr: str) -> None:
         """Statements writing ``expr`` (0/1, evaluated once) to a bit."""
+        if self.bits is not None and self.bits.write(self, op, expr):
+            return
         buf = self._buf(op.area)
         mask = 1 << op.bit
         if expr.isidentifier():

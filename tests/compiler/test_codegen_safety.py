@@ -51,7 +51,7 @@ SYMBOLS = f'''"Symbol","Address","Comment"
 
 NAME_OK = re.compile(r"^(s\d|eno|L|I|Q|M|V|SM|S|AI|AQ|AC|HC|PI|PQ|TV|TB|CV|CB|WD|P|C|n|pc|r|"
                      r"_[a-zA-Z]+\d*|n_(OB|SBR|INT)\d+_\d+(_[a-z]\d*)?_\d+|g_(OB|SBR|INT)\d+_\d+_\d+|"
-                     r"pou_(OB|SBR|INT)\d+|"
+                     r"pou_(OB|SBR|INT)\d+|b(I|Q|M|V|S)\d+_[0-7]|"
                      r"_pieces_pou_\w+|_costs_pou_\w+|range|abs|bytes)$")
 STRINGS_OK = {"s", "u", "r", "OB", "SBR", "INT"}
 

@@ -183,7 +183,7 @@
       mark(lc, st, "limit_closed", on(i.limit_closed));
       mark(edge, st, "safety_edge", on(i.safety_edge));
       lamp.classList.toggle("lit", on(st.lamp));
-      txt.textContent = "opening " + Math.round(num(st.opening)) + " mm  " +
+      txt.textContent = "door open " + Math.round(num(st.opening)) + " mm, " +
         (num(st.velocity) > 0 ? "opening" : num(st.velocity) < 0 ? "closing" : "still");
     };
   }

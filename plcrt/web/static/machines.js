@@ -315,4 +315,11 @@
       if (c) c.draw(st);
     }
   };
+
+  // a hello (and frame) that came before this deferred script ran
+  const P = window.plcrtPanel;
+  if (P && P.hello) {
+    M.onHello(P.hello);
+    if (P.frame) M.onFrame(P.frame);
+  }
 })();

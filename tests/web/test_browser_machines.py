@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -111,6 +112,23 @@ def test_the_conveyor_animates_and_its_start_button_reaches_the_plc(serve, page)
         "([id, x0]) => { const r = document.querySelector("
         "'[data-machine=conveyor] rect[data-part=\"' + id + '\"]');"
         " return r && parseFloat(r.getAttribute('x')) > x0 + 5; }", arg=[pid, x0])
+    assert page.errors == []
+
+
+def test_the_machines_are_drawn_when_the_hello_comes_before_machines_js(serve, page) -> None:
+    """machines.js is a deferred script: a hello (and frames) handled by
+    panel.js before it runs are drawn when it does (the script is held
+    back here until the hello has certainly come)."""
+    served = serve(conveyor())
+    # notes, as machines.js starts, whether panel.js already had the hello
+    page.add_init_script("""Object.defineProperty(window, 'plcrtMachines', {
+        configurable: true, get() { return this._m; },
+        set(v) { this._m = v; this.helloFirst = !!(window.plcrtPanel && window.plcrtPanel.hello); }
+    });""")
+    page.route("**/static/machines.js", lambda route: (time.sleep(1.5), route.continue_()))
+    open_machines(page, served)
+    assert page.evaluate("() => window.helloFirst") is True
+    assert machine_frame(page)["outputs"]["motor"] == 0
     assert page.errors == []
 
 

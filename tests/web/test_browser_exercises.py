@@ -44,3 +44,70 @@ def test_the_conveyor_exercise_is_graded_requirement_by_requirement(serve, page,
     page.wait_for_selector("#check-results li.passed >> text=5 passed, 0 failed", timeout=120000)
     assert page.locator("#check-results li.passed[data-test]").count() == 5
     assert page.locator("#check-results li.failed").count() == 0
+
+
+def _editor_text(page) -> str:
+    return page.evaluate("() => window.plcrtEditor.view.state.doc.toString()")
+
+
+def _end_of_line(page, n: int) -> None:
+    page.evaluate(f"() => {{ const v = window.plcrtEditor.view; const l = v.state.doc.line({n});"
+                  f" v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
+
+
+def test_a_student_edits_the_conveyor_exercise_downloads_it_and_the_machine_reacts(
+        serve, page, tmp_path) -> None:
+    """The whole flow in the page: the exercise opens with its goal text, its
+    program and the conveyor; a network typed with an error is marked at its
+    line and refused by Download; fixed and downloaded, it runs: start on
+    the machine runs the belt, the parts move, and the new network's output
+    (the diverter, which the starter never drives) reaches the machine."""
+    folder = tmp_path / "course" / "08-conveyor-sort"
+    shutil.copytree(COURSE / "08-conveyor-sort", folder)
+    served = serve(panel=lesson_panel(folder, watch_s=0.2))
+    open_panel(page, served)
+    page.wait_for_selector("[data-machine=conveyor] svg.machine-svg")
+    assert "sort the parts" in page.locator("body").inner_text()
+    page.click("#edit-toggle")
+    page.wait_for_function("() => window.plcrtEditor.loaded")
+    lines = _editor_text(page).splitlines()
+    assert lines[19] == "=      Q0.1" and lines[20] == "END_ORGANIZATION_BLOCK"
+    # a fourth network typed after line 20, with an error on line 23 (Q0.9)
+    _end_of_line(page, 20)
+    page.keyboard.press("Enter")
+    page.keyboard.type("Network 4 // divert while running\nLD     M0.0\n=      Q0.9")
+    assert _editor_text(page).splitlines()[22] == "=      Q0.9"
+    page.wait_for_selector(".cm-lintRange-error")
+    assert page.locator("#editor-diags li.error").first.text_content().startswith("line 23:")
+    assert "Q0.9" in page.locator(".cm-lintRange-error").first.text_content()
+    page.click("#editor-download")
+    page.wait_for_function("() => document.querySelector('#editor-status')"
+                           ".textContent.includes('has errors')")
+    assert page.locator("#networks .net").count() == 3
+    # fixed: Q0.9 -> Q0.2, the diverter
+    _end_of_line(page, 23)
+    page.keyboard.press("Backspace")
+    page.keyboard.type("2")
+    page.wait_for_function("() => document.querySelector('#editor-count')"
+                           ".textContent === 'no errors'")
+    assert page.locator(".cm-lintRange-error").count() == 0
+    page.click("#editor-download")
+    page.wait_for_function("() => document.querySelector('#editor-status')"
+                           ".textContent.startsWith('downloaded')")
+    page.wait_for_function("() => document.querySelectorAll('#networks .net').length === 4")
+    # the machine reacts: start on the drawing, Run, the belt runs and the
+    # diverter follows the new network
+    m = "window.plcrtPanel.frame.machines[0]"
+    page.wait_for_function(f"() => {m}.outputs.motor === 0 && {m}.outputs.divert === 0")
+    page.click("[data-machine=conveyor] button[data-button=start]")
+    page.click("#run")
+    page.wait_for_function(f"() => {m}.outputs.motor === 1 && {m}.outputs.divert === 1 && "
+                           "window.plcrtPanel.frame.io['Q0.2'] === 1")
+    page.wait_for_selector("[data-machine=conveyor] rect[data-part]")
+    part = page.locator("[data-machine=conveyor] rect[data-part]").first
+    pid, x0 = part.get_attribute("data-part"), float(part.get_attribute("x"))
+    page.wait_for_function(
+        "([id, x0]) => { const r = document.querySelector("
+        "'[data-machine=conveyor] rect[data-part=\"' + id + '\"]');"
+        " return r && parseFloat(r.getAttribute('x')) > x0 + 5; }", arg=[pid, x0])
+    assert page.errors == []

@@ -183,7 +183,7 @@
       mark(lc, st, "limit_closed", on(i.limit_closed));
       mark(edge, st, "safety_edge", on(i.safety_edge));
       lamp.classList.toggle("lit", on(st.lamp));
-      txt.textContent = "opening " + Math.round(num(st.opening)) + " mm  " +
+      txt.textContent = "door open " + Math.round(num(st.opening)) + " mm, " +
         (num(st.velocity) > 0 ? "opening" : num(st.velocity) < 0 ? "closing" : "still");
     };
   }
@@ -315,4 +315,11 @@
       if (c) c.draw(st);
     }
   };
+
+  // a hello (and frame) that came before this deferred script ran
+  const P = window.plcrtPanel;
+  if (P && P.hello) {
+    M.onHello(P.hello);
+    if (P.frame) M.onFrame(P.frame);
+  }
 })();

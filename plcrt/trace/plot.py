@@ -128,7 +128,9 @@ def plot(trace: Any, path: str | Path, *, signals: Sequence[str] | None = None,
                 ax.set_ylim(-0.2, 1.2)
         axes[-1].set_xlabel("time (s)")
         if title:
-            fig.suptitle(title, parse_math=False)
+            # control characters and lone surrogates (undecodable bytes) as
+            # escapes: the font renderer takes only encodable text
+            fig.suptitle(printable(title), parse_math=False)
         metadata: dict[str, Any] = {"Software": None} if fmt == "png" else \
             {"Date": None, "Creator": "plcrt"}
         try:

@@ -118,3 +118,14 @@ def test_missing_matplotlib(trace: Trace, tmp_path: Path,
         plot(trace, tmp_path / "t.png")
     assert "install the 'plot' extra: " in info.value.message
     assert not (tmp_path / "t.png").exists()
+
+
+def test_a_title_with_a_lone_surrogate_or_a_control_is_drawn_escaped(trace: Trace,
+                                                                     tmp_path: Path) -> None:
+    """A title holding what undecodable bytes become (a lone surrogate) or a
+    control character is drawn with escapes, never a renderer's TypeError
+    (found by the API fuzz)."""
+    path = tmp_path / "t.svg"
+    plot(trace, path, title="pump\ud800 \x1b[31m")
+    text = path.read_text()
+    assert "pump\\ud800 \\x1b[31m" in text

@@ -444,10 +444,12 @@ def test_dump_shows_networks_and_stl_lines(capsys: pytest.CaptureFixture[str]) -
     # the block's runner: here its one function (both networks) under the block's name
     assert "pou_OB1 = g_OB1_0_0" in lines
     # each marker is followed by that instruction's code (a run of contacts
-    # may be folded into one expression after its markers)
+    # may be folded into one expression after its markers, and a bit the
+    # run reads again is read into a local first)
     i = lines.index("    # [0] line 10: LD     I0.0")
-    code = next(line for line in lines[i + 1:] if not line.lstrip().startswith("#"))
-    assert "I[0]" in code
+    end = lines.index("# ==== OB1 network 2: Running lamp ====")
+    code = [line for line in lines[i + 1:end] if not line.lstrip().startswith("#")]
+    assert "I[0] & 1" in code[1] and "bQ0_0" in code[1]      # LD I0.0, O Q0.0, AN I0.1
 
 
 def test_dump_subroutine_block_names(capsys: pytest.CaptureFixture[str]) -> None:

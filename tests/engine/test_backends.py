@@ -66,6 +66,22 @@ def structured_programs(draw: st.DrawFn) -> str:
     return "\n".join(lines) + "\n"
 
 
+def scan_each(plcs, ib0: int, ib1: int) -> list:
+    """One scan of every PLC with input bytes IB0/IB1: the fault each
+    stopped on (its message), or None.  A drawn loop may run past the
+    watchdog; the differential runs want the same fault at the same scan."""
+    faults = []
+    for plc in plcs:
+        plc.mem.areas["PI"][0] = ib0
+        plc.mem.areas["PI"][1] = ib1
+        try:
+            plc.scan()
+            faults.append(None)
+        except PlcRuntimeError as err:
+            faults.append(str(err))
+    return faults
+
+
 def run_both(program: str, inputs, scan_ms: int, initial: bytes) -> None:
     plcs = [plcrt.load(program, scan_ms=scan_ms, backend=b) for b in ("python", "native")]
     for plc in plcs:
@@ -75,15 +91,7 @@ def run_both(program: str, inputs, scan_ms: int, initial: bytes) -> None:
     scan = 0
     for ib0, ib1, repeat in inputs:
         for _ in range(repeat):
-            faults = []
-            for plc in plcs:
-                plc.mem.areas["PI"][0] = ib0
-                plc.mem.areas["PI"][1] = ib1
-                try:
-                    plc.scan()
-                    faults.append(None)
-                except PlcRuntimeError as err:   # a drawn loop may run past the watchdog
-                    faults.append(str(err))
+            faults = scan_each(plcs, ib0, ib1)
             scan += 1
             assert faults[1] == faults[0], f"scan {scan}: faults differ\n{program}"
             for area in AREAS:

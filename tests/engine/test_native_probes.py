@@ -20,9 +20,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import plcrt
-from plcrt.errors import PlcRuntimeError
 
-from test_backends import AREAS, structured_programs
+from test_backends import AREAS, scan_each, structured_programs
 from test_differential import INITIAL_MEMORY, M_BYTES, SEGMENTS, V_BYTES, programs
 
 pytest.importorskip("llvmlite")
@@ -54,15 +53,7 @@ def run_probed(program: str, inputs, scan_ms: int, initial: bytes, breaks: list[
         for _ in range(repeat):
             if scan >= MAX_SCANS:
                 break
-            faults = []
-            for plc in (py, nat):
-                plc.mem.areas["PI"][0] = ib0
-                plc.mem.areas["PI"][1] = ib1
-                try:
-                    plc.scan()
-                    faults.append(None)
-                except PlcRuntimeError as err:   # a drawn loop may run past the watchdog
-                    faults.append(str(err))
+            faults = scan_each((py, nat), ib0, ib1)
             scan += 1
             assert faults[1] == faults[0], f"scan {scan}: faults differ\n{program}"
             for area in AREAS:

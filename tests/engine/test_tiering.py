@@ -22,10 +22,9 @@ from hypothesis import strategies as st
 
 import plcrt
 from plcrt.compiler.cache import programs
-from plcrt.errors import PlcRuntimeError
 from plcrt.engine import tiering
 
-from test_backends import AREAS, structured_programs
+from test_backends import AREAS, scan_each, structured_programs
 from test_differential import INITIAL_MEMORY, M_BYTES, SEGMENTS, V_BYTES
 
 pytest.importorskip("llvmlite")
@@ -68,15 +67,7 @@ def test_the_switch_at_any_scan_gives_the_images_of_both_backends(
                 auto._tier_up()
                 assert auto.backend["name"] == "native"
                 assert auto.backend["python_scans"] == switch
-            faults = []
-            for plc in plcs:
-                plc.mem.areas["PI"][0] = ib0
-                plc.mem.areas["PI"][1] = ib1
-                try:
-                    plc.scan()
-                    faults.append(None)
-                except PlcRuntimeError as err:   # a drawn loop may run past the watchdog
-                    faults.append(str(err))
+            faults = scan_each(plcs, ib0, ib1)
             scan += 1
             assert faults[0] == faults[1] == faults[2], f"scan {scan}\n{program}"
             assert _image(auto) == _image(py) == _image(nat), f"scan {scan}\n{program}"

@@ -78,6 +78,7 @@
       return { ok: false, message: "no answer from the panel server" };
     }
   }
+  E.api = api;   // the ladder drawing's requests too (ladder_edit.js)
 
   function status(text, level) {
     const s = $("editor-status");

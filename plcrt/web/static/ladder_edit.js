@@ -41,15 +41,8 @@
     NCI: "\u2524/I\u251c", P: "\u2524P\u251c", N: "\u2524N\u251c", NOT: "\u2524NOT\u251c" };
 
   // ------------------------------------------------------------- server
-  async function api(route, body) {
-    try {
-      const r = await fetch(route, { method: "POST", cache: "no-store",
-        headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
-      return await r.json();
-    } catch (e) {
-      return { ok: false, message: "no answer from the panel server" };
-    }
-  }
+  // a POST of JSON, answered with JSON (editor.js's; the editor loads first)
+  const api = (route, body) => window.plcrtEditor.api(route, body);
 
   function status(text, level) {
     const s = $("draw-status");

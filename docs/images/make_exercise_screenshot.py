@@ -12,54 +12,37 @@ needs ``apt-get install chromium`` and the test extra.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+from shoot import shoot   # first: it puts the checkout on sys.path
 
-from playwright.sync_api import sync_playwright  # noqa: E402
-
-from plcrt.web.cli import build_panel  # noqa: E402
-from web.conftest import CHROME_ARGS, Served, _chromium  # noqa: E402
+from plcrt.web.cli import build_panel
 
 FOLDER = "examples/course/08-conveyor-sort"
 
 
+def drive(page) -> None:
+    page.wait_for_selector("[data-machine=conveyor] svg")
+    page.click("#edit-toggle")
+    page.wait_for_function("() => window.plcrtEditor.loaded")
+    page.select_option("#speed", "10")
+    page.click("[data-machine=conveyor] button[data-button=start]")
+    page.click("#run")
+    page.wait_for_function("() => window.plcrtPanel.frame.t > 7.3", timeout=60000)
+    page.click("#stop")
+    # the page names the lesson by its absolute path, this clone's: the
+    # picture shows it as the README's command gives it
+    page.evaluate(f"() => {{ document.getElementById('files').textContent = "
+                  f"'{FOLDER}/lesson.awl'; window.scrollTo(0, 0); }}")
+    page.wait_for_timeout(500)
+
+
 def main() -> int:
-    os.chdir(ROOT)   # the page names the program as it was given: relative
     args = argparse.Namespace(
         programs=[FOLDER], symbols=None, encoding=None, data=None, cpu=None, plant=None,
         auto_symbols=False, backend="python", max_file_mb=None, scan_ms=10.0, clock=None,
         no_breakpoints=False, host="127.0.0.1", allow_host=[])
-    served = Served(build_panel(args))
-    try:
-        with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=_chromium(), args=CHROME_ARGS)
-            page = browser.new_page(viewport={"width": 1400, "height": 1450})
-            page.goto(served.url)
-            page.wait_for_selector("[data-machine=conveyor] svg")
-            page.click("#edit-toggle")
-            page.wait_for_function("() => window.plcrtEditor.loaded")
-            page.select_option("#speed", "10")
-            page.click("[data-machine=conveyor] button[data-button=start]")
-            page.click("#run")
-            page.wait_for_function("() => window.plcrtPanel.frame.t > 7.3", timeout=60000)
-            page.click("#stop")
-            # the page names the lesson by its absolute path, this clone's:
-            # the picture shows it as the README's command gives it
-            page.evaluate(f"() => {{ document.getElementById('files').textContent = "
-                          f"'{FOLDER}/lesson.awl'; window.scrollTo(0, 0); }}")
-            page.wait_for_timeout(500)
-            out = ROOT / "docs/images/exercise.png"
-            page.screenshot(path=str(out))
-            browser.close()
-            print(out)
-    finally:
-        served.close()
-    return 0
+    return shoot(build_panel(args), "exercise.png", 1450, drive)
 
 
 if __name__ == "__main__":

@@ -11,46 +11,30 @@ Drives Debian's Chromium through Playwright (as tests/web does); needs
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+from shoot import shoot   # first: it puts the checkout on sys.path
 
-from playwright.sync_api import sync_playwright  # noqa: E402
+from plcrt.web.server import Panel
+from plcrt.web.session import PanelSession
+import plcrt
 
-from plcrt.web.server import Panel  # noqa: E402
-from plcrt.web.session import PanelSession  # noqa: E402
-import plcrt  # noqa: E402
-from web.conftest import CHROME_ARGS, Served, _chromium  # noqa: E402
+
+def drive(page) -> None:
+    page.wait_for_selector("[data-machine=conveyor] svg")
+    page.select_option("#speed", "10")
+    page.click("[data-machine=conveyor] button[data-button=start]")
+    page.click("#run")
+    page.wait_for_function("() => window.plcrtPanel.frame.t > 9", timeout=60000)
+    page.click("#stop")
+    page.wait_for_timeout(500)
 
 
 def main() -> int:
-    os.chdir(ROOT)   # the page names the program as it was given: relative
     plc = plcrt.load(Path("examples/machines/conveyor.awl"),
                      plant=Path("examples/machines/conveyor.toml"))
-    served = Served(Panel(PanelSession(plc)))
-    try:
-        with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=_chromium(), args=CHROME_ARGS)
-            page = browser.new_page(viewport={"width": 1400, "height": 1000})
-            page.goto(served.url)
-            page.wait_for_selector("[data-machine=conveyor] svg")
-            page.select_option("#speed", "10")
-            page.click("[data-machine=conveyor] button[data-button=start]")
-            page.click("#run")
-            page.wait_for_function("() => window.plcrtPanel.frame.t > 9", timeout=60000)
-            page.click("#stop")
-            page.wait_for_timeout(500)
-            out = ROOT / "docs/images/machine.png"
-            page.screenshot(path=str(out))
-            browser.close()
-            print(out)
-    finally:
-        served.close()
-    return 0
+    return shoot(Panel(PanelSession(plc)), "machine.png", 1000, drive)
 
 
 if __name__ == "__main__":

@@ -53,6 +53,17 @@ CHROME_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
 REPO = Path(__file__).resolve().parents[2]
 
 
+def editor_text(page: Any) -> str:
+    """The text in the panel's STL editor (CodeMirror's document)."""
+    return page.evaluate("() => window.plcrtEditor.view.state.doc.toString()")
+
+
+def editor_end_of_line(page: Any, n: int) -> None:
+    """Put the editor's cursor at the end of line *n* (1-based) and focus it."""
+    page.evaluate(f"() => {{ const v = window.plcrtEditor.view; const l = v.state.doc.line({n});"
+                  f" v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
+
+
 def load_sample(text: str = PROGRAM, symbols: str | None = SYMBOLS, **kw: Any) -> plcrt.Plc:
     return plcrt.load(text, symbols=symbols, **kw)
 

@@ -15,6 +15,8 @@ from plcrt.web.editor import ProgramSource
 from plcrt.web.server import Panel
 from plcrt.web.session import PanelSession
 
+from .conftest import editor_end_of_line, editor_text
+
 PROGRAM = """\
 ORGANIZATION_BLOCK MAIN:OB1
 BEGIN
@@ -44,26 +46,16 @@ def _open_editor(page, served) -> None:
     page.wait_for_function("() => window.plcrtEditor.loaded")
 
 
-def _text(page) -> str:
-    return page.evaluate("() => window.plcrtEditor.view.state.doc.toString()")
-
-
-def _go_to_end_of_line(page, n: int) -> None:
-    page.evaluate(f"() => {{ const v = window.plcrtEditor.view; "
-                  f"const l = v.state.doc.line({n}); "
-                  f"v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
-
-
 def test_type_an_error_see_it_fix_it_download_and_run(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
     _open_editor(page, served)
-    assert "Network 1" in _text(page)
+    assert "Network 1" in editor_text(page)
     # a second network typed with the keyboard, with an error on line 6
-    _go_to_end_of_line(page, 5)
+    editor_end_of_line(page, 5)
     page.keyboard.press("Enter")
     page.keyboard.type("Network 2\nLD     Start\n=      Q0.9")
-    assert _text(page).splitlines()[7] == "=      Q0.9"
+    assert editor_text(page).splitlines()[7] == "=      Q0.9"
     page.wait_for_selector(".cm-lintRange-error")
     first = page.locator("#editor-diags li.error").first
     assert first.text_content().startswith("line 8:8: error:")
@@ -75,7 +67,7 @@ def test_type_an_error_see_it_fix_it_download_and_run(serve, page, tmp_path) -> 
                            ".textContent.includes('has errors')")
     assert page.locator("#networks .net").count() == 1
     # fix it: Q0.9 -> Q0.1
-    _go_to_end_of_line(page, 8)
+    editor_end_of_line(page, 8)
     page.keyboard.press("Backspace")
     page.keyboard.type("1")
     page.wait_for_function("() => document.querySelector('#editor-count')"
@@ -103,7 +95,7 @@ def test_completion_and_hover_help_come_from_the_registry_and_symbols(serve, pag
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
     _open_editor(page, served)
-    _go_to_end_of_line(page, 5)
+    editor_end_of_line(page, 5)
     page.keyboard.press("Enter")
     page.keyboard.type("TO")
     page.wait_for_selector(".cm-tooltip-autocomplete")
@@ -132,7 +124,7 @@ def test_save_writes_the_file(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
     _open_editor(page, served)
-    _go_to_end_of_line(page, 5)
+    editor_end_of_line(page, 5)
     page.keyboard.type("\nNetwork 2\nLD     I0.1\n=      Q0.2")
     assert page.locator("#editor-name.dirty").count() == 1
     page.click("#editor-save")
@@ -159,19 +151,19 @@ def test_a_file_changed_on_disk_is_loaded_again(serve, page, tmp_path) -> None:
         dialog.accept() if accept else dialog.dismiss()
 
     page.once("dialog", lambda d: answer(d, False))
-    _go_to_end_of_line(page, 5)
+    editor_end_of_line(page, 5)
     page.keyboard.type(" // mine")
     time.sleep(0.05)
     path.write_text(PROGRAM.replace("Q0.0", "Q0.4"))
     page.wait_for_function("() => document.querySelector('#editor-status')"
                            ".textContent.startsWith('kept your edits')", timeout=10000)
-    assert "changed on disk" in asked[0] and "// mine" in _text(page)
+    assert "changed on disk" in asked[0] and "// mine" in editor_text(page)
     # accepting loads the file
     page.once("dialog", lambda d: answer(d, True))
     path.write_text(PROGRAM.replace("Q0.0", "Q0.5"))
     page.wait_for_function("() => window.plcrtEditor.view.state.doc.toString()"
                            ".includes('Q0.5')", timeout=10000)
-    assert len(asked) == 2 and "// mine" not in _text(page)
+    assert len(asked) == 2 and "// mine" not in editor_text(page)
 
 
 def test_a_page_of_another_origin_cannot_save_or_download(serve, page, tmp_path) -> None:
@@ -221,7 +213,7 @@ def test_stl_is_highlighted_by_kind(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
     _open_editor(page, served)
-    _go_to_end_of_line(page, 5)
+    editor_end_of_line(page, 5)
     page.keyboard.type("\nNetwork 2\nLD     Start\nTON    T37, 16#0A\n")
     colors = page.evaluate("""() => {
         const root = document.querySelector('#editor-host').shadowRoot;
@@ -273,16 +265,16 @@ def test_switching_lessons_asks_before_unsaved_edits_go(serve, page, tmp_path) -
         shutil.copytree(COURSE / name, course / name)
     served = serve(panel=lesson_panel(course / "01-seal-in"))
     _open_editor(page, served)
-    assert _text(page) == (course / "01-seal-in" / "lesson.awl").read_text()
-    _go_to_end_of_line(page, 1)
+    assert editor_text(page) == (course / "01-seal-in" / "lesson.awl").read_text()
+    editor_end_of_line(page, 1)
     page.keyboard.type(" // mine")
     page.once("dialog", lambda d: d.dismiss())
     page.select_option("#lessons", "02-timers")
     assert page.locator("#lessons").input_value() == "01-seal-in"
-    assert "// mine" in _text(page)
+    assert "// mine" in editor_text(page)
     page.once("dialog", lambda d: d.accept())
     page.select_option("#lessons", "02-timers")
     page.wait_for_function("() => window.plcrtEditor.view.state.doc.toString()"
                            ".includes('T37')")
-    assert _text(page) == (course / "02-timers" / "lesson.awl").read_text()
+    assert editor_text(page) == (course / "02-timers" / "lesson.awl").read_text()
     assert "// mine" not in (course / "01-seal-in" / "lesson.awl").read_text()

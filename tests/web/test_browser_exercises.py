@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import shutil
 
-from .conftest import REPO
+from .conftest import REPO, editor_end_of_line, editor_text
 from .test_browser_lessons import lesson_panel, open_panel
 
 COURSE = REPO / "examples/course"
@@ -46,15 +46,6 @@ def test_the_conveyor_exercise_is_graded_requirement_by_requirement(serve, page,
     assert page.locator("#check-results li.failed").count() == 0
 
 
-def _editor_text(page) -> str:
-    return page.evaluate("() => window.plcrtEditor.view.state.doc.toString()")
-
-
-def _end_of_line(page, n: int) -> None:
-    page.evaluate(f"() => {{ const v = window.plcrtEditor.view; const l = v.state.doc.line({n});"
-                  f" v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
-
-
 def test_a_student_edits_the_conveyor_exercise_downloads_it_and_the_machine_reacts(
         serve, page, tmp_path) -> None:
     """The whole flow in the page: the exercise opens with its goal text, its
@@ -70,13 +61,13 @@ def test_a_student_edits_the_conveyor_exercise_downloads_it_and_the_machine_reac
     assert "sort the parts" in page.locator("body").inner_text()
     page.click("#edit-toggle")
     page.wait_for_function("() => window.plcrtEditor.loaded")
-    lines = _editor_text(page).splitlines()
+    lines = editor_text(page).splitlines()
     assert lines[19] == "=      Q0.1" and lines[20] == "END_ORGANIZATION_BLOCK"
     # a fourth network typed after line 20, with an error on line 23 (Q0.9)
-    _end_of_line(page, 20)
+    editor_end_of_line(page, 20)
     page.keyboard.press("Enter")
     page.keyboard.type("Network 4 // divert while running\nLD     M0.0\n=      Q0.9")
-    assert _editor_text(page).splitlines()[22] == "=      Q0.9"
+    assert editor_text(page).splitlines()[22] == "=      Q0.9"
     page.wait_for_selector(".cm-lintRange-error")
     assert page.locator("#editor-diags li.error").first.text_content().startswith("line 23:")
     assert "Q0.9" in page.locator(".cm-lintRange-error").first.text_content()
@@ -85,7 +76,7 @@ def test_a_student_edits_the_conveyor_exercise_downloads_it_and_the_machine_reac
                            ".textContent.includes('has errors')")
     assert page.locator("#networks .net").count() == 3
     # fixed: Q0.9 -> Q0.2, the diverter
-    _end_of_line(page, 23)
+    editor_end_of_line(page, 23)
     page.keyboard.press("Backspace")
     page.keyboard.type("2")
     page.wait_for_function("() => document.querySelector('#editor-count')"

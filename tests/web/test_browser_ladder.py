@@ -14,6 +14,7 @@ from plcrt.web.editor import ProgramSource
 from plcrt.web.server import Panel
 from plcrt.web.session import PanelSession
 
+from .conftest import editor_text
 from .test_browser_editor import _Plain
 
 PROGRAM = """\
@@ -55,10 +56,6 @@ def _open_drawing(page, served, network: str) -> None:
     page.wait_for_function("() => !document.querySelector('#draw').hidden")
 
 
-def _text(page) -> str:
-    return page.evaluate("() => window.plcrtEditor.view.state.doc.toString()")
-
-
 def _type_in_place(page, text: str) -> None:
     page.wait_for_selector("#draw-rung input.lad-input")
     assert page.evaluate("() => document.activeElement.className") == "lad-input"
@@ -87,7 +84,7 @@ def test_draw_a_seal_in_rung_with_mouse_and_keyboard_and_save(serve, page, tmp_p
     _type_in_place(page, "Motor")
     _wait_stl(page, "LD     Start\n=      Motor\n")
     # the editor holds the network as STL at once
-    assert "Network 1 // Seal-in\nLD     Start\n=      Motor\nNetwork 2" in _text(page)
+    assert "Network 1 // Seal-in\nLD     Start\n=      Motor\nNetwork 2" in editor_text(page)
     # with the keyboard: select Start (arrows), a normally closed contact
     # after it ('/'), then a parallel branch around Start ('o')
     page.focus("#draw-rung")
@@ -120,7 +117,7 @@ def test_draw_a_seal_in_rung_with_mouse_and_keyboard_and_save(serve, page, tmp_p
     page.focus("#draw-rung")
     page.keyboard.press("Control+z")
     _wait_stl(page, "LD     Start\nO      Motr\nAN     Stop\n=      Motor\n")
-    assert "O      Motr" in _text(page)
+    assert "O      Motr" in editor_text(page)
     page.keyboard.press("Control+y")
     _wait_stl(page, SEAL_IN)
     # Delete removes the selected element, undo brings it back
@@ -162,7 +159,7 @@ def test_a_network_without_ladder_form_stays_stl_and_a_new_one_is_drawn(serve, p
     page.click("#draw-palette [data-add='=']")
     _type_in_place(page, "Q0.5")
     _wait_stl(page, "LD     I0.5\n=      Q0.5\n")
-    assert _text(page).endswith("=      Q0.2\nNetwork 3\nLD     I0.5\n=      Q0.5\n"
+    assert editor_text(page).endswith("=      Q0.2\nNetwork 3\nLD     I0.5\n=      Q0.5\n"
                                 "END_ORGANIZATION_BLOCK\n")
     assert page.errors == []
 
@@ -238,7 +235,7 @@ def test_change_move_and_add_a_box_with_the_keyboard(serve, page, tmp_path) -> N
     page.keyboard.type("T37, VW1, VW2")
     page.keyboard.press("Enter")
     page.wait_for_function("() => document.querySelector('#draw-status').className === 'error'")
-    assert "TON    T37, +50" in _text(page)
+    assert "TON    T37, +50" in editor_text(page)
     page.focus("#draw-rung")
     for _ in range(4):
         page.keyboard.press("Control+z")
@@ -269,5 +266,5 @@ def test_elements_are_moved_with_the_mouse(serve, page, tmp_path) -> None:
     # a coil dropped among contacts is refused, nothing changes
     page.drag_and_drop(el.format("= Motor"), el.format("NO Stop"))
     page.wait_for_function("() => document.querySelector('#draw-status').className === 'warning'")
-    assert "S      Q0.3, 1\n=      Motor" in _text(page)
+    assert "S      Q0.3, 1\n=      Motor" in editor_text(page)
     assert page.errors == []

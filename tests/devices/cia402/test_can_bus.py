@@ -12,19 +12,19 @@ import itertools
 import logging
 import struct
 import threading
-import time
 
 import pytest
 
 canopen = pytest.importorskip("canopen")
 can = pytest.importorskip("can")
-from canopen.profiles.p402 import BaseNode402  # noqa: E402
 
 from plcrt import cia402  # noqa: E402
 from plcrt.devices.cia402.esm import EsmState  # noqa: E402
 from plcrt.devices.cia402.plant import DrivePlant  # noqa: E402
 from plcrt.devices.cia402.statemachine import State  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
+
+from can_master_helpers import master, remap_sync, trajectory, wait_for  # noqa: E402
 
 _channels = itertools.count()
 
@@ -51,34 +51,6 @@ def virtual_pair(name: str):
     return dev, mst
 
 
-def wait_for(cond, timeout=2.0):
-    end = time.monotonic() + timeout
-    while not cond() and time.monotonic() < end:
-        time.sleep(0.0005)
-    return cond()
-
-
-def master(mst, node_id, model="hcfa-am0520b"):
-    n = BaseNode402(node_id, cia402.object_dictionary(model, node_id=node_id))
-    mst.add_node(n)
-    n.nmt.state = "PRE-OPERATIONAL"
-    n.setup_402_state_machine(read_pdos=True)
-    return n
-
-
-def remap_sync(n, sim, rx=(0x6040, 0x607A), tx=(0x6064, 0x6041), trans=1):
-    """canopen's own remapping (``save()``): CiA 301 §7.5.2.36 over SDO."""
-    tpdo, rpdo = n.tpdo[sim.tpdo_no], n.rpdo[sim.rpdo_no]
-    for pdo, objs in ((tpdo, tx), (rpdo, rx)):
-        pdo.clear()
-        for index in objs:
-            pdo.add_variable(index)
-        pdo.trans_type = trans
-        pdo.enabled = True
-        pdo.save()
-    return tpdo, rpdo
-
-
 class Tpdos:
     """Every TPDO payload the master's network receives, per COB-ID."""
 
@@ -96,11 +68,6 @@ class Tpdos:
     def wait(self, count):
         with self.cond:
             self.cond.wait_for(lambda: all(len(v) >= count for v in self.got.values()), 5.0)
-
-
-def trajectory(k: int) -> int:
-    """5 k^2 up to k = 60 (steps below 6080h), then on at 600 counts per ms."""
-    return 5 * k * k if k <= 60 else 18_000 + 600 * (k - 60)
 
 
 def run_eight_drives(dev, mst):

@@ -17,7 +17,6 @@ import pytest
 
 canopen = pytest.importorskip("canopen")
 can = pytest.importorskip("can")
-from canopen.profiles.p402 import BaseNode402  # noqa: E402
 
 from plcrt import cia402  # noqa: E402
 from plcrt.devices.cia402.emcy import EMCY_TABLE, emcy_code  # noqa: E402
@@ -26,16 +25,10 @@ from plcrt.devices.cia402.plant import DrivePlant  # noqa: E402
 from plcrt.devices.cia402.reactions import FAULT_CODES  # noqa: E402
 from plcrt.devices.cia402.statemachine import State  # noqa: E402
 
+from can_master_helpers import master, remap_sync, trajectory, wait_for  # noqa: E402
+
 _channels = itertools.count()
 MODELS = ("hcfa-am0520b", "kinco-servo")
-
-
-def wait_for(cond, timeout=2.0):
-    """Frames are handled in the receivers' Notifier threads."""
-    end = time.monotonic() + timeout
-    while not cond() and time.monotonic() < end:
-        time.sleep(0.0005)
-    return cond()
 
 
 @pytest.fixture
@@ -70,31 +63,9 @@ class Frames:
             return list(self.got[can_id])
 
 
-def master(mst, node_id, model):
-    """The documented master: the CAN view's dictionary, PDOs read from the node."""
-    n = BaseNode402(node_id, cia402.object_dictionary(model, node_id=node_id))
-    mst.add_node(n)
-    n.nmt.state = "PRE-OPERATIONAL"
-    n.setup_402_state_machine(read_pdos=True)
-    return n
-
-
 def operational(n, sim):
     n.nmt.state = "OPERATIONAL"
     assert wait_for(lambda: sim.drive.esm.state is EsmState.OP)
-
-
-def remap_sync(n, sim, rx=(0x6040, 0x607A), tx=(0x6064, 0x6041), trans=1):
-    """Remap the CAN view's PDOs with canopen's own procedure (save())."""
-    tpdo, rpdo = n.tpdo[sim.tpdo_no], n.rpdo[sim.rpdo_no]
-    for pdo, objs in ((tpdo, tx), (rpdo, rx)):
-        pdo.clear()
-        for index in objs:
-            pdo.add_variable(index)
-        pdo.trans_type = trans
-        pdo.enabled = True
-        pdo.save()
-    return tpdo, rpdo
 
 
 # --------------------------------------------------------------------------- remapping
@@ -268,11 +239,6 @@ def test_pdos_and_sync_act_in_operational_only(bus):
 
 
 # --------------------------------------------------------------------------- CSP at 1 ms SYNC
-
-def trajectory(k: int) -> int:
-    """A smooth move: 5 k^2 up to k = 60 (steps below 6080h = 833 P/ms), then on at 600/ms."""
-    return 5 * k * k if k <= 60 else 18_000 + 600 * (k - 60)
-
 
 def test_eight_drives_follow_a_csp_trajectory_exactly_at_a_1ms_sync(bus):
     """Eight HCFA drives in CSP, each SYNC one 1 ms bus cycle (1006h =

@@ -66,13 +66,13 @@ def open_container(data: bytes, file: str, max_stream: int = MAX_STREAM) -> Cont
     Raises:
         PlcSyntaxError: a header or stream that is not a project's,
             truncated, or inflating to more than it declares.
-        PlcConfigError: a SMART V3 project (an encrypted zip) or a project
-            with a password.
+        PlcConfigError: a bare zip archive or a project with a password
+            (SMART V3 projects are opened by :mod:`.smartv3`).
     """
     if data[:2] == b"PK":
-        raise binary_error(file, _HEADER, 0, "a Micro/WIN SMART V3 project (an encrypted "
-                           "zip) is not read: save it as a V2 project (.smart)", PlcConfigError,
-                           "file")
+        raise binary_error(file, _HEADER, 0, "a bare zip archive, not a project file (a "
+                           "Micro/WIN SMART V3 project is a 256-byte header and an encrypted "
+                           "zip)", PlcConfigError, "file")
     layout = _LAYOUTS.get((data[:4], data[4:8]))
     if layout is None:
         raise binary_error(file, _HEADER, 0, "not a Micro/WIN V4 (.mwp) or Micro/WIN "

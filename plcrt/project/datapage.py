@@ -17,7 +17,7 @@ import struct
 from .codes import WIDTH_LETTER
 from .stream import Cursor
 
-__all__ = ["read_data_block"]
+__all__ = ["read_data_block", "read_data_page"]
 
 _CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 MAX_PAGES = 256
@@ -35,6 +35,12 @@ def read_data_block(c: Cursor) -> str:
     return "".join(line + "\r\n" for line in lines)
 
 
+def read_data_page(c: Cursor) -> list[str]:
+    """The lines of the data page at the cursor (a SMART V3 project keeps
+    each page apart, with no data-block header)."""
+    return _page(c)
+
+
 def _page(c: Cursor) -> list[str]:
     version = c.u1()
     c.expect(0x1388, 2, "data page header")
@@ -49,12 +55,11 @@ def _page(c: Cursor) -> list[str]:
         c.skip(86 if version >= 8 else 22)
     rows = [_row(c) for _ in range(c.count(2, MAX_ROWS, "number of data rows"))]
     comments: dict[int, str] = {}
-    wide = c.u1() == 2
-    for _ in range(c.count(2, MAX_ROWS, "number of data comments")):
-        if wide:
-            c.skip(4)
-        index = c.u2()
-        if index == 0xFFFF:
+    # version 2 (SMART V3): the count and each row's index are 4 bytes wide
+    width = 4 if c.u1() == 2 else 2
+    for _ in range(c.count(width, MAX_ROWS, "number of data comments")):
+        index = c.u4() if width == 4 else c.u2()
+        if index in (0xFFFF, 0xFFFFFFFF):
             continue
         c.skip(2 + 2 + 2 + 1)
         comments[index] = c.text()

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from .codes import AREAS, CLASSES, OPCODES, VAR_SECTIONS, VAR_TYPES, WIDTH_LETTER
 from .stream import Cursor
 
-__all__ = ["Block", "Net", "read_program_block", "MAX_BLOCKS", "MAX_OPERANDS"]
+__all__ = ["Block", "Net", "read_program_block", "read_network", "MAX_BLOCKS", "MAX_OPERANDS"]
 
 #: most blocks read (MAIN, 128 subroutines and 128 interrupt routines)
 MAX_BLOCKS = 512
@@ -35,6 +35,9 @@ _NETWORK_KINDS = {0x101: "FBD", 0x102: "LAD", 0x106: "STL"}
 _WIRES = frozenset((0x0, 0x1))
 #: a block's protection flags: 0x200/0x400 mark a block with a password
 _PROTECTED = 0x600
+#: the network layout of Micro/WIN SMART V3 (V2 and V1 write 4): an
+#: address operand is followed by 2 bytes (1)
+_V3_NETWORK = 7
 
 
 @dataclass
@@ -129,6 +132,11 @@ def _block(c: Cursor) -> Block:
     return block
 
 
+def read_network(c: Cursor, block: Block, index: int) -> Net:
+    """The network at the cursor (of a V4, SMART V2 or SMART V3 block)."""
+    return _network(c, block, index)
+
+
 def _network(c: Cursor, block: Block, index: int) -> Net:
     start = c.pos
     c.u2()
@@ -137,7 +145,7 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
     if editor is None:
         raise c.error(f"network {index + 1} of {block.ident}: editor code is not "
                       "LAD, FBD or STL", at)
-    c.skip(2)
+    v3 = c.u2() == _V3_NETWORK
     net = Net(c.text(), "", editor)
     c.expect(0, 1, "network header")
     net.comment = c.text()
@@ -162,7 +170,7 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
         code_at = c.pos
         code = c.u2()
         c.expect(0x101, 2, "statement")
-        operands = _operands(c, compiled=True)
+        operands = _operands(c, compiled=True, v3=v3)
         mnemonic = OPCODES.get(code)
         if mnemonic is None:
             raise c.error(f"network {index + 1} of {block.ident}: instruction code "
@@ -176,10 +184,10 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
                 drawn += 1
                 c.skip(2 + 2 + 2 + 4)
                 c.expect(0x101, 2, "STL line")
-                _operands(c, compiled=False)
+                _operands(c, compiled=False, v3=v3)
     else:
         for _ in range(c.count(2, 65535, "number of cells")):
-            drawn += _cell(c) not in _WIRES
+            drawn += _cell(c, v3) not in _WIRES
     if drawn and not net.statements:
         # the editor holds a program the CPU would not get: never run it as empty
         raise c.error(f"network {index + 1} of {block.ident} has {editor} content but no "
@@ -188,7 +196,7 @@ def _network(c: Cursor, block: Block, index: int) -> Net:
     return net
 
 
-def _cell(c: Cursor) -> int:
+def _cell(c: Cursor, v3: bool = False) -> int:
     """Step over one ladder or FBD cell (position, kind, labels, operands);
     returns its kind."""
     c.expect(0, 1, "cell")
@@ -198,27 +206,34 @@ def _cell(c: Cursor) -> int:
     c.skip(1 + 1 + 1 + 2)
     c.skip(53 * c.count(1, MAX_LABELS, "number of cell labels"))
     c.expect(0x101, 2, "cell")
-    _operands(c, compiled=True)
+    _operands(c, compiled=True, v3=v3, cell=True)
     return kind
 
 
-def _operands(c: Cursor, *, compiled: bool) -> list[str]:
+def _operands(c: Cursor, *, compiled: bool, v3: bool = False, cell: bool = False
+              ) -> list[str]:
     out = []
     for _ in range(c.count(2, MAX_OPERANDS, "number of operands")):
         if c.u2() == 0xFFFF:
             out.append("")
             continue
-        out.append(_operand(c, compiled))
+        out.append(_operand(c, compiled, v3, cell))
     return out
 
 
-def _operand(c: Cursor, compiled: bool) -> str:
+def _operand(c: Cursor, compiled: bool, v3: bool = False, cell: bool = False) -> str:
     c.skip(1 if compiled else 2)
-    c.skip(2 + 4 + 1 + 4)                     # kind, 0, 1, column
+    layout = c.u1()                           # 3, or 4 (a V3 cell's address: 2 more bytes)
+    c.skip(1 + 4 + 1 + 4)                     # kind, 0, 1, column
     at = c.pos
     form = c.u1()
     if form == 2:
-        return _address(c)
+        text = _address(c)
+        # SMART V3: an address in a statement, or in a cell of layout 4,
+        # ends with 2 bytes (1) (docs/project-files.md, SMART V3)
+        if v3 and (layout == 4 or not cell):
+            c.expect(1, 2, "address operand")
+        return text
     if form != 1:
         raise c.error(f"operand form {form} is neither a constant nor an address", at)
     kind, width, _area = c.u1(), c.u1(), c.u1()

@@ -15,6 +15,7 @@ and the CPU they are for; their data block and system block are not read
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,13 +29,15 @@ from .datapage import read_data_block
 from .program import Block, read_program_block
 from .r03 import read_v3_program
 from .r03tables import check_symbolic_cells, read_v3_symbols
+from .smartv3 import is_smartv3, open_smartv3
+from .smartv3pou import read_smartv3_content, recode_variables
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
 
 __all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
 
-#: file name endings read as project files
-PROJECT_SUFFIXES = (".mwp", ".smart")
+#: file name endings read as project files (in lower case)
+PROJECT_SUFFIXES = (".mwp", ".smart", ".smartv3")
 
 _CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 #: the start of the data block: version 2, a page count, a page (version
@@ -76,6 +79,8 @@ class Project:
 
 def read_project(data: bytes, file: str) -> Project:
     """The project in ``data`` (the bytes of a whole project file)."""
+    if is_smartv3(data):
+        return _smartv3_project(data, file)
     box = open_container(data, file)
     if box.format == "Micro/WIN V3":
         return _v3_project(box)
@@ -108,6 +113,19 @@ def _v3_project(box: Container) -> Project:
     return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
                    codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
                    notes=notes)
+
+
+def _smartv3_project(data: bytes, file: str) -> Project:
+    """A SMART V3 project: an encrypted zip of members (:mod:`.smartv3`)."""
+    archive = open_smartv3(data, file)
+    v3 = read_smartv3_content(archive)
+    bare = [dataclasses.replace(b, variables=[]) for b in v3.blocks]
+    codec = decode_bytes((blocks_text(bare) + v3.data).encode("latin-1"), file).encoding
+    recode_variables(v3.blocks, codec)
+    return Project(file, "Micro/WIN SMART V3", archive.version, v3.blocks,
+                   _recode(blocks_text(v3.blocks), codec), codec,
+                   symbols_text(SymbolTables(v3.symbols)), _recode(v3.data, codec), v3.cpu,
+                   v3.notes)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -46,8 +46,9 @@ def statement(index: int, mnemonic: str, operands: tuple[str, ...], tail: bool =
 
 
 def network(index: int, net: ir.Network, *, tail: bool = True, code: int | None = None,
-            drawn: bool = False) -> bytes:
-    out = u2(index) + u2(0x102) + u2(7) + strl(net.title) + u1(0) + strl(net.comment)
+            drawn: bool = False, encoding: str = "latin-1") -> bytes:
+    out = (u2(index) + u2(0x102) + u2(7) + _text(net.title, encoding) + u1(0)
+           + _text(net.comment, encoding))
     out += u1(2) + u4(0) + u1(2) + u4(0) + u1(2) + u4(0) + u2(0) + u2(len(net.insns))
     for i, insn in enumerate(net.insns):
         out += statement(i, insn.mnemonic, tuple(o.text for o in insn.operands), tail,
@@ -77,7 +78,7 @@ def pou(block: ir.Pou, *, layout: int = 0x83, flags: int = 1, kind: int | None =
     out += u2(0) + bytes(2 + 20 + 64) + u4(0) + u4(0) + bytes(3)      # author, protection
     out += bytes(32) + u1(0) + u2(len(nets))
     for i, net in enumerate(nets):
-        out += network(i, net, tail=tail, code=code)
+        out += network(i, net, tail=tail, code=code, encoding=encoding)
     table = variables_xml(block) if xml is None else xml
     out += u4(0) + u4(1) + u4(100) + u1(8) + u2(0) + u4(0) + u2(1) + bytes(22)
     out += u4(len(table)) + table

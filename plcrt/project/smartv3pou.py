@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 
-from ..errors import PlcConfigError, PlcError, PlcSyntaxError
+from ..errors import PlcConfigError, PlcError
 from .datapage import read_data_page
 from .program import MAX_BLOCKS, Block, read_network
 from .smartv3 import SmartV3Archive, member_label
@@ -56,9 +56,9 @@ class _MemberCursor(Cursor):
 
     __slots__ = ("space",)
 
-    def __init__(self, data: bytes, file: str, section: str, member: str) -> None:
+    def __init__(self, data: bytes, file: str, section: str) -> None:
         super().__init__(data, file, section)
-        self.space = f"member {member}"
+        self.space = "member"
 
     def error(self, message: str, at: int | None = None) -> PlcError:
         return binary_error(self.file, self.section, self.pos if at is None else at,
@@ -90,18 +90,18 @@ def read_smartv3_content(archive: SmartV3Archive) -> SmartV3Content:
                 continue
             if (block.kind, block.number) in seen:
                 raise binary_error(archive.file, f"program block {label}", 0,
-                                   f"a second block {block.ident}", space=f"member {label}")
+                                   f"a second block {block.ident}", space="member")
             seen.add((block.kind, block.number))
             out.blocks.append(block)
             if len(out.blocks) > MAX_BLOCKS:
                 raise binary_error(archive.file, f"program block {label}", 0, "more than "
-                                   f"{MAX_BLOCKS} blocks", space=f"member {label}")
+                                   f"{MAX_BLOCKS} blocks", space="member")
         elif kind == "data":
             pages.append(_page(body, archive.file, label))
         elif kind == "symbols":
             _symbols(body, archive.file, label, out)
         elif kind == "device":
-            root = parse_xml(body, archive.file, f"device {label}", label)
+            root = parse_xml(body, archive.file, f"device {label}")
             out.cpu = " ".join(_CONTROL.sub(" ", root.get("DeviceType", "")).split())[:40]
     if not any(b.kind == "OB" for b in out.blocks):
         raise binary_error(archive.file, _ZIP_SECTION, 0, "no program block MAIN in the "
@@ -111,11 +111,11 @@ def read_smartv3_content(archive: SmartV3Archive) -> SmartV3Content:
     return out
 
 
-def parse_xml(raw: bytes, file: str, section: str, member: str) -> ET.Element:
+def parse_xml(raw: bytes, file: str, section: str) -> ET.Element:
     """The root element of the XML document ``raw`` (a member of the
     archive), refused past :data:`MAX_XML` or with a document type or
     entity declaration."""
-    space = f"member {member}"
+    space = "member"
     if len(raw) > MAX_XML:
         raise binary_error(file, section, MAX_XML, f"the XML document is {len(raw)} bytes, "
                            f"more than the {MAX_XML} this reader parses", space=space)
@@ -134,7 +134,7 @@ def parse_xml(raw: bytes, file: str, section: str, member: str) -> ET.Element:
 
 
 def _pou(body: bytes, file: str, label: str, notes: list[str]) -> Block | None:
-    c = _MemberCursor(body, file, f"program block {label}", label)
+    c = _MemberCursor(body, file, f"program block {label}")
     c.expect(8, 1, "block version")
     at = c.pos
     kind = _KINDS.get(c.u2())
@@ -167,26 +167,26 @@ def _pou(body: bytes, file: str, label: str, notes: list[str]) -> Block | None:
     count = c.count(2, 65535, "number of networks")
     for index in range(count):
         block.networks.append(read_network(c, block, index))
-    _trailer(c, count, block, label, records=layout != 0x82)
+    _trailer(c, count, block, records=layout != 0x82)
     if kind == "FB":
-        return _function_block(block, c, label, notes)
+        return _function_block(block, c, notes)
     if block.protected:
         notes.append(f"{block.ident} ({block.name}) is protected by a password: it is "
                      "loaded as a protected block, its interface without its code")
     return block
 
 
-def _function_block(block: Block, c: Cursor, label: str, notes: list[str]) -> None:
+def _function_block(block: Block, c: Cursor, notes: list[str]) -> None:
     """A V3 function block: left out if it holds no code, else refused."""
     if any(net.statements for net in block.networks):
         raise binary_error(c.file, c.section, 0, f"function block {block.name!r} holds "
                            "code: function blocks (SMART V3) are not run by plcrt",
-                           PlcConfigError, f"member {label}")
+                           PlcConfigError, "member")
     notes.append(f"function block {block.name} is empty and left out")
     return None
 
 
-def _trailer(c: Cursor, networks: int, block: Block, label: str, records: bool) -> None:
+def _trailer(c: Cursor, networks: int, block: Block, records: bool) -> None:
     """What follows the networks: dependencies, the local variable table
     (XML) and (from V3.1 on) a record of cell labels per network, to the
     member's end."""
@@ -201,7 +201,7 @@ def _trailer(c: Cursor, networks: int, block: Block, label: str, records: bool) 
     c.skip(2 + 4 + 2 + 22)
     size = c.count(4, MAX_XML, "length of the local variable table")
     at = c.pos
-    root = parse_xml(c.take(size), c.file, c.section, label)
+    root = parse_xml(c.take(size), c.file, c.section)
     if root.tag != "LocVarTable":
         raise c.error(f"the local variable table is a {member_label(root.tag)!r}, not a "
                       "LocVarTable", at)
@@ -259,7 +259,7 @@ def _bytes_of(text: str, codec: str) -> str:
 
 
 def _page(body: bytes, file: str, label: str) -> tuple[int, list[str]]:
-    c = _MemberCursor(body, file, f"data block {label}", label)
+    c = _MemberCursor(body, file, f"data block {label}")
     index = int.from_bytes(body[5:7], "little") if len(body) >= 7 else 0
     lines = read_data_page(c)
     if c.pos != len(body):
@@ -269,7 +269,7 @@ def _page(body: bytes, file: str, label: str) -> tuple[int, list[str]]:
 
 def _symbols(body: bytes, file: str, label: str, out: SmartV3Content) -> None:
     section = f"symbol table {label}"
-    root = parse_xml(body, file, section, label)
+    root = parse_xml(body, file, section)
     count = 0
     for table in root.iter("VarTable"):
         kind = table.get("TableType", "")
@@ -279,7 +279,7 @@ def _symbols(body: bytes, file: str, label: str, out: SmartV3Content) -> None:
             count += 1
             if count > MAX_SYMBOLS:
                 raise binary_error(file, section, 0, f"more than {MAX_SYMBOLS} symbols",
-                                   space=f"member {label}")
+                                   space="member")
             name = row.get("Name", "")
             if not name:
                 continue

@@ -125,7 +125,9 @@ def parse_xml(raw: bytes, file: str, section: str) -> ET.Element:
                            "document type or entity, or holds a NUL byte: not read",
                            PlcConfigError, space)
     try:
-        return ET.fromstring(raw)
+        # UTF-8 whatever the document declares: no codec is looked up by a
+        # name read from the file
+        return ET.fromstring(raw, parser=ET.XMLParser(encoding="utf-8"))
     except ET.ParseError as e:
         line, column = e.position
         at = sum(len(x) + 1 for x in raw.split(b"\n")[:max(line - 1, 0)]) + column

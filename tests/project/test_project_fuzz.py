@@ -160,3 +160,56 @@ def test_a_stream_longer_than_declared_is_refused() -> None:
     head, body = _split(data)
     with pytest.raises(PlcError, match="not the 10 its header declares"):
         read_project(container(body, declared=10), "x.mwp")
+
+
+# -- SMART V3 (.smartV3): the file, its zip and its members mutated; the zip
+# and the members are encrypted again, so the mutants pass the tag
+
+
+@functools.cache
+def _v3_members() -> tuple[tuple[str, bytes], ...]:
+    import smartv3_writer
+    from test_project_load import EVERY_CODE
+    program = parse_program(EVERY_CODE, "x.awl")
+    return tuple(smartv3_writer.members(program, symbols=[("A", "I0.0", "a")],
+                                        data=[("VW0", [1, 2], "c")]))
+
+
+def _v3_mutant(kind: str, rng: random.Random) -> bytes:
+    import smartv3_writer as v3
+    entries = list(_v3_members())
+    plain = v3.zip_bytes(entries)
+    if kind == "file":                    # the file cut, or a bit of it flipped
+        data = bytearray(v3.encrypt(plain))
+        if rng.random() < 0.5:
+            return bytes(data[:rng.randrange(len(data))])
+        data[rng.randrange(len(data))] ^= 1 << rng.randrange(8)
+        return bytes(data)
+    if kind == "zip":                     # bits of the archive (directory, headers)
+        raw = bytearray(plain)
+        for _ in range(rng.randint(1, 8)):
+            raw[rng.randrange(len(raw))] ^= 1 << rng.randrange(8)
+        return v3.encrypt(bytes(raw))
+    read = [i for i, (n, _) in enumerate(entries) if n.endswith((".poubin", ".dbbin", ".xml"))]
+    at = rng.choice(read)
+    raw = bytearray(entries[at][1])
+    if kind == "member-truncated":
+        raw = raw[:rng.randrange(len(raw))]
+    elif kind == "member-flipped":
+        for _ in range(rng.randint(1, 8)):
+            raw[rng.randrange(len(raw))] ^= 1 << rng.randrange(8)
+    else:                                 # counts and lengths set to extremes
+        for _ in range(rng.randint(1, 4)):
+            pos = rng.randrange(len(raw) - 4)
+            width = rng.choice((1, 2, 4))
+            raw[pos:pos + width] = rng.choice((b"\xff", b"\x00", b"\x7f")) * width
+    entries[at] = (entries[at][0], bytes(raw))
+    return v3.encrypt(v3.zip_bytes(entries))
+
+
+@pytest.mark.parametrize("kind", ["file", "zip", "member-truncated", "member-flipped",
+                                  "member-forged"])
+def test_smartv3_mutants_end_in_plc_errors(kind: str) -> None:
+    rng = random.Random(f"{SEED}/smartv3/{kind}")
+    for k in range(MUTANTS):
+        _check(_v3_mutant(kind, rng), f"own.smartV3~{kind}{k}", traced=k % 10 == 0)

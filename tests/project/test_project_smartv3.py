@@ -368,3 +368,13 @@ def test_a_member_name_is_only_compared() -> None:
                for n, b in w.members(program)]
     project = read_project(w.encrypt(w.zip_bytes(entries)), "p.smartV3")
     assert ir_of(parse_program(project.awl, "p")) == ir_of(program)
+
+
+@pytest.mark.parametrize("declared", ["x-no-such-codec", "utf-7", "utf-16"])
+def test_the_xml_is_utf8_whatever_it_declares(declared: str) -> None:
+    """No codec is looked up by a name read from the file: the symbol table
+    reads as UTF-8 under any declaration."""
+    xml = w.symbols_xml(SYMBOLS).replace(b'encoding="UTF-8"', f'encoding="{declared}"'.encode())
+    entries = [(n, xml if "GlbVar" in n else b) for n, b in w.members(_program())]
+    project = read_project(w.encrypt(w.zip_bytes(entries)), "p.smartV3")
+    assert project.symbols.startswith("Start\tI0.0\tstart button\r\n")

@@ -1,4 +1,5 @@
-"""Micro/WIN V3 and V4 (``.mwp``) and Micro/WIN SMART V2 (``.smart``) project files.
+"""Micro/WIN V3 and V4 (``.mwp``) and Micro/WIN SMART V2 and V3 (``.smart``,
+``.smartV3``) project files.
 
 A front end beside :mod:`plcrt.lang`: it reads a project file (container,
 bounded decompression, program block, symbol tables, data block) and hands
@@ -13,6 +14,8 @@ Submodules: :mod:`.stream` (the bounded cursor), :mod:`.container`
 :mod:`.tables` (symbol tables), :mod:`.datapage` (data block), :mod:`.codes`
 (the code tables), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
 (Micro/WIN V3 projects: blocks and cells, compiled code, symbol table),
+:mod:`.smartv3` and :mod:`.smartv3pou` (SMART V3 projects: the encrypted
+zip, its blocks, symbol tables and data pages),
 :mod:`.awl` (the export text), :mod:`.reader` (the
 sections in order), :mod:`.frontend` (what ``load`` calls), :mod:`.cli`
 (``plcrt export``).  The package imports them when a name below is first

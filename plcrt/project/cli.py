@@ -31,10 +31,11 @@ def register(sub: Any) -> None:
     """Add the ``export`` subcommand to the ``plcrt`` parser."""
     p = sub.add_parser(
         "export", help="write a project file's STL export, symbol table and data block",
-        description="Read a Micro/WIN V4 (.mwp) or Micro/WIN SMART V2 (.smart) project and "
+        description="Read a Micro/WIN V4 (.mwp) or Micro/WIN SMART V2/V3 (.smart, .smartV3) "
+                    "project and "
                     "write its program as an STL export (.awl), its symbol table "
                     "(tab-separated) and its data block, in the project's code page.")
-    p.add_argument("project", metavar="PROJECT", help="the project file (.mwp, .smart)")
+    p.add_argument("project", metavar="PROJECT", help="the project file (.mwp, .smart, .smartV3)")
     p.add_argument("--awl", metavar="F", help="write the program's STL export here")
     p.add_argument("--symbols", metavar="F", help="write the symbol table here")
     p.add_argument("--data", metavar="F", help="write the data block here")

@@ -1,7 +1,8 @@
 """The project-file front end as :mod:`plcrt.lang.sources` calls it.
 
 Importing this module registers :func:`load_project` in
-:data:`plcrt.lang.sources.PROJECT_READERS` for ``.mwp`` and ``.smart``, so
+:data:`plcrt.lang.sources.PROJECT_READERS` for ``.mwp``, ``.smart`` and
+``.smartv3`` (suffixes are compared in lower case), so
 ``plcrt.load("x.mwp")`` and the command line read project files
 (:mod:`plcrt.loader` and ``plcrt show`` import it).  It is kept apart from
 the package's ``__init__`` so that ``plcrt --help``, which imports

@@ -10,7 +10,9 @@ Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
 read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table),
 and the CPU they are for; their data block and system block are not read
-(docs/project-files.md, "Micro/WIN V3 projects").
+(docs/project-files.md, "Micro/WIN V3 projects").  SMART V3 projects
+(``.smartV3``, an encrypted zip) are opened by :mod:`.smartv3` and their
+members read by :mod:`.smartv3pou`.
 """
 
 from __future__ import annotations

@@ -31,9 +31,6 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field
 
-from cryptography.exceptions import InvalidTag
-from cryptography.hazmat.primitives.ciphers.aead import AESGCM
-
 from ..errors import PlcConfigError, PlcSyntaxError
 from .container import MAX_STREAM
 from .stream import binary_error
@@ -125,6 +122,10 @@ def open_smartv3(data: bytes, file: str) -> SmartV3Archive:
                            "a SMART V3 project's (1 or 2)", space="file")
     version = data[4:16].decode("ascii")
     view = _VIEWS.get(data[18], f"view {data[18]}")
+    # perf: imported here, not by every load of an .awl (plcrt.loader
+    # imports the project reader); about 25 ms
+    from cryptography.exceptions import InvalidTag
+    from cryptography.hazmat.primitives.ciphers.aead import AESGCM
     key = hashlib.sha256(_DEFAULT_PASSWORD).digest()
     try:
         plain = AESGCM(key).decrypt(_NONCE, data[HEADER_SIZE:], _AAD)

@@ -60,6 +60,7 @@ _FLAG_AT = 121
 _PROTECTED, _INVALID = 1, 0
 _VIEWS = {0: "LAD", 1: "STL", 2: "FBD"}
 _EOCD = b"PK\x05\x06"
+_ZIP64_LOCATOR = b"PK\x06\x07"
 _EOCD_SIZE = 22
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 #: what a member holds, by the end of its name (compared in lower case)
@@ -153,7 +154,10 @@ def _check_directory(plain: bytes, file: str) -> None:
                          "project is not a zip archive")
     _sig, _disk, _start, _here, total, size, offset, _note = struct.unpack_from(
         "<IHHHHIIH", plain, at)
-    if total == 0xFFFF or size == 0xFFFFFFFF or offset == 0xFFFFFFFF:
+    # zipfile takes the counts of a zip64 record when its locator precedes
+    # the end record: none is accepted, so the counts checked are its counts
+    zip64 = at >= 20 and plain[at - 20:at - 16] == _ZIP64_LOCATOR
+    if zip64 or total == 0xFFFF or size == 0xFFFFFFFF or offset == 0xFFFFFFFF:
         raise _zip_error(file, at, "a zip64 archive is not read (a project is far smaller)")
     if total > MAX_MEMBERS:
         raise _zip_error(file, at, f"the archive declares {total} members, more than the "

@@ -342,6 +342,15 @@ def test_many_members_are_refused(forge_count: bool) -> None:
     _refused(w.encrypt(bytes(plain)), PlcSyntaxError, "members, more than")
 
 
+def test_a_zip64_record_is_refused() -> None:
+    """A zip64 locator before the end record would give zipfile other
+    counts than the ones checked: refused."""
+    plain = w.zip_bytes(w.members(_program()))
+    at = plain.rfind(b"PK\x05\x06")
+    locator = b"PK\x06\x07" + struct.pack("<IQI", 0, 0, 1)
+    _refused(w.encrypt(plain[:at] + locator + plain[at:]), PlcSyntaxError, "zip64")
+
+
 def test_a_huge_directory_is_refused() -> None:
     entries = [(f"{i:06d}" + "n" * 2000, b"") for i in range(MAX_DIRECTORY // 2000)]
     _refused(w.encrypt(w.zip_bytes(entries, zipfile.ZIP_STORED)), PlcSyntaxError,

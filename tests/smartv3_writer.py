@@ -135,10 +135,12 @@ def members(program: ir.Program, *, symbols: list = (), data: list = (),
 
 
 def zip_bytes(entries: list[tuple[str, bytes]], method: int = zipfile.ZIP_DEFLATED) -> bytes:
+    """The archive of ``entries``, byte for byte the same for the same
+    entries (fixed time stamps)."""
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", method) as box:
         for name, body in entries:
-            box.writestr(name, body)
+            box.writestr(zipfile.ZipInfo(name, (2024, 1, 1, 0, 0, 0)), body, method)
     return buffer.getvalue()
 
 

@@ -31,7 +31,7 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field
 
-from ..errors import PlcConfigError, PlcSyntaxError
+from ..errors import PlcConfigError, PlcError
 from .container import MAX_STREAM
 from .stream import binary_error
 
@@ -139,10 +139,9 @@ def open_smartv3(data: bytes, file: str) -> SmartV3Archive:
     return archive
 
 
-def _zip_error(file: str, offset: int, message: str, section: str = _ZIP) -> PlcSyntaxError:
-    error = binary_error(file, section, offset, message, space="decrypted zip archive")
-    assert isinstance(error, PlcSyntaxError)
-    return error
+def _zip_error(file: str, offset: int, message: str, section: str = _ZIP) -> PlcError:
+    """A :class:`PlcSyntaxError` at ``offset`` of the decrypted archive."""
+    return binary_error(file, section, offset, message, space="decrypted zip archive")
 
 
 def _check_directory(plain: bytes, file: str) -> None:

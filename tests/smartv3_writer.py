@@ -45,14 +45,25 @@ def statement(index: int, mnemonic: str, operands: tuple[str, ...], tail: bool =
     return out
 
 
+def contact(text: str, layout: int) -> bytes:
+    """A ladder cell: a normally open contact naming ``text``, its operand of
+    ``layout`` 3 or 4 (4: an address ends with 2 bytes (1))."""
+    head = u1(0) + u1(0) + u1(0) + u2(0x103) + u2(0x14) + u1(0) + u1(3) + u1(0) + u2(0)
+    body = operand(text) + (u2(1) if layout == 4 and operand(text)[0] == 2 else b"")
+    return (head + u1(0) + u2(0x101) + u2(1)
+            + u2(0) + u1(1) + u1(layout) + u1(1) + u4(0) + u1(1) + u4(0) + body)
+
+
 def network(index: int, net: ir.Network, *, tail: bool = True, code: int | None = None,
-            drawn: bool = False, encoding: str = "latin-1") -> bytes:
+            drawn: bool = False, encoding: str = "latin-1", cells: tuple = ()) -> bytes:
     out = (u2(index) + u2(0x102) + u2(7) + _text(net.title, encoding) + u1(0)
            + _text(net.comment, encoding))
     out += u1(2) + u4(0) + u1(2) + u4(0) + u1(2) + u4(0) + u2(0) + u2(len(net.insns))
     for i, insn in enumerate(net.insns):
         out += statement(i, insn.mnemonic, tuple(o.text for o in insn.operands), tail,
                          code if i == 0 else None)
+    if cells:
+        return out + u1(1) + u2(len(cells)) + b"".join(contact(t, k) for t, k in cells)
     return out + u1(1) + (u2(1) + CONTACT if drawn else u2(0))
 
 
@@ -68,8 +79,9 @@ def variables_xml(pou: ir.Pou) -> bytes:
 
 def pou(block: ir.Pou, *, layout: int = 0x83, flags: int = 1, kind: int | None = None,
         tail: bool = True, code: int | None = None, xml: bytes | None = None,
-        encoding: str = "latin-1") -> bytes:
-    """One ``.poubin`` member."""
+        encoding: str = "latin-1", cells: tuple = ()) -> bytes:
+    """One ``.poubin`` member; ``cells`` (operand, layout) are drawn in its
+    first network."""
     number = 0 if block.kind == "OB" else block.number
     nets = block.networks
     out = u1(8) + u2(_KIND[block.kind] if kind is None else kind) + u2(0) + u2(number)
@@ -78,7 +90,8 @@ def pou(block: ir.Pou, *, layout: int = 0x83, flags: int = 1, kind: int | None =
     out += u2(0) + bytes(2 + 20 + 64) + u4(0) + u4(0) + bytes(3)      # author, protection
     out += bytes(32) + u1(0) + u2(len(nets))
     for i, net in enumerate(nets):
-        out += network(i, net, tail=tail, code=code, encoding=encoding)
+        out += network(i, net, tail=tail, code=code, encoding=encoding,
+                       cells=cells if i == 0 else ())
     table = variables_xml(block) if xml is None else xml
     out += u4(0) + u4(1) + u4(100) + u1(8) + u2(0) + u4(0) + u2(1) + bytes(22)
     out += u4(len(table)) + table

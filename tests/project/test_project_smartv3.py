@@ -243,6 +243,26 @@ def test_an_address_without_its_v3_tail_is_refused() -> None:
     assert "of the member" in e.message
 
 
+@pytest.mark.parametrize("layout, tail", [(3, False), (4, True)])
+def test_cell_operands_of_both_layouts_are_stepped_over(layout: int, tail: bool) -> None:
+    """A cell's address operand of layout 4 ends with 2 bytes (1), one of
+    layout 3 does not: both are stepped over, the code is the network's."""
+    program = _program()
+    cells = (("I0.0", layout), ("VW100", layout), ("+5", layout))
+    entries = [(n, w.pou(program.pous[0], cells=cells) if n.endswith("MAIN.poubin") else b)
+               for n, b in w.members(program)]
+    project = read_project(w.encrypt(w.zip_bytes(entries)), "p.smartV3")
+    assert ir_of(parse_program(project.awl, "p")) == ir_of(program)
+
+
+def test_a_cell_address_of_layout_4_without_its_tail_is_refused() -> None:
+    program = _program()
+    main_block = w.pou(program.pous[0], cells=(("I0.0", 4),))
+    broken = main_block.replace(w.contact("I0.0", 4), w.contact("I0.0", 4)[:-2] + b"\0\0")
+    entries = [(n, broken if n.endswith("MAIN.poubin") else b) for n, b in w.members(program)]
+    _refused(w.encrypt(w.zip_bytes(entries)), PlcSyntaxError, "address operand")
+
+
 def test_an_unknown_block_layout_is_refused() -> None:
     program = _program()
     entries = [(n, w.pou(program.pous[0], layout=0x85) if n.endswith("MAIN.poubin") else b)

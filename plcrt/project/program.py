@@ -122,14 +122,20 @@ def _block(c: Cursor) -> Block:
         var = _variable(c)
         if var is not None:
             block.variables.append(var)
+    skip_dependencies(c)
+    c.skip(8)
+    return block
+
+
+def skip_dependencies(c: Cursor) -> None:
+    """The list of blocks and libraries a block calls: names and stamps the
+    reader has no use for (the calls are in the code)."""
     deps = c.count(4, 4096, "number of dependencies")
     if deps:
         c.expect(0, 1, "dependency list")
         for _ in range(deps):
             c.text()
             c.skip(1 + 2 + 8 + 16 + 4)
-    c.skip(8)
-    return block
 
 
 def read_network(c: Cursor, block: Block, index: int) -> Net:

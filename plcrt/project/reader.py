@@ -22,7 +22,6 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import PlcConfigError
 from ..lang.encoding import decode_bytes
 from ..lang.limits import read_capped
 from .awl import blocks_text

@@ -25,7 +25,7 @@ import xml.etree.ElementTree as ET
 
 from ..errors import PlcConfigError, PlcError
 from .datapage import read_data_page
-from .program import MAX_BLOCKS, Block, read_network
+from .program import MAX_BLOCKS, Block, read_network, skip_dependencies
 from .smartv3 import SmartV3Archive, member_label
 from .stream import Cursor, binary_error
 
@@ -192,12 +192,7 @@ def _trailer(c: Cursor, networks: int, block: Block, records: bool) -> None:
     """What follows the networks: dependencies, the local variable table
     (XML) and (from V3.1 on) a record of cell labels per network, to the
     member's end."""
-    deps = c.count(4, 4096, "number of dependencies")
-    if deps:
-        c.expect(0, 1, "dependency list")
-        for _ in range(deps):
-            c.text()
-            c.skip(1 + 2 + 8 + 16 + 4)
+    skip_dependencies(c)
     c.skip(4 + 4)
     c.expect(8, 1, "block trailer")
     c.skip(2 + 4 + 2 + 22)

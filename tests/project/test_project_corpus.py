@@ -14,7 +14,6 @@ corpus folder).  Skipped where the corpus or a file is absent.
 from __future__ import annotations
 
 import os
-import random
 import sys
 import zlib
 from pathlib import Path
@@ -27,7 +26,7 @@ from plcrt.errors import PlcSyntaxError
 from plcrt.project import read_project
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_project_load import ir_of  # noqa: E402
+from test_project_load import ir_of, same_run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 _ENV = os.environ.get("PLCRT_CORPUS")
@@ -85,7 +84,7 @@ def test_corpus_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -
     again = plcrt.load(out[0], symbols=out[1] if out[1].stat().st_size else None,
                        data=out[2])
     assert ir_of(again.program) == ir_of(plc.program)
-    _same_run(plc, again, 300)
+    same_run(plc, again, 300)
 
 
 @pytest.mark.parametrize("name", sorted(REFUSED))
@@ -123,7 +122,7 @@ def test_project_is_its_own_export(name: str) -> None:
         assert ir_of(project.program) != ir_of(export.program)
         pytest.skip(f"code not compared: {REVISIONS[name]}")
     assert ir_of(project.program) == ir_of(export.program)
-    _same_run(project, export, 300)
+    same_run(project, export, 300)
 
 
 def test_symbols_of_a_project() -> None:
@@ -135,18 +134,6 @@ def test_symbols_of_a_project() -> None:
     assert zcd.program.encoding == "gbk"
     assert zcd.program.pous[0].name == "主程序"
     assert zcd.symbols is not None and zcd.symbols.lookup("复位按键").address == "I0.3"
-
-
-def _same_run(a, b, scans: int) -> None:
-    rng = random.Random(28)
-    for _ in range(scans):
-        for bit in range(16):
-            value = rng.random() < 0.3
-            a.write(f"I{bit // 8}.{bit % 8}", value)
-            b.write(f"I{bit // 8}.{bit % 8}", value)
-        a.scan()
-        b.scan()
-    assert a.mem.snapshot().areas == b.mem.snapshot().areas
 
 
 def test_smart_code_0x2db_is_the_mul_di_box_of_its_network() -> None:

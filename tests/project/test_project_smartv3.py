@@ -12,7 +12,6 @@ a time and memory bound.
 from __future__ import annotations
 
 import io
-import random
 import struct
 import sys
 import time
@@ -32,7 +31,7 @@ from plcrt.project.smartv3 import MAX_DIRECTORY, MAX_MEMBER, MAX_MEMBERS
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import smartv3_writer as w  # noqa: E402
-from test_project_load import EVERY_CODE, _programs, ir_of  # noqa: E402
+from test_project_load import EVERY_CODE, _programs, ir_of, same_run  # noqa: E402
 
 SYMBOLS = [("Start", "I0.0", "start button"), ("Level", "VW10", "tank"),
            ("Flag", "SM0.5", ""), ("Count", "C3", "")]
@@ -80,15 +79,7 @@ def test_project_is_its_export_network_by_network(tmp_path: Path, text: str) -> 
     awl.write_text(text, encoding="utf-8")
     a, b = plcrt.load(path), plcrt.load(awl)
     assert ir_of(a.program) == ir_of(b.program)
-    rng = random.Random(28)
-    for _ in range(200):
-        for bit in range(16):
-            value = rng.random() < 0.3
-            a.write(f"I{bit // 8}.{bit % 8}", value)
-            b.write(f"I{bit // 8}.{bit % 8}", value)
-        a.scan()
-        b.scan()
-    assert a.mem.snapshot().areas == b.mem.snapshot().areas
+    same_run(a, b, 200)
 
 
 @pytest.mark.parametrize("layout", [0x82, 0x83, 0x84], ids=["V3.0", "V3.1", "V3.2"])

@@ -29,8 +29,8 @@ from plcrt.lang.stl import parse_program
 from plcrt.project import read_project
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_project_corpus import _file, _same_run  # noqa: E402
-from test_project_load import ir_of  # noqa: E402
+from test_project_corpus import _file  # noqa: E402
+from test_project_load import ir_of, same_run  # noqa: E402
 
 PAIR = "santiagoesdras__Practica_1_taller__"
 ESDRAS = f"{PAIR}Proyecto Esdras__Practica 1.mwp"
@@ -90,7 +90,7 @@ def test_v3_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -> No
     for line in project.symbols.splitlines():
         name, address = line.split("\t")[:2]
         assert again.symbols.lookup(name).address == plc.symbols.lookup(name).address == address
-    _same_run(plc, again, 300)
+    same_run(plc, again, 300)
 
 
 def test_v3_project_is_its_own_export() -> None:
@@ -102,7 +102,7 @@ def test_v3_project_is_its_own_export() -> None:
     assert [len(p.networks) for p in project.program.pous] == [14, 1, 1]
     assert ir_of(project.program) == ir_of(export)
     assert [p.comment for p in project.program.pous] == [p.comment for p in export.pous]
-    _same_run(project, plcrt.load(_export_text(EXPORTS[ESDRAS])), 300)
+    same_run(project, plcrt.load(_export_text(EXPORTS[ESDRAS])), 300)
 
 
 @pytest.mark.parametrize("name", sorted(REVISIONS))

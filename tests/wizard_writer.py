@@ -43,9 +43,22 @@ def pto_record(output: int = 0, *, max_speed: float = 20000.0, min_speed: float 
             + b"\x5a" * 64)
 
 
-def pid_record_v4(memory: int = 300) -> bytes:
-    """A V4 PID wizard record (its header, then 40 bytes standing for the rest)."""
-    return v4_header(0x02, "PID0", "PID0_DATA", memory) + b"\x33" * 40
+def pid_record_v4(loop: int = 0, memory: int = 300, sample_s: float = 0.1) -> bytes:
+    """A V4 PID wizard record for loop ``loop`` (its described fields)."""
+    return (v4_header(0x02, f"PID{loop}", f"PID{loop}_DATA", memory) + u1(2) + u4(loop)
+            + u1(1) + f4(1.0) + f4(0.0) + f4(sample_s) + b"\x33" * 20 + f4(0.0) + u4(0)
+            + u4(32000) + f4(0.0) + f4(1.0) + (u1(0) + f4(0.0)) * 2 + u1(0) + u2(0) + u1(0)
+            + strl(f"PID{loop}_INIT", 1) + strl("PID_EXE", 1) + bytes(75))
+
+
+def position_record(module: int = 0, memory: int = 700) -> bytes:
+    """A V4 EM253 Position Control wizard record (its described fields)."""
+    subs = ["CTRL", "MAN", "GOTO", "RUN", "RSEEK", "LDOFF", "LDPOS", "SRATE", "DIS", "CLR",
+            "CFG"]
+    return (v4_header(0x10, f"POS{module}", f"POS{module}_DATA", memory) + u1(0) + u1(module)
+            + bytes(2 + 1 + 4 + 2) + u4(2000) + strl("mm") + f4(10.0) + f8(100.0)
+            + f8(5000.0) + f8(500.0) + f8(1.0) + u4(1000) + u4(1000) + u4(0) + u1(1)
+            + b"".join(strl(f"POS{module}_{k}") for k in subs) + bytes(47))
 
 
 def v4_tail(records: list[bytes] = ()) -> bytes:

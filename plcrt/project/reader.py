@@ -91,7 +91,8 @@ def read_project(data: bytes, file: str) -> Project:
         block.comment = block.comment or tables.block_comments.get(block.name, "")
     data, cpu, end = _data_block(box, cursor.pos)
     wizards = read_wizards(Cursor(box.stream, file, WIZARDS, end),
-                           box.format.startswith("Micro/WIN SMART"), (b.name for b in blocks))
+                           box.format.startswith("Micro/WIN SMART"),
+                           {b.name: b.protected for b in blocks})
     program, symbols = blocks_text(blocks), symbols_text(tables)
     # one code page for the program and its tables, detected as an export's
     decoded = decode_bytes((program + symbols + data).encode("latin-1"), file)

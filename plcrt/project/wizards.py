@@ -31,8 +31,9 @@ from __future__ import annotations
 import math
 import re
 import struct
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any
 
 from ..errors import PlcError
 from .stream import Cursor
@@ -46,10 +47,11 @@ WIZARD_NAMES = {0x01: "Text Display", 0x02: "PID", 0x08: "NETR/NETW", 0x10: "Pos
                 "(CP243-1)", 0x81: "Internet (CP243-1 IT)", 0x84: "Position Control (PTO)"}
 #: what plcrt does instead of a wizard it does not map (one phrase each)
 _NOT_MAPPED = {
-    0x02: "its loop table is the data block's page and its code PIDx_INIT is in the program "
-          "block (docs/pid.md)",
-    0x10: "plcrt simulates another positioning module (docs/em253.md), not the EM253's "
-          "POSx_ blocks",
+    0x02: "the loop table's initial values are the data page's rows (the data block) and "
+          "plcrt emulates the PID instruction (docs/pid.md), not the wizard's subroutines",
+    0x10: "the module's configuration block is the data page's rows (the data block); plcrt "
+          "simulates another positioning module (docs/em253.md), not the EM253's POSx_ "
+          "subroutines",
 }
 MAX_CONFIGS = 64
 MAX_LIST = 32          #: axes, loops, counters, PWM outputs of one SMART list
@@ -85,10 +87,11 @@ class Wizards:
     notes: list[str] = field(default_factory=list)
 
 
-def read_wizards(c: Cursor, smart: bool, blocks: Iterable[str] = ()) -> Wizards:
+def read_wizards(c: Cursor, smart: bool, blocks: Mapping[str, bool] | None = None
+                 ) -> Wizards:
     """The wizard sections after the data block (the cursor stands on the
-    CPU section that follows it); ``blocks`` are the program's block names
-    (a wizard whose blocks the program holds is named in a note)."""
+    CPU section that follows it); ``blocks`` maps the program's block names
+    to whether each is protected (the notes say where a wizard's code is)."""
     out = Wizards()
     c.section = SECTION
     try:
@@ -100,7 +103,7 @@ def read_wizards(c: Cursor, smart: bool, blocks: Iterable[str] = ()) -> Wizards:
     except PlcError as e:
         out.notes.append(f"the wizard configurations are not read: {e.message}")
         return out
-    _map(out, set(blocks))
+    _map(out, dict(blocks or {}))
     return out
 
 
@@ -130,14 +133,19 @@ def _v4(c: Cursor, out: Wizards) -> None:
                              "found (the record before them is not fully described)")
             return
         c.pos = at
-        out.configs.append(_v4_record(c))
-        start = c.pos
+        w, start = _v4_record(c)
+        out.configs.append(w)
+        try:
+            _V4_FIELDS.get(w.fields["id"], _no_fields)(c, w.fields)
+        except PlcError as e:
+            out.notes.append(f"the fields of the {w.kind} wizard's configuration '{w.name}' "
+                             f"are not read: {e.message}")
 
 
 def _next_v4_record(c: Cursor, start: int) -> int:
-    """The next record's offset: its header is the only layout checked so
-    (a wizard's own fields are not all described, so the end of the record
-    before it is not known)."""
+    """The next record's offset, searched from the end of the header before
+    it: a record is found by its header (the fields of a PTO record are not
+    all described, so where it ends is not known)."""
     for match in _V4_RECORD.finditer(c.data, start):
         probe = Cursor(c.data, c.file, SECTION, match.start())
         try:
@@ -163,14 +171,45 @@ def _v4_header(c: Cursor) -> tuple[int, str, str, int]:
     return ident, name, page, memory
 
 
-def _v4_record(c: Cursor) -> Wizard:
+def _v4_record(c: Cursor) -> tuple[Wizard, int]:
+    """The record's header as a :class:`Wizard`, and where its fields start."""
     at = c.pos
     ident, name, page, memory = _v4_header(c)
     kind = WIZARD_NAMES.get(ident, f"0x{ident:x}")
-    w = Wizard(kind, name, at, {"id": ident, "data page": page, "memory": f"VB{memory}"})
-    if ident == 0x84:
-        _v4_pto(c, w.fields)
-    return w
+    return Wizard(kind, name, at, {"id": ident, "data page": page,
+                                   "memory": f"VB{memory}"}), c.pos
+
+
+def _no_fields(c: Cursor, f: dict[str, Any]) -> None:
+    """A wizard plcrt does not simulate: its fields are not read."""
+
+
+def _v4_pid(c: Cursor, f: dict[str, Any]) -> None:
+    """The PID wizard's loop: its number, ranges and subroutines."""
+    c.expect(2, 1, "PID record")
+    f["loop"] = c.count(4, 7, "PID loop number")
+    c.expect(1, 1, "PID record")
+    f["sp_high"], f["sp_low"], f["sample_s"] = c.f4(), c.f4(), c.f4()
+    c.skip(20 + 4)
+    f["pv_low"], f["pv_high"] = struct.unpack("<ii", c.take(8))
+    c.skip(8 + 5 + 5 + 1 + 2 + 1)
+    f["subroutines"] = [c.text(1), c.text(1)]       # INIT, the loops' interrupt routine
+
+
+def _v4_position(c: Cursor, f: dict[str, Any]) -> None:
+    """The EM253 Position Control wizard: the module and its subroutines."""
+    c.skip(1)
+    f["module"] = c.u1()
+    c.skip(2 + 1 + 4 + 2)
+    f["pulses_per_rev"] = c.u4()
+    f["unit"] = c.text()
+    c.skip(4)
+    f["ss_speed"], f["max_speed"] = _f8(c), _f8(c)
+    c.skip(16)
+    f["accel_ms"], f["decel_ms"] = c.u4(), c.u4()
+    c.skip(4)
+    c.expect(1, 1, "position record")
+    f["subroutines"] = [c.text() for _ in range(11)]
 
 
 def _v4_pto(c: Cursor, f: dict[str, Any]) -> None:
@@ -182,6 +221,10 @@ def _v4_pto(c: Cursor, f: dict[str, Any]) -> None:
     f["accel_ms"], f["decel_ms"] = c.u4(), c.u4()
     c.skip(5)
     f["subroutines"] = [c.text() for _ in range(5)]   # CTRL, MAN, RUN, LDPOS, ADV
+
+
+#: the fields read of each V4 wizard's record (its id -> reader)
+_V4_FIELDS = {0x02: _v4_pid, 0x10: _v4_position, 0x84: _v4_pto}
 
 
 # -- Micro/WIN SMART V2 --------------------------------------------------------
@@ -297,44 +340,71 @@ def _pwm(c: Cursor, out: Wizards) -> None:
 
 # -- what plcrt runs of them --------------------------------------------------
 
-def _map(out: Wizards, blocks: set[str]) -> None:
+def _map(out: Wizards, blocks: dict[str, bool]) -> None:
     """Each configuration onto a plant table, or a note naming it."""
     for w in out.configs:
         f = w.fields
         where = f"the {w.kind} wizard's configuration '{w.name}'"
         if "id" in f:                          # a Micro/WIN V4 record
-            if f["id"] == 0x84:
+            if f["id"] == 0x84 and "subroutines" in f:
                 _map_pto(w, where, out)
-            else:
+            elif f["id"] != 0x84:
                 why = _NOT_MAPPED.get(f["id"], "plcrt does not simulate it")
-                out.notes.append(f"{where} (data page '{f['data page']}') is not mapped: "
-                                 f"{why}")
+                code = _code(f.get("subroutines", ())[:1], blocks)
+                out.notes.append(f"{where} (data page '{f['data page']}', memory from "
+                                 f"{f['memory']}) is not mapped: {why}{code}")
         elif w.kind == "PWM":
-            if not f["enabled"]:
-                continue
-            base = _TIME_BASES.get(f["time_base"])
-            if f["output"] not in (0, 1):
-                out.notes.append(f"{where}: PWM{f['output']} is not mapped (plcrt emulates "
-                                 "PWM0_RUN and PWM1_RUN, Q0.0 and Q0.1)")
-            elif base is None:
-                out.notes.append(f"{where}: time base {f['time_base']} is not one plcrt "
-                                 "knows (0 microseconds, 1 milliseconds): not mapped")
-            else:
-                out.plant.setdefault("pwm", {})[str(f["output"])] = {"time_base": base}
+            if f["enabled"]:
+                _map_pwm(w, where, out)
         elif w.kind == "Motion axis":
-            # every SMART project holds the axes; only those it uses are named
+            # every SMART project holds the axes: those its program uses are named
             if any(b.startswith(f"AXIS{f['axis']}_") for b in blocks):
-                out.notes.append(f"{where} is read, not run: " + _SMART_NOTES[w.kind])
+                out.notes.append(f"{where} is not mapped: plcrt does not emulate the SMART "
+                                 f"motion wizard's AXIS{f['axis']}_ blocks")
         elif f["enabled"]:                     # a SMART PID loop or counter
-            out.notes.append(f"{where} is read, not run: " + _SMART_NOTES[w.kind])
+            code = _code((f["subroutine"],), blocks)
+            out.notes.append(f"{where} is not mapped: {_SMART_NOTES[w.kind]}{code}")
 
 
+#: what the SMART wizards' configurations are to plcrt
 _SMART_NOTES = {
-    "PID": "plcrt does not emulate the wizard's PIDx_CTRL (the PID instruction is, "
-           "docs/pid.md)",
-    "HSC": "the wizard's HSCx_INIT in the program block defines the counter",
-    "Motion axis": "plcrt does not emulate the SMART motion wizard's AXISx_ blocks",
+    "PID": "plcrt emulates the PID instruction (docs/pid.md), not the wizard's subroutine",
+    "HSC": "the counter is what the wizard's subroutine sets up (HDEF, HSC; docs/events.md)",
 }
+
+
+def _code(names: Any, blocks: dict[str, bool]) -> str:
+    """Where the wizard's (first) subroutine is: the configuration is a
+    record of what that code does when the program block holds it readable."""
+    for name in names:
+        if name not in blocks:
+            return f"; its subroutine {name} is not in the program block"
+        if blocks[name]:
+            return f"; its subroutine {name} is protected and does not run"
+        return f"; its subroutine {name} is in the program block and runs"
+    return ""
+
+
+def _map_pwm(w: Wizard, where: str, out: Wizards) -> None:
+    f = w.fields
+    base = _TIME_BASES.get(f["time_base"])
+    if f["output"] not in (0, 1):
+        out.notes.append(f"{where}: PWM{f['output']} is not mapped (plcrt emulates "
+                         "PWM0_RUN and PWM1_RUN, Q0.0 and Q0.1)")
+    elif base is None:
+        out.notes.append(f"{where}: time base {f['time_base']} is not one plcrt knows "
+                         "(0 microseconds, 1 milliseconds): not mapped")
+    elif _free(out, str(f["output"]), where):
+        out.plant.setdefault("pwm", {})[str(f["output"])] = {"time_base": base}
+
+
+def _free(out: Wizards, output: str, where: str) -> bool:
+    """Whether no configuration before this one gave the output a table."""
+    if any(output in out.plant.get(kind, {}) for kind in ("pto", "pwm")):
+        out.notes.append(f"{where}: Q0.{output} is configured by a wizard before it: not "
+                         "mapped")
+        return False
+    return True
 
 
 def _map_pto(w: Wizard, where: str, out: Wizards) -> None:
@@ -363,10 +433,12 @@ def _map_pto(w: Wizard, where: str, out: Wizards) -> None:
             out.notes.append(f"{where}: {key} {f[key]} is above {PTO_RAMP_MS} ms: not mapped")
             return
         table[key] = f[key]
-    out.plant.setdefault("pto", {})[output] = table
-    out.notes.append(f"{where} gives [pto.{output}] (speeds and ramps); its profiles and "
-                     "counter option are not in the described part of the record: give "
-                     f"them in a plant file's [pto.{output}]")
+    if _free(out, output, where):
+        out.plant.setdefault("pto", {})[output] = table
+        out.notes.append(f"{where} gives [pto.{output}] (speeds and ramps); its profiles and "
+                         f"counter option (in data page '{f['data page']}' and the record's "
+                         "undescribed part) are not read: give them in a plant file's "
+                         f"[pto.{output}]")
 
 
 def plant_toml(plant: dict[str, dict[str, dict[str, Any]]]) -> str:

@@ -35,7 +35,7 @@ from plcrt.project.container import MAX_STREAM
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from project_writer import container, project_bytes, stream  # noqa: E402
 from wizard_writer import (hsc_counter, motion_axis, pid_loop, pid_record_v4,  # noqa: E402
-                           pto_record, pwm_output, smart_lists, v4_tail)
+                           position_record, pto_record, pwm_output, smart_lists, v4_tail)
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
@@ -140,7 +140,8 @@ def _wizard_seeds() -> list[tuple[str, bytes, int]]:
     record of each wizard the reader reads."""
     program = parse_program("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\n"
                             "= Q0.0\nEND_ORGANIZATION_BLOCK\n", "x.awl")
-    v4 = v4_tail([pid_record_v4(), pto_record(0), pto_record(1, accel_ms=0)])
+    v4 = v4_tail([pid_record_v4(), position_record(), pto_record(0),
+                  pto_record(1, accel_ms=0)])
     smart = smart_lists([motion_axis(0, profiles=2)], [pid_loop(0, enabled=True)],
                         [hsc_counter(0, enabled=True, steps=2)],
                         [pwm_output(0), pwm_output(1, time_base=1), pwm_output(2)])

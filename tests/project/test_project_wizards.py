@@ -24,7 +24,8 @@ from plcrt.term.tables import pulse_outputs
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from project_writer import container, project_bytes, stream  # noqa: E402
 from wizard_writer import (hsc_counter, motion_axis, pid_loop, pid_record_v4,  # noqa: E402
-                           pto_record, pwm_output, smart_lists, v4_tail)
+                           position_record, pto_record, pwm_output, smart_lists, v4_header,
+                           v4_tail)
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
@@ -135,6 +136,47 @@ def test_plant_file_table_replaces_the_project_wizard(tmp_path: Path) -> None:
     assert own[1] != _move(plcrt.load(path, scan_ms=5))[1]
 
 
+def test_v4_pid_and_position_records_are_named_with_where_their_code_is() -> None:
+    """The PID loop's subroutine is protected in this program (a note says it
+    does not run), the EM253's are absent; a record of a wizard plcrt does not
+    read (a Text Display) is named too, and a PTO record after them maps."""
+    init = _WIZARD_SBR.format(name="PID0_INIT", n=3, ins="PV_I:WORD;", outs="Output:WORD;")
+    program = parse_program(MANUAL + init, "m.awl")
+    records = [pid_record_v4(0, sample_s=0.5), position_record(1),
+               v4_header(0x01, "TD0", "TD0_DATA", 900) + b"\x11" * 30, pto_record(1)]
+    body = stream(program, wizards=v4_tail(records), protected=("SBR3",))
+    project = read_project(container(body), "m.mwp")
+    pid, pos, td, pto = project.wizards
+    assert (pid.fields["loop"], pid.fields["sample_s"], pid.fields["pv_high"]) == (0, 0.5, 32000)
+    assert pid.fields["subroutines"] == ["PID0_INIT", "PID_EXE"]
+    assert (pos.fields["module"], pos.fields["pulses_per_rev"], pos.fields["max_speed"]) == \
+        (1, 2000, 5000.0)
+    assert pos.fields["subroutines"][0] == "POS1_CTRL" and td.kind == "Text Display"
+    notes = "\n".join(project.notes)
+    assert "'PID0' (data page 'PID0_DATA', memory from VB300) is not mapped" in notes
+    assert "PID0_INIT is protected and does not run" in notes
+    assert "POS1_CTRL is not in the program block" in notes
+    assert "'TD0' (data page 'TD0_DATA', memory from VB900) is not mapped" in notes
+    assert project.plant.startswith("[pto.1]\n")
+    # a PID record whose fields are not laid out as described: named, and the
+    # records after it read
+    head = len(v4_header(0x02, "PID0", "PID0_DATA", 300))
+    record = pid_record_v4()
+    broken = [record[:head] + b"\x09" + record[head + 1:], pto_record(0)]
+    project = read_project(container(stream(program, wizards=v4_tail(broken))), "m.mwp")
+    assert any("fields of the PID wizard's configuration 'PID0' are not read" in n
+               for n in project.notes)
+    assert project.plant.startswith("[pto.0]\n")
+
+
+def test_two_configurations_of_one_output_keep_the_first() -> None:
+    records = [pto_record(0, accel_ms=100), pto_record(0, accel_ms=900)]
+    project = read_project(container(stream(parse_program(MANUAL, "m.awl"),
+                                            wizards=v4_tail(records))), "m.mwp")
+    assert "accel_ms = 100\n" in project.plant
+    assert any("Q0.0 is configured by a wizard before it" in n for n in project.notes)
+
+
 @pytest.mark.parametrize("change, why", [
     ({"max_speed": 250000.0}, "max_speed 250000.0"),
     ({"ss_speed": 200.5}, "ss_speed 200.5"),
@@ -167,7 +209,8 @@ def test_smart_pwm_output_maps_onto_pwm_table(tmp_path: Path) -> None:
     assert project.wizards[3].fields["mode"] == 9
     assert project.plant == '[pwm.0]\ntime_base = "ms"\n'
     assert any("PWM2 is not mapped" in n for n in project.notes)
-    assert any("PID0_CTRL" in n and "not run" in n for n in project.notes)
+    assert any("'PID0_CTRL' is not mapped" in n and "PID0_CTRL is not in the program block"
+               in n for n in project.notes)
     assert not any("PID1_CTRL" in n for n in project.notes)      # not enabled
     # the time base reaches PWM0_RUN: Cycle 20 is 20 ms, Duty_Cycle 5 is 5 ms
     plc = plcrt.load(path, scan_ms=1)

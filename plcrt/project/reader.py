@@ -3,7 +3,8 @@
 :func:`read_project` opens the container (:mod:`.container`), finds the
 program block in the inflated stream and reads it (:mod:`.program`), then
 writes the blocks as STL export text (:mod:`.awl`) whose code page is
-detected as an export's is.  The result holds that text, the blocks and
+detected as an export's is; the wizard sections after the CPU name give
+plant tables (:mod:`.wizards`).  The result holds that text, the blocks and
 what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
@@ -101,6 +102,8 @@ def read_project(data: bytes, file: str) -> Project:
              "protected block, its interface without its code" for b in blocks if b.protected]
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
     notes += [_recode(note, codec) for note in wizards.notes]
+    for wizard in wizards.configs:              # names in the project's code page
+        wizard.name = _recode(wizard.name, codec)
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
                    _recode(symbols, codec), _recode(data, codec), cpu, notes,
                    wizards.configs, plant_toml(wizards.plant))

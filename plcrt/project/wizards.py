@@ -42,9 +42,11 @@ __all__ = ["Wizard", "Wizards", "read_wizards", "plant_toml", "WIZARD_NAMES"]
 
 SECTION = "wizard configuration"
 #: Micro/WIN V4 wizard ids (the public format description names them)
-WIZARD_NAMES = {0x01: "Text Display", 0x02: "PID", 0x08: "NETR/NETW", 0x10: "Position Control "
-                "(EM253)", 0x20: "Modem (EM241)", 0x40: "AS-i (CP243-2)", 0x80: "Ethernet "
-                "(CP243-1)", 0x81: "Internet (CP243-1 IT)", 0x84: "Position Control (PTO)"}
+WIZARD_NAMES = {
+    0x01: "Text Display", 0x02: "PID", 0x08: "NETR/NETW", 0x10: "Position Control (EM253)",
+    0x20: "Modem (EM241)", 0x40: "AS-i (CP243-2)", 0x80: "Ethernet (CP243-1)",
+    0x81: "Internet (CP243-1 IT)", 0x84: "Position Control (PTO)",
+}
 #: what plcrt does instead of a wizard it does not map (one phrase each)
 _NOT_MAPPED = {
     0x02: "the loop table's initial values are the data page's rows (the data block) and "
@@ -240,7 +242,10 @@ def _smart(c: Cursor, out: Wizards) -> None:
 
 
 def _motion(c: Cursor, out: Wizards) -> None:
+    at = c.pos
     version = c.u1()
+    if version not in (1, 3):                  # 3: SMART V2, 1: V1 (fixed records)
+        raise c.error(f"motion list version {version} is not one this reader knows", at)
     if version == 3:
         c.skip(8)
     for _ in range(c.count(4, MAX_LIST, "number of motion axes")):

@@ -101,7 +101,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         _emit_json(args, plc, values, str(fault or stopped) if fault or stopped else None)
     elif not quiet:
         _print_values(program, plc, values)
-        if args.plant:
+        if args.plant or plc.program.project_plant:      # a project's wizards: a plant
             print_devices(plc)
             _print_machines(plc)
     if fault is not None:

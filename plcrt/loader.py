@@ -127,8 +127,31 @@ def load(source: str | Path | Sequence[str | Path], *, symbols: Any = None,
         program, symbols, data = read_program(source_items(source), symbols, data,
                                               encoding=encoding, max_bytes=limit,
                                               v_bytes=cpu_model(cpu).v_bytes)
+        plant = _project_plant(plant, program)
         return Plc(program, symbols=symbols, data=data, scan_ms=scan_ms, cpu=cpu, plant=plant,
                    **kw)
+
+
+def _project_plant(plant: Any, program: Any) -> Any:
+    """The plant with the ``[pto.N]`` / ``[pwm.N]`` tables of a project
+    file's wizards (``program.project_plant``) for each output the plant
+    does not configure itself: a plant file's table replaces the project's
+    (docs/project-files.md, "Wizards")."""
+    text = getattr(program, "project_plant", "")
+    if not text:
+        return plant
+    # perf: see is_plant
+    from dataclasses import replace
+
+    from .devices.plant import load_plant
+    from .devices.ptowizard.config import PROJECT_WIZARDS
+    wizards = load_plant(text, f"{program.file} {PROJECT_WIZARDS}")
+    if plant is None:
+        return wizards
+    own = set(plant.pto) | set(plant.pwm)
+    pto = {n: c for n, c in wizards.pto.items() if n not in own}
+    pwm = {n: c for n, c in wizards.pwm.items() if n not in own}
+    return replace(plant, pto={**pto, **plant.pto}, pwm={**pwm, **plant.pwm})
 
 
 def read_plant(plant: str | Path | dict[str, Any]) -> Any:

@@ -26,7 +26,8 @@ _BIT = re.compile(r"^([&*]?)(I|Q|V|M|SM|S|L)(\d+)\.([0-7])$")
 _WORD = re.compile(r"^([&*]?)(I|Q|V|M|SM|S|L|AI|AQ)([BWD])(\d+)$")
 _NUMBERED = re.compile(r"^(T|C|HC|AC)(\d+)$")
 _KIND = {"OB": 0x3E8, "SBR": 0x3E9, "INT": 0x3EA}
-_TYPE = {"BOOL": 0x2, "BYTE": 0x40004, "WORD": 0x48, "DWORD": 0x90, "REAL": 0x1000}
+_TYPE = {"BOOL": 0x2, "BYTE": 0x40004, "WORD": 0x48, "DWORD": 0x90, "REAL": 0x1000,
+         "DINT": 0x90}
 _SECTION = {s: k for k, s in VAR_SECTIONS.items()}
 
 
@@ -138,16 +139,20 @@ def data_section(rows: list[tuple[str, list[int], str]]) -> bytes:
 def stream(program: ir.Program, *, smart: bool = False,
            symbols: list[tuple[str, str, str]] = (), data: list = (),
            cpu: str = "CPU 224 REL 02.01", protected: tuple[str, ...] = (),
-           drawn: tuple = ()) -> bytes:
+           drawn: tuple = (), wizards: bytes | None = None) -> bytes:
     """The decompressed project: filler, program block, symbols, data, CPU.
     ``drawn`` lists (block, network) pairs given a ladder contact besides
-    their code."""
+    their code; ``wizards`` is what follows the CPU name (default: no wizard
+    configured, tests/wizard_writer.py writes them)."""
     body = b"\x10" + b"\x55" * 64                   # stands for preamble and system block
     body += u1(2) + u2(len(program.pous))
     body += b"".join(block(p, smart, p.ident in protected, drawn) for p in program.pous)
     body += symbol_section(list(symbols))
     body += b"\x03" + b"\x55" * 16                  # stands for the status charts
-    body += data_section(list(data)) + u1(0) + strl(cpu) + bytes(16)
+    if wizards is None:
+        from wizard_writer import wizard_tail
+        wizards = wizard_tail(smart)
+    body += data_section(list(data)) + u1(0) + strl(cpu) + wizards
     return body
 
 

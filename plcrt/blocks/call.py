@@ -170,6 +170,11 @@ def _bit_reads(g: Any, reads: list[Any]) -> list[str]:
     return out
 
 
+#: a protected block's parameters are matched by size: a project file stores
+#: a local variable's size, not its signedness (docs/project-files.md)
+_SIZE = {"DINT": "DWORD", "INT": "WORD"}
+
+
 def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
     """CALL of a program subroutine named like a registered library block:
     emit the built-in block when the body is empty (a protected block of the
@@ -183,12 +188,12 @@ def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
     if entry is None:
         return False
     variants, family = entry
-    own = [(v.decl.section, v.decl.type.upper()) for v in callee.local_vars.values()
-           if v.decl.section != "TEMP"]
+    own = [(v.decl.section, _SIZE.get(t, t)) for v in callee.local_vars.values()
+           if v.decl.section != "TEMP" for t in (v.decl.type.upper(),)]
     empty = not any(net.insns for net in callee.pou.networks)
     itfs = [interfaces()[n] for n in variants if n in interfaces()]
     for itf in itfs:
-        if empty and own == [(p.dir, p.type) for p in itf.params]:
+        if empty and own == [(p.dir, _SIZE.get(p.type, p.type)) for p in itf.params]:
             return library_call(g, insn, resolver, name=itf.name)
     once = g.unit.hooks.setdefault("protected-once", set())
     if callee.pou.ident not in once:
@@ -198,7 +203,8 @@ def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
             ("has instructions", not empty),
             ("has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
              + f", not the library's {wanted}",
-             all(own != [(p.dir, p.type) for p in itf.params] for itf in itfs))) if bad]
+             all(own != [(p.dir, _SIZE.get(p.type, p.type)) for p in itf.params]
+                 for itf in itfs))) if bad]
         g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the {family} "
                f"block {name} but {' and '.join(why)}: the program's own subroutine runs, not "
                f"the library emulation", f"protected-own-{callee.pou.ident}")

@@ -110,6 +110,9 @@ class Program:
     source: str = field(repr=False, default="")
     #: codec its files were decoded with ("" for text, or files that differ)
     encoding: str = ""
+    #: plant tables a project file's wizards give (TOML, as a plant file
+    #: writes them; docs/project-files.md, "Wizards"); "" for none
+    project_plant: str = ""
 
     def instruction_count(self) -> int:
         return sum(len(n.insns) for p in self.pous for n in p.networks)

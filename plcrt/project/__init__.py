@@ -11,7 +11,8 @@ Importing :mod:`.frontend` registers the reader in
 
 Submodules: :mod:`.stream` (the bounded cursor), :mod:`.container`
 (header, password, zlib), :mod:`.program` (blocks, networks, statements),
-:mod:`.tables` (symbol tables), :mod:`.datapage` (data block), :mod:`.codes`
+:mod:`.tables` (symbol tables), :mod:`.datapage` (data block),
+:mod:`.wizards` (the wizard configurations and their plant tables), :mod:`.codes`
 (the code tables), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
 (Micro/WIN V3 projects: blocks and cells, compiled code, symbol table),
 :mod:`.smartv3` and :mod:`.smartv3pou` (SMART V3 projects: the encrypted

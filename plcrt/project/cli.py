@@ -4,10 +4,12 @@ and data block, written as Micro/WIN writes them.
 ::
 
     plcrt export PROJECT [--awl OUT.awl] [--symbols OUT.txt] [--data OUT.db]
-        [--max-file-mb MB]
+        [--plant OUT.toml] [--max-file-mb MB]
 
 Each file is written in the project's code page with CR LF line ends, so
-it can be read, diffed and versioned, and loaded again by ``plcrt``.
+it can be read, diffed and versioned, and loaded again by ``plcrt``; the
+plant tables the project's wizards give (``--plant``) are UTF-8 TOML, as a
+plant file is.
 Errors (an unreadable project, an output that cannot be written) are
 :class:`~plcrt.errors.PlcError` s, reported by :mod:`plcrt.cli`.
 
@@ -39,6 +41,8 @@ def register(sub: Any) -> None:
     p.add_argument("--awl", metavar="F", help="write the program's STL export here")
     p.add_argument("--symbols", metavar="F", help="write the symbol table here")
     p.add_argument("--data", metavar="F", help="write the data block here")
+    p.add_argument("--plant", metavar="F", help="write the plant tables the project's wizards "
+                   "give ([pto.N], [pwm.N]) here")
     p.add_argument("--max-file-mb", type=float, default=None, metavar="MB",
                    help="largest project file read (default 16)")
     p.set_defaults(func=cmd_export)
@@ -54,11 +58,18 @@ def cmd_export(args: argparse.Namespace) -> int:
     codec = "cp1252" if project.encoding in ("", "ascii") else project.encoding
     outputs = ((args.awl, project.awl), (args.symbols, project.symbols),
                (args.data, project.data))
-    if not any(path for path, _ in outputs):
-        raise PlcConfigError("plcrt export: give at least one of --awl, --symbols, --data")
+    plant = getattr(args, "plant", None)
+    if not any(path for path, _ in outputs) and not plant:
+        raise PlcConfigError("plcrt export: give at least one of --awl, --symbols, --data, "
+                             "--plant")
     for path, text in outputs:
         if path:
             _write(path, text, codec)
+    if plant:
+        _write(plant, project.plant, "utf-8")
+        if not project.plant:
+            print(printable(f"{args.project}: note: no wizard configuration gives a plant "
+                            "table; the plant file written is empty"), file=sys.stderr)
     for note in project.notes:        # names read from the file: escaped
         print(printable(f"{args.project}: note: {note}"), file=sys.stderr)
     return 0

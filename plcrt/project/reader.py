@@ -3,7 +3,8 @@
 :func:`read_project` opens the container (:mod:`.container`), finds the
 program block in the inflated stream and reads it (:mod:`.program`), then
 writes the blocks as STL export text (:mod:`.awl`) whose code page is
-detected as an export's is.  The result holds that text, the blocks and
+detected as an export's is; the wizard sections after the CPU name give
+plant tables (:mod:`.wizards`).  The result holds that text, the blocks and
 what the header says; :func:`plcrt.project.load_project` parses it.
 
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
@@ -34,6 +35,7 @@ from .smartv3 import is_smartv3, open_smartv3
 from .smartv3pou import read_smartv3_content, recode_variables
 from .stream import Cursor, binary_error
 from .tables import SymbolTables, read_symbol_tables
+from .wizards import SECTION as WIZARDS, Wizard, plant_toml, read_wizards
 
 __all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
 
@@ -76,6 +78,10 @@ class Project:
     #: the CPU the project is for, as Micro/WIN names it ("CPU 224 REL 02.01")
     cpu: str = ""
     notes: list[str] = field(default_factory=list)
+    #: the wizard configurations read (docs/project-files.md, "Wizards")
+    wizards: list[Wizard] = field(default_factory=list)
+    #: the plant tables they give, as a plant file writes them ("" for none)
+    plant: str = ""
 
 
 def read_project(data: bytes, file: str) -> Project:
@@ -90,7 +96,10 @@ def read_project(data: bytes, file: str) -> Project:
     tables = read_symbol_tables(cursor)
     for block in blocks:          # the block's title is its comment in the block-name table
         block.comment = block.comment or tables.block_comments.get(block.name, "")
-    data, cpu = _data_block(box, cursor.pos)
+    data, cpu, end = _data_block(box, cursor.pos)
+    wizards = read_wizards(Cursor(box.stream, file, WIZARDS, end),
+                           box.format.startswith("Micro/WIN SMART"),
+                           {b.name: b.protected for b in blocks})
     program, symbols = blocks_text(blocks), symbols_text(tables)
     # one code page for the program and its tables, detected as an export's
     decoded = decode_bytes((program + symbols + data).encode("latin-1"), file)
@@ -98,8 +107,12 @@ def read_project(data: bytes, file: str) -> Project:
     notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
              "protected block, its interface without its code" for b in blocks if b.protected]
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
+    notes += [_recode(note, codec) for note in wizards.notes]
+    for wizard in wizards.configs:              # names in the project's code page
+        wizard.name = _recode(wizard.name, codec)
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
-                   _recode(symbols, codec), _recode(data, codec), cpu, notes)
+                   _recode(symbols, codec), _recode(data, codec), cpu, notes,
+                   wizards.configs, plant_toml(wizards.plant))
 
 
 def _v3_project(box: Container) -> Project:
@@ -129,10 +142,10 @@ def _smartv3_project(data: bytes, file: str) -> Project:
                    v3.notes)
 
 
-def _data_block(box: Container, start: int) -> tuple[str, str]:
-    """(data block text, CPU name) of the sections after the symbol tables
-    (the status charts between them are stepped over by finding the data
-    block's header)."""
+def _data_block(box: Container, start: int) -> tuple[str, str, int]:
+    """(data block text, CPU name, its offset) of the sections after the
+    symbol tables (the status charts between them are stepped over by
+    finding the data block's header)."""
     match = _DATA_BLOCK.search(box.stream, start)
     if match is None:
         raise binary_error(box.file, "data block", start, "no data block found after the "
@@ -143,7 +156,7 @@ def _data_block(box: Container, start: int) -> tuple[str, str]:
     name = ""
     if cpu is not None and cpu.group(1)[0] == len(cpu.group(2)):
         name = cpu.group(2).decode("ascii")
-    return text, name
+    return text, name, cursor.pos
 
 
 def _recode(text: str, codec: str) -> str:

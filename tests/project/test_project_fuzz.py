@@ -33,7 +33,9 @@ from plcrt.project import read_project
 from plcrt.project.container import MAX_STREAM
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from project_writer import container, project_bytes  # noqa: E402
+from project_writer import container, project_bytes, stream  # noqa: E402
+from wizard_writer import (hsc_counter, motion_axis, pid_loop, pid_record_v4,  # noqa: E402
+                           position_record, pto_record, pwm_output, smart_lists, v4_tail)
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
@@ -131,6 +133,55 @@ def test_mutants_end_in_plc_errors(kind: str, seed_name: str) -> None:
     rng = random.Random(f"{SEED}/{kind}/{seed_name}")
     for k, (name, mutant) in enumerate(_mutants(kind, seed_name, rng)):
         _check(mutant, name, traced=k % 10 == 0)
+
+
+def _wizard_seeds() -> list[tuple[str, bytes, int]]:
+    """(name, stream, offset of its wizard sections) of projects with a
+    record of each wizard the reader reads."""
+    program = parse_program("ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\n"
+                            "= Q0.0\nEND_ORGANIZATION_BLOCK\n", "x.awl")
+    v4 = v4_tail([pid_record_v4(), position_record(), pto_record(0),
+                  pto_record(1, accel_ms=0)])
+    smart = smart_lists([motion_axis(0, profiles=2)], [pid_loop(0, enabled=True)],
+                        [hsc_counter(0, enabled=True, steps=2)],
+                        [pwm_output(0), pwm_output(1, time_base=1), pwm_output(2)])
+    out = []
+    for name, tail, is_smart in (("wizards.mwp", v4, False), ("wizards.smart", smart, True)):
+        body = stream(program, smart=is_smart, wizards=tail)
+        out.append((name, body, len(body) - len(tail)))
+    return out
+
+
+@pytest.mark.parametrize("seed", _wizard_seeds(), ids=lambda s: s[0])
+def test_mutated_wizard_records_end_in_plc_errors_or_valid_tables(seed: tuple) -> None:
+    """Bits flipped and counts forged in the wizard sections only: the
+    project loads (with a note where a section is not read) or raises a
+    PlcError, and the plant tables it gives are always a valid plant file's."""
+    from plcrt.devices.plant import load_plant
+
+    name, body, start = seed
+    smart = name.endswith(".smart")
+    rng = random.Random(f"{SEED}/wizards/{name}")
+    mapped = 0
+    for k in range(MUTANTS * 8):
+        raw = bytearray(body)
+        for _ in range(rng.randint(1, 6)):
+            at = rng.randrange(start, len(raw) - 4)
+            if k % 2:
+                raw[at] ^= 1 << rng.randrange(8)
+            else:
+                width = rng.choice((1, 2, 4, 8))
+                raw[at:at + width] = rng.choice((b"\xff", b"\x00", b"\x7f", b"\x41")) * width
+        mutant = container(bytes(raw[:len(body)]), smart=smart)
+        _check(mutant, f"{name}~wizard{k}", traced=k % 10 == 0)
+        try:
+            project = read_project(mutant, name)
+        except PlcError:
+            continue
+        if project.plant:
+            mapped += 1
+            load_plant(project.plant, name)        # raises if a table is not valid
+    assert mapped > 0                              # the mutants did not all break the records
 
 
 @functools.cache

@@ -24,6 +24,7 @@ from typing import Any, Optional
 
 from ...blocks import register_block, register_protected
 from ...engine.pulse import FAST_OUTPUTS, MIN_CYCLE_US
+from .config import PROJECT_WIZARDS
 from .plan import change_trains, continuous_trains, profile_trains, stop_trains
 
 #: Error output codes (plcrt's own: the wizard's numbers are not public)
@@ -224,8 +225,10 @@ class _Block:
                    f"{family}{output}_* blocks report Error {NO_CONFIG} (docs/pto-wizard.md)",
                    f"ptowizard-noconfig-{table}{output}")
             return
+        origin = (f"the project's {wizard} wizard configuration" if PROJECT_WIZARDS in cfg.where
+                  else "the plant's")
         g.warn(f"{itf.name}: the {wizard} wizard's subroutines for Q0.{output} are emulated "
-               f"from the plant's [{table}.{output}]; the wizard's ramp algorithm, error "
+               f"from {origin} [{table}.{output}]; the wizard's ramp algorithm, error "
                f"numbers and V-memory table are not public: plcrt's choices are in "
                f"docs/pto-wizard.md", f"ptowizard-{table}{output}")
         limit = 1_000_000 // FAST_OUTPUTS.get(g.unit.model.name, MIN_CYCLE_US)

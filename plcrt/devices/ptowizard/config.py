@@ -51,6 +51,9 @@ _PROFILE_KEYS = {"relative": {"mode", "steps"},
 _STEP_KEYS = {"speed", "pulses"}
 _PWM_KEYS = {"time_base"}
 TIME_BASES = {"us": 1, "ms": 1000}
+#: the file name of the tables a project file's wizards give, after the
+#: project's name (plcrt.loader; docs/project-files.md, "Wizards")
+PROJECT_WIZARDS = "(its wizards)"
 
 
 @dataclass(frozen=True)

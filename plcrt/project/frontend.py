@@ -28,7 +28,8 @@ def load_project(path: str, limit: int) -> tuple[ir.Program, Any, Any]:
     program's :attr:`~plcrt.lang.ir.Program.source` is its STL export."""
     project = read_project_file(path, limit)
     program = parse_program(project.awl, path)
-    program = ir.Program(program.pous, program.file, program.source, project.encoding)
+    program = ir.Program(program.pous, program.file, program.source, project.encoding,
+                         system=project.system)
     symbols = parse_symbols(project.symbols, path) if project.symbols else None
     data = None
     if project.data.strip():

@@ -29,6 +29,7 @@ from .program import Block, read_program_block
 from .r03 import read_v3_program
 from .r03tables import check_symbolic_cells, read_v3_symbols
 from .stream import Cursor, binary_error
+from .sysblock import SystemBlock, read_system_block
 from .tables import SymbolTables, read_symbol_tables
 
 __all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
@@ -72,6 +73,8 @@ class Project:
     #: the CPU the project is for, as Micro/WIN names it ("CPU 224 REL 02.01")
     cpu: str = ""
     notes: list[str] = field(default_factory=list)
+    #: the system block (None: not read, see notes)
+    system: SystemBlock | None = None
 
 
 def read_project(data: bytes, file: str) -> Project:
@@ -80,6 +83,7 @@ def read_project(data: bytes, file: str) -> Project:
     if box.format == "Micro/WIN V3":
         return _v3_project(box)
     cursor = _program_cursor(box)
+    system, not_read = read_system_block(box.stream, file, box.format, cursor.pos)
     blocks = read_program_block(cursor)
     tables = read_symbol_tables(cursor)
     for block in blocks:          # the block's title is its comment in the block-name table
@@ -92,8 +96,9 @@ def read_project(data: bytes, file: str) -> Project:
     notes = [f"{b.ident} ({b.name}) is protected by a password: it is loaded as a "
              "protected block, its interface without its code" for b in blocks if b.protected]
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
+    notes += [not_read] if not_read else []
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
-                   _recode(symbols, codec), _recode(data, codec), cpu, notes)
+                   _recode(symbols, codec), _recode(data, codec), cpu, notes, system)
 
 
 def _v3_project(box: Container) -> Project:

@@ -115,7 +115,7 @@ class PowerCycle:
         twin._permanent = self._permanent
         twin.mode = "STOP" if self.startup == "STOP" or (
             self.startup == "LAST" and me.mode != "RUN") else "RUN"
-        twin._t_us = me._t_us                     # a power cycle takes no simulated time
+        twin._t_us = twin._irq_t = me._t_us       # a power cycle takes no simulated time
         for key, value in me.forces.items():
             twin.force(key, value)
         clock = dict(me.clock.__dict__)           # the clock runs on through the cycle

@@ -34,6 +34,7 @@ from plcrt.project.container import MAX_STREAM
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from project_writer import container, project_bytes  # noqa: E402
+from sysblock_writer import smart_block, v4_block  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
@@ -50,7 +51,10 @@ def _seeds() -> dict[str, bytes]:
     program = parse_program(EVERY_CODE, "x.awl")
     seeds = {"own.mwp": project_bytes(program, symbols=[("A", "I0.0", "a")],
                                       data=[("VW0", [1, 2], "c")]),
-             "own.smart": project_bytes(program, smart=True)}
+             "own.smart": project_bytes(program, smart=True),
+             "own-system.mwp": project_bytes(program, system=v4_block(pulse_catch=(2,))),
+             "own-system.smart": project_bytes(program, smart=True,
+                                               system=smart_block(startup="RUN"))}
     env = os.environ.get("PLCRT_CORPUS")
     folder = Path(env) / "mwp" if env else CORPUS
     if folder.is_dir():
@@ -160,3 +164,50 @@ def test_a_stream_longer_than_declared_is_refused() -> None:
     head, body = _split(data)
     with pytest.raises(PlcError, match="not the 10 its header declares"):
         read_project(container(body, declared=10), "x.mwp")
+
+
+def _system_span(data: bytes) -> tuple[int, int] | None:
+    """(start, end) of the system block in the stream of ``data`` (up to
+    the program block), or None."""
+    from plcrt.project.container import open_container
+    from plcrt.project.reader import _program_cursor
+    from plcrt.project.sysblock import read_system_block
+    box = open_container(data, "seed")
+    end = _program_cursor(box).pos
+    system = read_system_block(box.stream, "seed", box.format, end)[0]
+    return (system.offset, end) if system is not None else None
+
+
+SYSTEM_SEEDS = sorted(n for n in SEEDS if not SEEDS[n].startswith(b"GJK\0R03.")
+                      and _system_span(SEEDS[n]) is not None)
+
+
+@pytest.mark.parametrize("seed_name", SYSTEM_SEEDS)
+def test_mutated_system_blocks_end_in_plc_errors(seed_name: str) -> None:
+    """Bytes flipped and forged inside the system block only: the project
+    reads with bounded settings, or a PlcError names the file."""
+    data = SEEDS[seed_name]
+    head, body = _split(data)
+    lo, hi = _system_span(data)
+    rng = random.Random(f"{SEED}/system/{seed_name}")
+    for k in range(4 * MUTANTS):
+        raw = bytearray(body)
+        for _ in range(rng.randint(1, 6)):
+            at = rng.randrange(lo, hi - 4)
+            if k % 2:
+                raw[at] ^= 1 << rng.randrange(8)
+            else:
+                width = rng.choice((1, 2, 4))
+                raw[at:at + width] = rng.choice((b"\xff", b"\x00", b"\x7f", b"\x80")) * width
+        name = f"{seed_name}~system{k}"
+        mutant = head + struct.pack("<I", len(raw)) + zlib.compress(bytes(raw))
+        _check(mutant, name, traced=k % 10 == 0)
+        try:
+            system = read_project(mutant, name).system
+        except PlcError:
+            continue
+        if system is not None:                      # what is read is bounded
+            for r in system.settings.ranges or ():
+                assert r.area in "VMTC" and r.start <= 0xFFFF and r.count <= 0x10000
+            assert all(0 <= a <= 126 for a in system.settings.addresses.values())
+            assert system.settings.startup in (None, "RUN", "STOP", "LAST")

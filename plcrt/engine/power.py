@@ -39,6 +39,8 @@ __all__ = ["PowerCycle"]
 _AREA = {"V": ("V", 1), "M": ("M", 1), "T": ("TV", 2), "C": ("CV", 2)}
 #: SM0.2 (Retentive_Lost) in SMB0
 SM0_2 = 0x04
+#: the PPI rates a port runs at (as the plant file's ppi_baud)
+PPI_BAUDS = (9600, 19200, 187500)
 
 
 class PowerCycle:
@@ -53,12 +55,14 @@ class PowerCycle:
     def _power_up_settings(self, plant: Any, data: Any) -> None:
         """Take the system block's settings: the plant file's ``[cpu]``
         values, else the project's system block, else the defaults."""
+        me: Any = self
         project = getattr(self.program, "system", None)
         project = getattr(project, "settings", project)
         given = getattr(plant, "system", None)
         ranges: tuple[RetentiveRange, ...] | None = None
         startup = None
         addresses: dict[int, int] = {}
+        bauds: dict[int, int] = {}
         for settings in (project, given):      # the plant file's values win
             if not isinstance(settings, SystemSettings):
                 continue
@@ -68,6 +72,7 @@ class PowerCycle:
                                for r in settings.ranges)
             startup = settings.startup or startup
             addresses.update(settings.addresses)
+            bauds.update(settings.bauds)
         #: the retentive ranges this CPU keeps through :meth:`power_cycle`
         self.retentive: tuple[RetentiveRange, ...] = (
             ranges if ranges is not None else default_ranges(self.model))
@@ -76,9 +81,14 @@ class PowerCycle:
         #: the data block: V memory's permanent copy, restored at power-up
         self._permanent = data
         self._sm0_lost = 0
-        for port, address in addresses.items():
-            if port in self.station.addresses:
-                self.station.addresses[port] = address
+        # a port the plant file has a [port.N] table for is set up by it
+        ports = [p for p in me.ports if p.number not in (getattr(plant, "ports", None) or {})]
+        for port in ports:
+            if port.number in addresses:
+                port.address = addresses[port.number]
+                self.station.addresses[port.number] = port.address
+            if bauds.get(port.number) in PPI_BAUDS:
+                port.ppi_baud = bauds[port.number]
         # the load itself is a download followed by RUN (as Micro/WIN offers
         # at its end); the start-up mode is the mode at power-up (power_cycle)
 

@@ -4,7 +4,7 @@ What it is: the data model of the settings plcrt simulates from the
 system block (S7-200 System Manual, chapter 4, "Saving and restoring
 data" and "Configuring the retentive ranges"; Micro/WIN's System Block
 dialog): the retentive ranges kept through a power cycle, the mode the
-CPU starts in, and the station address of each port.  They come from a
+CPU starts in, and the station address and PPI baud rate of each port.  They come from a
 project's system block (:mod:`plcrt.project.sysblock`) or from the plant
 file's ``[cpu]`` table, and the engine applies them
 (:mod:`plcrt.engine.power`).  A range is checked here against the CPU's
@@ -67,6 +67,8 @@ class SystemSettings:
     startup: str | None = None
     #: port number -> station address (a port not named keeps 2)
     addresses: dict[int, int] = field(default_factory=dict)
+    #: port number -> PPI baud rate (a port not named keeps 9600)
+    bauds: dict[int, int] = field(default_factory=dict)
     #: where they come from, for messages ("the system block of x.mwp")
     source: str = ""
 

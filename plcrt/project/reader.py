@@ -9,8 +9,10 @@ what the header says; :func:`plcrt.project.load_project` parses it.
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
 read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table),
-and the CPU they are for; their data block and system block are not read
-(docs/project-files.md, "Micro/WIN V3 projects").
+the CPU they are for and their retentive ranges; their data block and the
+rest of their system block are not read (docs/project-files.md,
+"Micro/WIN V3 projects").  The system block (:mod:`.sysblock`) lies before
+the program block.
 """
 
 from __future__ import annotations
@@ -26,10 +28,10 @@ from .awl import blocks_text
 from .container import Container, open_container
 from .datapage import read_data_block
 from .program import Block, read_program_block
-from .r03 import read_v3_program
+from .r03 import find_v3_main, read_v3_program
 from .r03tables import check_symbolic_cells, read_v3_symbols
 from .stream import Cursor, binary_error
-from .sysblock import SystemBlock, read_system_block
+from .sysblock import SystemBlock, read_system_block, read_v3_system_block
 from .tables import SymbolTables, read_symbol_tables
 
 __all__ = ["Project", "read_project", "read_project_file", "PROJECT_SUFFIXES"]
@@ -50,8 +52,9 @@ _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
 #: the CPU a Micro/WIN V3 project is for, at the start of its stream
 _V3_CPU = re.compile(rb"\x00(CPU [ -~]{1,40}?)\x00")
 #: what a Micro/WIN V3 project holds that the reader does not read
-_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table and CPU are read; its "
-            "data block and system block are not (their layout is not decoded)")
+_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table, CPU and retentive "
+            "ranges are read; its data block and the rest of its system block are not (their "
+            "layout is not decoded)")
 
 
 @dataclass
@@ -104,7 +107,9 @@ def read_project(data: bytes, file: str) -> Project:
 def _v3_project(box: Container) -> Project:
     v3 = read_v3_program(box.stream, box.file)
     rows, why = read_v3_symbols(box.stream, box.file, v3.end)
-    notes = [_V3_NOTE] + ([why] if why else [])
+    main = find_v3_main(box.stream)
+    system, not_read = read_v3_system_block(box.stream, box.file, max(main, 0))
+    notes = [_V3_NOTE] + ([why] if why else []) + ([not_read] if not_read else [])
     if not why:
         check_symbolic_cells(v3, rows, Cursor(box.stream, box.file, "program block"))
     program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
@@ -112,7 +117,7 @@ def _v3_project(box: Container) -> Project:
     cpu = _V3_CPU.search(box.stream, 0, 0x40)
     return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
                    codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
-                   notes=notes)
+                   notes=notes, system=system)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -31,7 +31,7 @@ from ..errors import PlcConfigError
 from ..memory.system import RetentiveRange, SystemSettings
 from .stream import Cursor, binary_error
 
-__all__ = ["SystemBlock", "read_system_block", "V4_SIZE"]
+__all__ = ["SystemBlock", "read_system_block", "read_v3_system_block", "V4_SIZE"]
 
 SECTION = "system block"
 #: the fixed size of a Micro/WIN V4 system block (version 0x010e)
@@ -42,6 +42,10 @@ _GAP = 1 + 4 * 16
 #: a SMART system block's start: its version, then nulls (44; 35 in V1)
 _SMART_START = re.compile(rb"(?:\x0f\x06|\x13\x06)\x00{44}|\x0f\x03\x00{35}")
 
+#: six retentive ranges (four zero bytes, a data width, an area code, the
+#: offset and the count), as a V3 project holds them
+_V3_RANGES = re.compile(rb"(?:\x00{4}[\x02\x04\x08]\x00{3}[\x10\x20\x40\x80]\x00{3}.{8}){6}",
+                        re.S)
 #: area code of a retentive range -> (area, data widths it is stored with)
 _AREAS = {0x10: ("V", (2,)), 0x20: ("M", (2,)), 0x40: ("T", (4, 8)), 0x80: ("C", (4, 8))}
 #: SMART start-up mode byte -> mode
@@ -68,7 +72,8 @@ _MAX_INPUTS = 64
 class SystemBlock:
     """A system block, read."""
 
-    #: its version (0x010e: Micro/WIN V4; 0x060f: SMART V2)
+    #: its version (0x010e: Micro/WIN V4; 0x060f: SMART V2; 0: Micro/WIN
+    #: V3, of which only the retentive ranges are read)
     version: int
     #: its offset in the decompressed project
     offset: int
@@ -123,6 +128,19 @@ def read_system_block(stream: bytes, file: str, fmt: str, program_start: int
     return block, ""
 
 
+def read_v3_system_block(stream: bytes, file: str, program_start: int
+                         ) -> tuple[SystemBlock | None, str]:
+    """The retentive ranges of a Micro/WIN V3 project (its system block's
+    other fields are not decoded): six ranges laid out as V4's, found
+    before the program block by their form."""
+    match = _V3_RANGES.search(stream, 0, program_start)
+    if match is None:
+        return None, _not_found("the retentive ranges of a Micro/WIN V3 system block")
+    c = Cursor(stream, file, SECTION, match.start())
+    return SystemBlock(0, match.start(), SystemSettings(
+        _ranges(c), source=f"the system block of {file}")), ""
+
+
 def _not_found(what: str) -> str:
     return (f"the system block was not read ({what} was not found before the program "
             "block): the defaults apply (retentive ranges, start-up in RUN)")
@@ -169,6 +187,11 @@ def _address(c: Cursor, port: int) -> int:
     return address
 
 
+def _bauds(baud: dict[int, int | str]) -> dict[int, int]:
+    """The baud rates that were decoded."""
+    return {port: rate for port, rate in baud.items() if isinstance(rate, int)}
+
+
 def _read_v4(c: Cursor) -> SystemBlock:
     """Micro/WIN V4 (version 0x010e): a fixed layout."""
     start = c.pos
@@ -207,7 +230,7 @@ def _read_v4(c: Cursor) -> SystemBlock:
     # analog outputs in STOP, the LEDs, edit in RUN (read and ignored)
     c.skip(1 + 7 * 16 + 1 + 4 + 1 + 4 + 32 * 4 + 1 + 8 + 1)
     c.skip(4)
-    return SystemBlock(0x010E, start, SystemSettings(ranges, None, addresses,
+    return SystemBlock(0x010E, start, SystemSettings(ranges, None, addresses, _bauds(baud),
                                                       f"the system block of {c.file}"),
                        baud, filters=filters, pulse_catch=catch)
 
@@ -249,7 +272,7 @@ def _read_smart(c: Cursor, program_start: int) -> SystemBlock:
     _expect(c, 3, 1, "marker before the IP settings")
     c.skip(80 + 16)          # fixed IP, address, mask, gateway, station name
     block = SystemBlock(version, start, SystemSettings(
-        ranges, startup, {0: address}, f"the system block of {c.file}"), baud)
+        ranges, startup, {0: address}, _bauds(baud), f"the system block of {c.file}"), baud)
     if block_version != 3:
         _smart_cpu(c, block)
     if c.pos > program_start:

@@ -171,15 +171,18 @@ def _system_span(data: bytes) -> tuple[int, int] | None:
     the program block), or None."""
     from plcrt.project.container import open_container
     from plcrt.project.reader import _program_cursor
-    from plcrt.project.sysblock import read_system_block
+    from plcrt.project.r03 import find_v3_main
+    from plcrt.project.sysblock import read_system_block, read_v3_system_block
     box = open_container(data, "seed")
+    if box.format == "Micro/WIN V3":          # the six ranges, 120 bytes
+        system = read_v3_system_block(box.stream, "seed", find_v3_main(box.stream))[0]
+        return (system.offset, system.offset + 124) if system is not None else None
     end = _program_cursor(box).pos
     system = read_system_block(box.stream, "seed", box.format, end)[0]
     return (system.offset, end) if system is not None else None
 
 
-SYSTEM_SEEDS = sorted(n for n in SEEDS if not SEEDS[n].startswith(b"GJK\0R03.")
-                      and _system_span(SEEDS[n]) is not None)
+SYSTEM_SEEDS = sorted(n for n in SEEDS if _system_span(SEEDS[n]) is not None)
 
 
 @pytest.mark.parametrize("seed_name", SYSTEM_SEEDS)

@@ -100,6 +100,8 @@ def read_project(data: bytes, file: str) -> Project:
              "protected block, its interface without its code" for b in blocks if b.protected]
     notes += [f"symbol {name!r} is not exported: {why}" for name, why in tables.skipped]
     notes += [not_read] if not_read else []
+    if system is not None and not system.cpu:      # a V4 block names no CPU
+        system.cpu = cpu
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
                    _recode(symbols, codec), _recode(data, codec), cpu, notes, system)
 
@@ -115,9 +117,11 @@ def _v3_project(box: Container) -> Project:
     program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
     codec = decode_bytes((program + symbols).encode("latin-1"), box.file).encoding
     cpu = _V3_CPU.search(box.stream, 0, 0x40)
+    name = cpu.group(1).decode() if cpu else ""
+    if system is not None:
+        system.cpu = name
     return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
-                   codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
-                   notes=notes, system=system)
+                   codec, _recode(symbols, codec), cpu=name, notes=notes, system=system)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str]:

@@ -245,3 +245,19 @@ def test_port_settings_reach_the_ports_unless_the_plant_file_sets_them(tmp_path:
     assert plc.station.addresses[1] == 9
     plc.power_cycle()
     assert [p.address for p in plc.ports] == [6, 9]
+
+
+def test_check_reports_the_system_block_and_the_cpu(tmp_path: Path, capsys) -> None:
+    from plcrt.cli import main
+    path = _write(tmp_path, True, smart_block([("V", 0, 100)], startup="LAST", pulse_catch=(2,)))
+    assert main(["check", str(path), "--cpu", "CPU 224"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[1:] == [f"{path}: system block: {line}" for line in (
+        "retentive ranges: VB0:100", "start-up mode: LAST",
+        "port 0: station address 2, baud rate 9600",
+        "CPU: CPU ST40 firmware V02.05.00_00.00.07.00 (runs as CPU224; --cpu chooses)",
+        "pulse catch: I0.2")]
+    path = _write(tmp_path, False, v4_block(), "v4")
+    assert main(["check", str(path)]) == 0
+    assert (f"{path}: system block: CPU: CPU 224 REL 02.01 (runs as CPU226; --cpu chooses)"
+            in capsys.readouterr().err)

@@ -66,12 +66,14 @@ def smart_block(ranges=(), *, startup: str | int = "STOP", address: int = 2, bau
     out += u1(2) + u4(address) + u4(baud) + bytes(8)
     out += u1(1) + ranges_bytes(ranges)
     out += u1(5) + u4(1) + u4(0) + bytes(22)               # privileges, security, password
-    out += u1(1) + u4(10) + u1(1) + u1(0) + u1(STARTUP.get(startup, startup)) + u2(0) + u4(1) + u4(1)
+    out += u1(1) + u4(10) + u1(1) + u1(0) + u1(STARTUP.get(startup, startup))
+    out += u2(0) + u4(1) + u4(1)                           # missing hardware, errors allowed
     out += u1(3) + u4(0) + bytes([1, 2, 168, 192]) + bytes([0, 255, 255, 255]) + u4(0)
     out += bytes(64) + bytes(16)
     kind = bytes(cpu)
     out += u1(0) + bytes(12) + kind + u2(0x8000) + u1(6) + u2(1) + bytes(10) + u4(0) + bytes(16)
-    out += (bytes(cpu2) if cpu2 else kind) + u2(0x8000) + u4(1) + u4(0) + u1(len(firmware)) + firmware.encode()
+    out += (bytes(cpu2) if cpu2 else kind) + u2(0x8000) + u4(1) + u4(0)
+    out += u1(len(firmware)) + firmware.encode()
     out += u2(0x0101) + u4(0)
     out += u1(2) + u4(inputs) + b"".join(
         u1(0) + u1(filter_code | (0x40 if b in pulse_catch else 0)) for b in range(inputs))

@@ -1,9 +1,9 @@
 """Micro/WIN V3 and V4 (``.mwp``) and Micro/WIN SMART V2 (``.smart``) project files.
 
 A front end beside :mod:`plcrt.lang`: it reads a project file (container,
-bounded decompression, program block, symbol tables, data block) and hands
-:mod:`plcrt.lang` the STL export text of its program, so a project loads
-into the same :class:`~plcrt.lang.ir.Program` its ``.awl`` export does.
+bounded decompression, system block, program block, symbol tables, data
+block) and hands :mod:`plcrt.lang` the STL export text of its program, so
+a project loads into the same :class:`~plcrt.lang.ir.Program` its ``.awl`` export does.
 Importing :mod:`.frontend` registers the reader in
 :data:`plcrt.lang.sources.PROJECT_READERS` (:mod:`plcrt.loader` does), so
 ``plcrt.load("x.mwp")`` and the command line read project files.
@@ -11,9 +11,9 @@ Importing :mod:`.frontend` registers the reader in
 Submodules: :mod:`.stream` (the bounded cursor), :mod:`.container`
 (header, password, zlib), :mod:`.program` (blocks, networks, statements),
 :mod:`.tables` (symbol tables), :mod:`.datapage` (data block), :mod:`.codes`
-(the code tables), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
-(Micro/WIN V3 projects: blocks and cells, compiled code, symbol table),
-:mod:`.awl` (the export text), :mod:`.reader` (the
+(the code tables), :mod:`.sysblock` (the system block), :mod:`.r03`,
+:mod:`.r03codes` and :mod:`.r03tables` (Micro/WIN V3 projects: blocks and
+cells, compiled code, symbol table), :mod:`.awl` (the export text), :mod:`.reader` (the
 sections in order), :mod:`.frontend` (what ``load`` calls), :mod:`.cli`
 (``plcrt export``).  The package imports them when a name below is first
 used, so importing :mod:`plcrt.project.cli` for ``plcrt --help`` stays

@@ -244,3 +244,17 @@ def test_property_retentive_bytes_survive_everything_else_is_cleared(
         assert areas[name] == want, area
     for name in ("TB", "CB", "Q", "S", "AC"):
         assert not any(areas[name]), name
+
+
+def test_a_plc_with_machines_and_modules_power_cycles() -> None:
+    """The plant's devices start again with the CPU; the program runs on."""
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[2]
+    plc = plcrt.load(root / "examples/machines/conveyor.awl",
+                     plant=root / "examples/machines/conveyor.toml")
+    plc.run(1.0)
+    devices = [type(d) for d in plc.devices]
+    plc.power_cycle()
+    assert [type(d) for d in plc.devices] == devices and not any(plc.mem.areas["Q"])
+    plc.run(1.0)
+    assert plc.fault is None and plc.mode == "RUN" and plc.time == 2.0

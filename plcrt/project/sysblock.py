@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from typing import cast
 
 from ..errors import PlcConfigError
 from ..memory.system import RetentiveRange, SystemSettings
@@ -147,9 +148,7 @@ def _not_found(what: str) -> str:
 
 
 def _refuse(c: Cursor, at: int, message: str) -> PlcConfigError:
-    err = binary_error(c.file, SECTION, at, message, PlcConfigError)
-    assert isinstance(err, PlcConfigError)
-    return err
+    return cast(PlcConfigError, binary_error(c.file, SECTION, at, message, PlcConfigError))
 
 
 def _expect(c: Cursor, value: int, width: int, what: str) -> None:

@@ -53,6 +53,11 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"{name}: {count_text(diags)} ({len(prog.pous)} block(s), "
           f"{prog.network_count()} network(s), {prog.instruction_count()} instruction(s))",
           file=sys.stderr)
+    system = getattr(prog, "system", None)    # a project's system block (docs/retentive.md)
+    for line in system.lines() if system is not None else ():
+        if line.startswith("CPU: "):
+            line += f" (runs as {plc.model.name}; --cpu chooses)"
+        print(printable(f"{name}: system block: {line}"), file=sys.stderr)
     return EXIT_OK
 
 

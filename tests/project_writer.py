@@ -16,7 +16,7 @@ import struct
 import zlib
 
 from plcrt.lang import ir
-from plcrt.project.codes import AREAS, CLASSES, OPCODES, VAR_SECTIONS, VAR_TYPES
+from plcrt.project.codes import AREAS, CLASSES, OPCODES, VAR_SECTIONS
 
 CODES = {m: c for c, m in OPCODES.items()}
 _AREA = {p: a for a, p in AREAS.items()}
@@ -139,12 +139,15 @@ def data_section(rows: list[tuple[str, list[int], str]]) -> bytes:
 def stream(program: ir.Program, *, smart: bool = False,
            symbols: list[tuple[str, str, str]] = (), data: list = (),
            cpu: str = "CPU 224 REL 02.01", protected: tuple[str, ...] = (),
-           drawn: tuple = (), wizards: bytes | None = None) -> bytes:
+           drawn: tuple = (), system: bytes = b"", wizards: bytes | None = None) -> bytes:
     """The decompressed project: filler, program block, symbols, data, CPU.
     ``drawn`` lists (block, network) pairs given a ladder contact besides
-    their code; ``wizards`` is what follows the CPU name (default: no wizard
-    configured, tests/wizard_writer.py writes them)."""
+    their code; ``system`` a system block (tests/sysblock_writer.py), with
+    the flag byte and four time stamps that follow it; ``wizards`` is what
+    follows the CPU name (default: no wizard configured,
+    tests/wizard_writer.py writes them)."""
     body = b"\x10" + b"\x55" * 64                   # stands for preamble and system block
+    body += system + (b"\x00" + b"\xe9\x07" * 32 if system else b"")
     body += u1(2) + u2(len(program.pous))
     body += b"".join(block(p, smart, p.ident in protected, drawn) for p in program.pous)
     body += symbol_section(list(symbols))

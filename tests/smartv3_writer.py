@@ -133,10 +133,11 @@ def symbols_xml(symbols: list[tuple[str, str, str]], extra: str = "") -> bytes:
 
 
 def members(program: ir.Program, *, symbols: list = (), data: list = (),
-            cpu: str = "CPU ST40", **kw) -> list[tuple[str, bytes]]:
+            cpu: str = "CPU ST40", system: bytes = bytes(64), **kw) -> list[tuple[str, bytes]]:
     """(name, bytes) of the archive's members, in the order Micro/WIN writes
-    them (Windows separators)."""
-    out = [("p\\m_cSystemBlockData.bin", bytes(64))]
+    them (Windows separators); ``system`` the system block's member
+    (tests/sysblock_writer.py writes one; the default is not one)."""
+    out = [("p\\m_cSystemBlockData.bin", system)]
     if data:
         out.append(("p\\Data Block\\Page_1.dbbin", data_page(list(data))))
     out.append(("p\\m_mGlbVarTables.xml", symbols_xml(list(symbols))))

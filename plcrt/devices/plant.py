@@ -15,6 +15,8 @@
     [cpu]
     wire = { "I0.0" = "Q0.0" }  # the output Q0.0 (or its pulses) drives the input I0.0
     clock = "2026-12-02T08:00:00"   # the real-time clock at power-up (TODR)
+    retentive = ["VB0:100", "MB14:18", "T0:32", "C0:256"]   # kept by power_cycle()
+    startup = "RUN"             # or "STOP", "LAST": the mode at power-up
 
     [module.1]                  # a fieldbus master module with CiA 402 drives
     kind = "FIELDBUS"
@@ -138,6 +140,8 @@ class Plant:
     ports: dict[int, PortConfig] = field(default_factory=dict)
     #: the Ethernet interface for GET/PUT ([ethernet])
     ethernet: EthernetConfig | None = None
+    #: retentive ranges and start-up mode ([cpu] retentive, startup), or None
+    system: Any = None
     #: the machines ([machine.NAME], plcrt.devices.machines)
     machines: list[Any] = field(default_factory=list)
 
@@ -235,7 +239,8 @@ def _build(data: dict, file: str) -> Plant:
                 raise PlcConfigError(f"{awhere}: unknown key(s) {_keys(unknown)}")
             cfg.axes[int(akey)] = _axis(ax, awhere)
         modules[slot] = cfg
-    plant = Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports, ethernet)
+    plant = Plant(modules, file, wiring, encoders, pto, pwm, processes, clock, ports, ethernet,
+                  system=_system(data.get("cpu", {}), file))
     if "machine" in data:
         from .machines import parse as parse_machines   # perf: only for a plant with machines
         taken = {("I", b): "cpu.wire/encoder" for b in (*wiring, *(
@@ -255,10 +260,10 @@ def _cpu(cpu: Any, file: str) -> tuple[dict[int, int], list[dict[str, Any]]]:
     where = f"{file}: cpu"
     if not isinstance(cpu, dict):
         raise PlcConfigError(f"{where} must be a table")
-    unknown = set(cpu) - {"wire", "encoder", "process", "clock"}
+    unknown = set(cpu) - {"wire", "encoder", "process", "clock", "retentive", "startup"}
     if unknown:
         raise PlcConfigError(f"{where}: unknown key(s) {_keys(unknown)} "
-                             f"(known: wire, encoder, process, clock)")
+                             f"(known: wire, encoder, process, clock, retentive, startup)")
     wire = cpu.get("wire", {})
     if not isinstance(wire, dict):
         raise PlcConfigError(f"{where}.wire must be a table {{ \"I0.0\" = \"Q0.0\" }}")
@@ -280,6 +285,19 @@ def _clock(cpu: dict, file: str) -> Any:
         return None
     from ..engine.clock import start_time
     return start_time(cpu["clock"], f"{file}: cpu.clock")
+
+
+def _system(cpu: dict, file: str) -> Any:
+    """``[cpu] retentive = ["VB0:100", ...]`` and ``startup = "STOP"``: what a
+    project's system block would set (docs/retentive.md), or None."""
+    if "retentive" not in cpu and "startup" not in cpu:
+        return None
+    from ..memory.system import SystemSettings, parse_ranges, parse_startup
+    ranges = parse_ranges(cpu["retentive"], f"{file}: cpu.retentive") \
+        if "retentive" in cpu else None
+    startup = parse_startup(cpu["startup"], f"{file}: cpu.startup") \
+        if "startup" in cpu else None
+    return SystemSettings(ranges, startup, source=file)
 
 
 _ENCODER_KEYS = {"inputs", "hz", "start", "stop", "direction"}

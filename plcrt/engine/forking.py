@@ -185,7 +185,7 @@ class Forking:
         dst.scheduler.reset([dst.interrupts, dst.edges, *dst.pulse,
                              *(twin[id(s)] for s in self.scheduler.sources[4:])])
         for name in ("scans", "_t_us", "_prev_start", "mode", "fault", "stop_requested",
-                     "_entered_run",
+                     "_entered_run", "_permanent", "_sm0_lost",
                      "_irq_t", "_pi0", "_sources_on"):
             setattr(dst, name, getattr(self, name))
         dst._calm_hi = 0   # its timer bank and scan count are ours now

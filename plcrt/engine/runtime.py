@@ -47,6 +47,7 @@ from .hsc import Encoder, make_counters
 from .interrupts import Interrupts
 from .netjobs import make_ethernet
 from .pid import make_loops
+from .power import PowerCycle
 from .ports import make_ports
 from .pulse import make_outputs
 from .scan import SMB0, ScanLoop
@@ -55,7 +56,8 @@ from .timers import TimerBank
 from .values import check_backend, check_parsed_inputs, scan_time_us, shown_value, source_items
 
 
-class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess):
+class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, PowerCycle,
+          AddressAccess):
     """A loaded program, ready to scan.  Create it with :func:`plcrt.load`
     (or :meth:`from_program`, another instance of a compiled program)."""
 
@@ -249,6 +251,8 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, AddressAccess
                          if p.kind == "INT" and f"pou_INT{p.number}" in ns}
         if data is not None:
             data.apply(self.mem.areas["V"])
+        # retentive ranges, start-up mode, port addresses (engine/power.py)
+        self._power_up_settings(plant, data)
         # SMW22/24/26: last, minimum and maximum scan time in ms.  SMB0..29
         # are read-only to the program, so they are written once.
         ms = min(self.scan_us // 1000, 0xFFFF).to_bytes(2, "big")

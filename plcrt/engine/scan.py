@@ -301,12 +301,13 @@ class ScanLoop:
             self._clock(now)
         if scans and not self._entered_run:
             sm[0] = self._smb0[scans & 1]
-        elif scans:   # RUN entered from STOP (set_mode): SM0.1 on, SM0.3 off
-            sm[0] = 0x83 | 0x40 | self._smb0[0]
+        elif self._entered_run:   # RUN entered from STOP (set_mode): SM0.1 on, SM0.3 off
+            # SM0.2 (retentive data lost) on the first scan after power-up
+            sm[0] = 0x83 | 0x40 | self._smb0[0] | (0 if scans else self._sm0_lost)
             self._entered_run = False
             scans = 0   # no calm window for this first scan
-        else:
-            sm[0] = 0x8B | 0x40 | self._smb0[0]
+        else:             # the first scan from power-up: SM0.1, SM0.3 (and SM0.2) on
+            sm[0] = 0x8B | 0x40 | self._smb0[0] | self._sm0_lost
         timers = self.timers
         if timers.quiet(now):
             timers.ms1 = now // 1000

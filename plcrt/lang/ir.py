@@ -13,7 +13,7 @@ This module holds data only: no parsing and no semantics.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 from ..errors import SourceLoc
 
@@ -113,6 +113,9 @@ class Program:
     #: plant tables a project file's wizards give (TOML, as a plant file
     #: writes them; docs/project-files.md, "Wizards"); "" for none
     project_plant: str = ""
+    #: the system block of the project file it was read from (None for an
+    #: export): settings for the CPU, not part of the program's IR
+    system: Any = field(default=None, compare=False, repr=False)
 
     def instruction_count(self) -> int:
         return sum(len(n.insns) for p in self.pous for n in p.networks)

@@ -2,9 +2,9 @@
 ``.smartV3``) project files.
 
 A front end beside :mod:`plcrt.lang`: it reads a project file (container,
-bounded decompression, program block, symbol tables, data block) and hands
-:mod:`plcrt.lang` the STL export text of its program, so a project loads
-into the same :class:`~plcrt.lang.ir.Program` its ``.awl`` export does.
+bounded decompression, system block, program block, symbol tables, data
+block) and hands :mod:`plcrt.lang` the STL export text of its program, so
+a project loads into the same :class:`~plcrt.lang.ir.Program` its ``.awl`` export does.
 Importing :mod:`.frontend` registers the reader in
 :data:`plcrt.lang.sources.PROJECT_READERS` (:mod:`plcrt.loader` does), so
 ``plcrt.load("x.mwp")`` and the command line read project files.
@@ -13,7 +13,7 @@ Submodules: :mod:`.stream` (the bounded cursor), :mod:`.container`
 (header, password, zlib), :mod:`.program` (blocks, networks, statements),
 :mod:`.tables` (symbol tables), :mod:`.datapage` (data block),
 :mod:`.wizards` (the wizard configurations and their plant tables), :mod:`.codes`
-(the code tables), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
+(the code tables), :mod:`.sysblock` (the system block), :mod:`.r03`, :mod:`.r03codes` and :mod:`.r03tables`
 (Micro/WIN V3 projects: blocks and cells, compiled code, symbol table),
 :mod:`.smartv3` and :mod:`.smartv3pou` (SMART V3 projects: the encrypted
 zip, its blocks, symbol tables and data pages),

@@ -10,10 +10,12 @@ what the header says; :func:`plcrt.project.load_project` parses it.
 Micro/WIN V3 projects (``R03.xx``) hold their program blocks in another
 layout (compiled CPU code and a grid of ladder cells, no statement list),
 read by :mod:`.r03` and :mod:`.r03tables` (with the user's symbol table),
-and the CPU they are for; their data block and system block are not read
-(docs/project-files.md, "Micro/WIN V3 projects").  SMART V3 projects
+the CPU they are for and their retentive ranges; their data block and the
+rest of their system block are not read (docs/project-files.md,
+"Micro/WIN V3 projects").  SMART V3 projects
 (``.smartV3``, an encrypted zip) are opened by :mod:`.smartv3` and their
-members read by :mod:`.smartv3pou`.
+members read by :mod:`.smartv3pou`.  The system block (:mod:`.sysblock`) lies before
+the program block.
 """
 
 from __future__ import annotations
@@ -29,11 +31,12 @@ from .awl import blocks_text
 from .container import Container, open_container
 from .datapage import read_data_block
 from .program import Block, read_program_block
-from .r03 import read_v3_program
+from .r03 import find_v3_main, read_v3_program
 from .r03tables import check_symbolic_cells, read_v3_symbols
 from .smartv3 import is_smartv3, open_smartv3
 from .smartv3pou import read_smartv3_content, recode_variables
 from .stream import Cursor, binary_error
+from .sysblock import SystemBlock, read_system_block, read_v3_system_block
 from .tables import SymbolTables, read_symbol_tables
 from .wizards import SECTION as WIZARDS, Wizard, plant_toml, read_wizards
 
@@ -55,8 +58,9 @@ _PROGRAM_BLOCK = re.compile(rb"\x02..[\x07\x08]\xe8\x03\x00\x00\x00\x00", re.S)
 #: the CPU a Micro/WIN V3 project is for, at the start of its stream
 _V3_CPU = re.compile(rb"\x00(CPU [ -~]{1,40}?)\x00")
 #: what a Micro/WIN V3 project holds that the reader does not read
-_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table and CPU are read; its "
-            "data block and system block are not (their layout is not decoded)")
+_V3_NOTE = ("a Micro/WIN V3 project: its program block, symbol table, CPU and retentive "
+            "ranges are read; its data block and the rest of its system block are not (their "
+            "layout is not decoded)")
 
 
 @dataclass
@@ -82,6 +86,8 @@ class Project:
     wizards: list[Wizard] = field(default_factory=list)
     #: the plant tables they give, as a plant file writes them ("" for none)
     plant: str = ""
+    #: the system block (None: not read, see notes)
+    system: SystemBlock | None = None
 
 
 def read_project(data: bytes, file: str) -> Project:
@@ -92,6 +98,7 @@ def read_project(data: bytes, file: str) -> Project:
     if box.format == "Micro/WIN V3":
         return _v3_project(box)
     cursor = _program_cursor(box)
+    system, not_read = read_system_block(box.stream, file, box.format, cursor.pos)
     blocks = read_program_block(cursor)
     tables = read_symbol_tables(cursor)
     for block in blocks:          # the block's title is its comment in the block-name table
@@ -110,23 +117,30 @@ def read_project(data: bytes, file: str) -> Project:
     notes += [_recode(note, codec) for note in wizards.notes]
     for wizard in wizards.configs:              # names in the project's code page
         wizard.name = _recode(wizard.name, codec)
+    notes += [not_read] if not_read else []
+    if system is not None and not system.cpu:      # a V4 block names no CPU
+        system.cpu = cpu
     return Project(file, box.format, box.version, blocks, _recode(program, codec), codec,
                    _recode(symbols, codec), _recode(data, codec), cpu, notes,
-                   wizards.configs, plant_toml(wizards.plant))
+                   wizards.configs, plant_toml(wizards.plant), system)
 
 
 def _v3_project(box: Container) -> Project:
     v3 = read_v3_program(box.stream, box.file)
     rows, why = read_v3_symbols(box.stream, box.file, v3.end)
-    notes = [_V3_NOTE] + ([why] if why else [])
+    main = find_v3_main(box.stream)
+    system, not_read = read_v3_system_block(box.stream, box.file, max(main, 0))
+    notes = [_V3_NOTE] + ([why] if why else []) + ([not_read] if not_read else [])
     if not why:
         check_symbolic_cells(v3, rows, Cursor(box.stream, box.file, "program block"))
     program, symbols = blocks_text(v3.blocks), symbols_text(SymbolTables(rows))
     codec = decode_bytes((program + symbols).encode("latin-1"), box.file).encoding
     cpu = _V3_CPU.search(box.stream, 0, 0x40)
+    name = cpu.group(1).decode() if cpu else ""
+    if system is not None:
+        system.cpu = name
     return Project(box.file, box.format, box.version, v3.blocks, _recode(program, codec),
-                   codec, _recode(symbols, codec), cpu=cpu.group(1).decode() if cpu else "",
-                   notes=notes)
+                   codec, _recode(symbols, codec), cpu=name, notes=notes, system=system)
 
 
 def _smartv3_project(data: bytes, file: str) -> Project:
@@ -136,10 +150,17 @@ def _smartv3_project(data: bytes, file: str) -> Project:
     bare = [dataclasses.replace(b, variables=[]) for b in v3.blocks]
     codec = decode_bytes((blocks_text(bare) + v3.data).encode("latin-1"), file).encoding
     recode_variables(v3.blocks, codec)
+    system, not_read = None, "the archive holds no system block: the defaults apply"
+    for kind, _name, body in archive.members:
+        if kind == "system":            # a SMART system block alone (0x0613/0x0615)
+            system, not_read = read_system_block(body, file, "Micro/WIN SMART", len(body))
+    if system is not None and not system.cpu:
+        system.cpu = v3.cpu
+    notes = v3.notes + ([not_read] if not_read else [])
     return Project(file, "Micro/WIN SMART V3", archive.version, v3.blocks,
                    _recode(blocks_text(v3.blocks), codec), codec,
                    symbols_text(SymbolTables(v3.symbols)), _recode(v3.data, codec), v3.cpu,
-                   v3.notes)
+                   notes, system=system)
 
 
 def _data_block(box: Container, start: int) -> tuple[str, str, int]:

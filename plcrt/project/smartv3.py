@@ -65,7 +65,7 @@ _EOCD_SIZE = 22
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 #: what a member holds, by the end of its name (compared in lower case)
 _KINDS = ((".poubin", "program"), (".dbbin", "data"), ("m_mglbvartables.xml", "symbols"),
-          (".devproj", "device"))
+          (".devproj", "device"), ("m_csystemblockdata.bin", "system"))
 #: what zipfile raises on a damaged archive
 _ZIP_ERRORS = (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, OSError,
                ValueError, struct.error, NotImplementedError, RuntimeError, IndexError,
@@ -80,9 +80,10 @@ class SmartV3Archive:
     file: str
     version: str
     view: str
-    #: (kind, member name, bytes): kind is "program", "data", "symbols" or "device"
+    #: (kind, member name, bytes): kind is "program", "data", "symbols", "device"
+    #: or "system"
     members: list[tuple[str, str, bytes]] = field(default_factory=list)
-    #: names of the members not read (system block, status charts, wizards)
+    #: names of the members not read (status charts, wizards, ...)
     others: list[str] = field(default_factory=list)
 
 

@@ -424,6 +424,13 @@ class Harness(Stimuli, Motion):
         self.plc.set_mode(mode)
         return self
 
+    def power_cycle(self, *, retentive_lost: bool = False) -> Harness:
+        """Switch the CPU off and on (:meth:`Plc.power_cycle`): the retentive
+        ranges keep their values, the rest is cleared, V outside them comes
+        back from the data block, the CPU starts in its start-up mode."""
+        self.plc.power_cycle(retentive_lost=retentive_lost)
+        return self
+
     def warn(self, message: str, loc: SourceLoc | None, key: str) -> Harness:
         """Add a run-time warning (reported once per ``key``), as :meth:`Plc.warn`."""
         self.plc.warn(message, loc, key)

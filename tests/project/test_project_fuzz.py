@@ -36,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from project_writer import container, project_bytes, stream  # noqa: E402
 from wizard_writer import (hsc_counter, motion_axis, pid_loop, pid_record_v4,  # noqa: E402
                            position_record, pto_record, pwm_output, smart_lists, v4_tail)
+from sysblock_writer import smart_block, v4_block  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT.parent / "shared" / "corpus" / "mwp"
@@ -52,7 +53,10 @@ def _seeds() -> dict[str, bytes]:
     program = parse_program(EVERY_CODE, "x.awl")
     seeds = {"own.mwp": project_bytes(program, symbols=[("A", "I0.0", "a")],
                                       data=[("VW0", [1, 2], "c")]),
-             "own.smart": project_bytes(program, smart=True)}
+             "own.smart": project_bytes(program, smart=True),
+             "own-system.mwp": project_bytes(program, system=v4_block(pulse_catch=(2,))),
+             "own-system.smart": project_bytes(program, smart=True,
+                                               system=smart_block(startup="RUN"))}
     env = os.environ.get("PLCRT_CORPUS")
     folder = Path(env) / "mwp" if env else CORPUS
     if folder.is_dir():
@@ -264,3 +268,53 @@ def test_smartv3_mutants_end_in_plc_errors(kind: str) -> None:
     rng = random.Random(f"{SEED}/smartv3/{kind}")
     for k in range(MUTANTS):
         _check(_v3_mutant(kind, rng), f"own.smartV3~{kind}{k}", traced=k % 10 == 0)
+
+
+def _system_span(data: bytes) -> tuple[int, int] | None:
+    """(start, end) of the system block in the stream of ``data`` (up to
+    the program block), or None."""
+    from plcrt.project.container import open_container
+    from plcrt.project.reader import _program_cursor
+    from plcrt.project.r03 import find_v3_main
+    from plcrt.project.sysblock import read_system_block, read_v3_system_block
+    box = open_container(data, "seed")
+    if box.format == "Micro/WIN V3":          # the six ranges, 120 bytes
+        system = read_v3_system_block(box.stream, "seed", find_v3_main(box.stream))[0]
+        return (system.offset, system.offset + 124) if system is not None else None
+    end = _program_cursor(box).pos
+    system = read_system_block(box.stream, "seed", box.format, end)[0]
+    return (system.offset, end) if system is not None else None
+
+
+SYSTEM_SEEDS = sorted(n for n in SEEDS if _system_span(SEEDS[n]) is not None)
+
+
+@pytest.mark.parametrize("seed_name", SYSTEM_SEEDS)
+def test_mutated_system_blocks_end_in_plc_errors(seed_name: str) -> None:
+    """Bytes flipped and forged inside the system block only: the project
+    reads with bounded settings, or a PlcError names the file."""
+    data = SEEDS[seed_name]
+    head, body = _split(data)
+    lo, hi = _system_span(data)
+    rng = random.Random(f"{SEED}/system/{seed_name}")
+    for k in range(4 * MUTANTS):
+        raw = bytearray(body)
+        for _ in range(rng.randint(1, 6)):
+            at = rng.randrange(lo, hi - 4)
+            if k % 2:
+                raw[at] ^= 1 << rng.randrange(8)
+            else:
+                width = rng.choice((1, 2, 4))
+                raw[at:at + width] = rng.choice((b"\xff", b"\x00", b"\x7f", b"\x80")) * width
+        name = f"{seed_name}~system{k}"
+        mutant = head + struct.pack("<I", len(raw)) + zlib.compress(bytes(raw))
+        _check(mutant, name, traced=k % 10 == 0)
+        try:
+            system = read_project(mutant, name).system
+        except PlcError:
+            continue
+        if system is not None:                      # what is read is bounded
+            for r in system.settings.ranges or ():
+                assert r.area in "VMTC" and r.start <= 0xFFFF and r.count <= 0x10000
+            assert all(0 <= a <= 126 for a in system.settings.addresses.values())
+            assert system.settings.startup in (None, "RUN", "STOP", "LAST")

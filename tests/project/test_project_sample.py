@@ -1,7 +1,7 @@
 """examples/project/seal_in.mwp, the sample project of docs/project-files.md,
-is what the tests' writer makes of programs/seal_in.awl with its symbols
-and a data block (so the sample cannot drift from the writer the tests
-check the reader with)."""
+is what the tests' writer makes of programs/seal_in.awl with its symbols,
+a data block and Micro/WIN's default system block (so the sample cannot
+drift from the writer the tests check the reader with)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from project_writer import project_bytes  # noqa: E402
+from sysblock_writer import v4_block  # noqa: E402
 
 from plcrt.lang.stl import parse_program
 
@@ -24,7 +25,7 @@ DATA = [("VW100", [1500], "motor run-up time, ms")]
 def sample_bytes() -> bytes:
     program = parse_program((ROOT / "programs" / "seal_in.awl").read_text(encoding="utf-8"),
                             "seal_in.awl")
-    return project_bytes(program, symbols=SYMBOLS, data=DATA)
+    return project_bytes(program, symbols=SYMBOLS, data=DATA, system=v4_block())
 
 
 def test_sample_is_the_writers() -> None:

@@ -201,6 +201,16 @@ def program_key(program: Any, **options: Any) -> tuple[Any, ...]:
     return head + tuple((name, _fingerprint(value)) for name, value in sorted(options.items()))
 
 
+def _same(cached: Any, program: Any) -> bool:
+    """Whether a cached build's program is ``program``: equal IR, and the
+    same system block (the settings a PLC of the build powers up with,
+    which the IR's equality leaves out)."""
+    if cached is program:
+        return True
+    return cached == program and (getattr(cached, "system", None)
+                                  == getattr(program, "system", None))
+
+
 class ProgramCache:
     """Compiled programs (:class:`plcrt.compiler.program.CompiledProgram`)
     by :func:`program_key`, least recently used first
@@ -218,7 +228,7 @@ class ProgramCache:
         """The compiled program under ``key`` if it is of ``program``, else None."""
         with self._lock:
             entry = self._entries.get(key) if self.max_entries > 0 else None
-            if entry is None or not (entry.program is program or entry.program == program):
+            if entry is None or not _same(entry.program, program):
                 self.misses += 1
                 return None
             self._entries.move_to_end(key)
@@ -230,7 +240,7 @@ class ProgramCache:
         a build of another backend is made already)."""
         with self._lock:
             entry = self._entries.get(key) if self.max_entries > 0 else None
-            if entry is None or not (entry.program is program or entry.program == program):
+            if entry is None or not _same(entry.program, program):
                 return None
         return self.get(key, program)
 

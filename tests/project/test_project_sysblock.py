@@ -294,3 +294,18 @@ def test_a_smart_v3_project_without_its_system_block_says_the_defaults_apply(
     project = read_project(path.read_bytes(), str(path))
     assert project.system is None
     assert any("defaults apply" in note for note in project.notes)
+
+
+def test_a_build_is_shared_only_with_the_same_system_block(tmp_path: Path) -> None:
+    """The same program under another system block is another build: a PLC
+    made from the second load's compiled program powers up with its own
+    ranges, not those of the first build in the cache."""
+    path = tmp_path / "p.mwp"
+    path.write_bytes(project_bytes(PROGRAM, system=v4_block((("V", 100, 2),))))
+    first = plcrt.load(path)
+    path.write_bytes(project_bytes(PROGRAM, system=v4_block((("V", 200, 4),))))
+    second = plcrt.load(path)
+    again = plcrt.Plc.from_program(second.compiled)
+    assert [str(r) for r in first.retentive] == ["VB100:2"]
+    assert [str(r) for r in again.retentive] == ["VB200:4"]
+    assert second.compiled is not first.compiled

@@ -45,6 +45,12 @@ from .unit import Compiled, Piece, PouInfo, Unit
 #: same time and memory as with 32 / 400.
 GROUP_PIECES = 256
 GROUP_LINES = 2000
+#: perf: with the native backend a block's pieces are planned and emitted
+#: this many at a time, so that their lines and resolved instructions are
+#: never held for a whole block (measured on 2026-12-05: the 100 000-statement
+#: mixed program's one block held about 100 MiB of them at once, which left
+#: Python's small-object heap fragmented after the load)
+NATIVE_WINDOW = 256
 
 
 def generate(unit: Unit) -> tuple[str, LineLocs]:
@@ -143,6 +149,63 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             emit_def(name, group)
             calls.append(f"{name}(L)")
 
+        fnames: list[str] = []
+        group: list[Any] = []    # consecutive Python pieces not yet emitted
+        prev: int | None = None  # the segment of the last record emitted
+        planned: list[Any] = []  # native: the pieces of ``records``
+        carry = None
+        if unit.native is not None:
+            from . import native
+            carry = native.OpenSegment()
+
+        def emit_records(recs: list[Any], segs: list[int | None] | None) -> None:
+            """Emit the records of consecutive pieces, ``segs`` their segments."""
+            nonlocal group, prev
+            if info.flow:
+                # a jump may land on any piece: one function each; a native
+                # piece runs through a wrapper that falls through
+                for i, rec in enumerate(recs):
+                    emit_def(rec[0], [rec])
+                    seg = segs[i] if segs is not None else None
+                    if seg is None:
+                        fnames.append(rec[0])
+                    else:
+                        out.extend([f"def _nw{seg}(L, _f=_nseg{seg}):", "    _f()", ""])
+                        fnames.append(f"_nw{seg}")
+                return
+            # consecutive Python pieces share one function; a native piece
+            # keeps its own function for plcrt dump, as comments
+            assert calls is not None
+            for i, rec in enumerate(recs):
+                seg = segs[i] if segs is not None else None
+                if seg is not None:
+                    if group:
+                        emit_group(group)
+                        group = []
+                    emit_def(rec[0], [rec], shown=True)
+                    if seg != prev:
+                        calls.append(f"_nseg{seg}()")
+                else:
+                    group.append(rec)
+                    if _group_full(group):
+                        emit_group(group)
+                        group = []
+                prev = seg
+
+        def emit_planned() -> None:
+            """Plan the native segments of the pieces in ``records`` and emit them."""
+            edges = unit.hooks.get("edges")
+            if edges is not None and unit.native.edges is None:
+                unit.native.edges = unit.bind(edges, "EM")
+            segs = native.plan_pou(unit.native, p.ident, info.flow,
+                                   [(pc.network.number, pc.resolved, pc.entry_depth)
+                                    for pc in planned], carry)
+            for pc in planned:
+                pc.resolved = None
+            planned.clear()
+            emit_records(records, segs)
+            records.clear()
+
         for piece in info.pieces:
             unit.current_piece = piece
             if unit.native is not None:
@@ -175,53 +238,17 @@ def generate(unit: Unit) -> tuple[str, LineLocs]:
             if full:
                 emit_group(records)
                 records = []
-        segs = None
-        if unit.native is not None:
-            from .native import plan_pou
-            edges = unit.hooks.get("edges")
-            if edges is not None and unit.native.edges is None:
-                unit.native.edges = unit.bind(edges, "EM")
-            segs = plan_pou(unit.native, p.ident, info.flow,
-                            [(pc.network.number, pc.resolved, pc.entry_depth)
-                             for pc in info.pieces])
-            for pc in info.pieces:
-                pc.resolved = None
-
-        fnames: list[str] = []
-        if info.flow:
-            # a jump may land on any piece: one function each; a native
-            # piece runs through a wrapper that falls through
-            for i, rec in enumerate(records):
-                emit_def(rec[0], [rec])
-                seg = segs[i] if segs is not None else None
-                if seg is None:
-                    fnames.append(rec[0])
-                else:
-                    out.extend([f"def _nw{seg}(L, _f=_nseg{seg}):", "    _f()", ""])
-                    fnames.append(f"_nw{seg}")
+            if carry is not None:
+                planned.append(piece)
+                if len(planned) >= NATIVE_WINDOW:
+                    emit_planned()
+        if carry is not None:
+            emit_planned()
+            carry.close(unit.native)
         else:
-            # consecutive Python pieces share one function; a native piece
-            # keeps its own function for plcrt dump, as comments
-            assert calls is not None
-            group: list[Any] = []
-            prev: int | None = None
-            for i, rec in enumerate(records):
-                seg = segs[i] if segs is not None else None
-                if seg is not None:
-                    if group:
-                        emit_group(group)
-                        group = []
-                    emit_def(rec[0], [rec], shown=True)
-                    if seg != prev:
-                        calls.append(f"_nseg{seg}()")
-                else:
-                    group.append(rec)
-                    if _group_full(group):
-                        emit_group(group)
-                        group = []
-                prev = seg
-            if group:
-                emit_group(group)
+            emit_records(records, None)
+        if group:
+            emit_group(group)
         maybe_cut()
         out.extend(_runner(unit, info, fnames, calls))
         out.append("")

@@ -31,7 +31,7 @@ from . import probes  # noqa: F401 - registers the probes' lowerings
 from .fn import DECLARE, function
 from .lower import Fn, NotLowered, lower_piece
 
-__all__ = ["MODULE_CHARS", "NativePlan", "NotLowered", "plan_pou"]
+__all__ = ["MODULE_CHARS", "NativePlan", "NotLowered", "OpenSegment", "plan_pou"]
 
 
 #: characters of IR text per LLVM module: a program's native code is
@@ -106,9 +106,25 @@ class NativePlan:
         self._defined, self._called = set(), set()
 
 
+class OpenSegment:
+    """The segment a block's planning leaves open between two runs of its
+    pieces (:func:`plan_pou` with ``carry``): a block's pieces are planned
+    as they are generated, a window at a time, so that their resolved
+    instructions are never held for a whole block."""
+
+    __slots__ = ("fn",)
+
+    def __init__(self) -> None:
+        self.fn: Fn | None = None
+
+    def close(self, plan: NativePlan) -> None:
+        """End the block: write its open segment."""
+        self.fn = _close(plan, self.fn)
+
+
 def plan_pou(plan: NativePlan, block: str, flow: bool,
-             pieces: list[tuple[int, list[tuple[str, list[Any], int]], int]]
-             ) -> list[int | None]:
+             pieces: list[tuple[int, list[tuple[str, list[Any], int]], int]],
+             carry: OpenSegment | None = None) -> list[int | None]:
     """Group the pieces of one block into segments.
 
     ``pieces``: per piece, its network number, its resolved instructions and
@@ -118,10 +134,13 @@ def plan_pou(plan: NativePlan, block: str, flow: bool,
     share one segment (the runner is a straight list of calls); in a block
     with them each lowered piece is its own segment, since a jump may land
     on any piece.  The pieces that hold the jumps, labels and loops
-    themselves stay Python.
+    themselves stay Python.  ``carry``: the pieces are one run of the
+    block's, in order, and the segment open at their end stays open in it
+    for the next run (:meth:`OpenSegment.close` ends the block); None: they
+    are the whole block.
     """
     out: list[int | None] = [None] * len(pieces)
-    seg: Fn | None = None
+    seg: Fn | None = carry.fn if carry is not None else None
     for i, (net, insns, depth) in enumerate(pieces):
         f = seg if seg is not None else Fn(plan.part)
         mark = (len(f.body), set(f.slots))
@@ -141,7 +160,10 @@ def plan_pou(plan: NativePlan, block: str, flow: bool,
         out[i] = len(plan.names)
         if flow:
             seg = _close(plan, seg)
-    _close(plan, seg)
+    if carry is not None:
+        carry.fn = seg
+    else:
+        _close(plan, seg)
     return out
 
 

@@ -226,9 +226,12 @@ class CanPdos:
 
     # ---------------------------------------------------------------- codecs
     def _codec(self, ch: Channel) -> tuple:
-        """(struct or None, keys, entries, size, getter) for the current map
-        (perf: built once per mapping); *getter* takes the values of *keys*
-        from the store's live values as a tuple."""
+        """(struct or None, keys, entries, size, getter, held getter, held
+        picker) for the current map (perf: built once per mapping); *getter*
+        takes the values of *keys* from the store's live values as a tuple,
+        *held getter* from the held values over them (:meth:`sample`), *held
+        picker* from the held values alone (None: a key is not the drive's
+        own, or no struct)."""
         if ch.codec[1] is not None:
             return ch.codec[1]          # perf: built once per mapping (write() clears it)
         entries = self.entries(ch)
@@ -248,8 +251,10 @@ class CanPdos:
             keys.append((e.index, e.sub))
         size = (sum(e.bits for e in entries) + 7) // 8
         keys = tuple(keys)
+        own_only = ok and all(k in OWN_KEYS for k in keys)
         codec = (struct.Struct(fmt) if ok else None, keys, entries, size, _getter(keys),
-                 _held_getter(keys))
+                 _held_getter(keys),
+                 _getter(tuple(OWN_KEYS.index(k) for k in keys)) if own_only else None)
         ch.codec = (entries, codec)
         return codec
 
@@ -258,7 +263,7 @@ class CanPdos:
         drive's own objects as :meth:`~.drive_io.ProcessData.publish_deferred`
         holds them (in the order of OWN_KEYS), over the store's values."""
         codec = ch.codec[1] or self._codec(ch)        # perf: the codec at hand
-        st, keys, entries, _, get, get_held = codec
+        st, keys, entries, _, get, get_held, _ = codec
         live = self.drive._live            # perf: the store's live dict, no property call
         values = get(live) if held is None else get_held(live, held)
         if st is not None:
@@ -310,9 +315,15 @@ class CanPdos:
         if not self.active:
             return frames, values
         for ch in self.sync_rx:
-            if ch.pending is not None:
-                values.update(self.decode(ch, ch.pending))
+            pending = ch.pending
+            if pending is not None:
                 ch.pending = None
+                st, keys = (ch.codec[1] or self._codec(ch))[:2]
+                if st is not None:
+                    # perf: decode() inline: the pairs go into values, no dict between
+                    values.update(zip(keys, st.unpack_from(pending)))
+                else:
+                    values.update(self.decode(ch, pending))
         for ch in self.sync_tx:
             if ch.trans == 0:
                 data = self.sample(ch, held)
@@ -322,7 +333,14 @@ class CanPdos:
             ch.syncs += 1
             if ch.syncs >= ch.trans:
                 ch.syncs = 0
-                data = self.sample(ch, held)
+                codec = ch.codec[1] or self._codec(ch)
+                pick = codec[6]
+                if pick is not None and held is not None:
+                    # perf: sample() inline for a map of the drive's own
+                    # objects: packed straight from the held values
+                    data = codec[0].pack(*pick(held))
+                else:
+                    data = self.sample(ch, held)
                 ch.sent, ch.sent_at = data, t           # perf: _sent inline
                 frames.append((ch.cob_id & 0x7FF, data))
         return frames, values

@@ -409,8 +409,9 @@ class CanopenDrive:
                 if clock == "sync":
                     t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
                     # perf: the objects at the SYNC held for its TPDOs, not
-                    # written: exchange() below writes the cycle's
-                    drive.advance(t, hold=True)
+                    # written: exchange() below writes the cycle's (the
+                    # lock is held: the drive's _locked forms)
+                    drive.hold_locked(t)
                 elif clock == "wall":
                     self._catch_up()
                 t = drive.now
@@ -418,7 +419,7 @@ class CanopenDrive:
                 if values or clock == "sync":
                     if (0x6060, 0) in values:
                         values = self._rx_values(values)
-                    drive.exchange(t, values, True)     # decoded by the RPDOs' maps
+                    drive.exchange_locked(t, values, True)   # decoded by the RPDOs' maps
                 if pdos.event_tx:                  # perf: no event-driven TPDO, no search
                     frames += pdos.events(t)
                 if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from .axis import Axis
+from .drive_csp import CspCycle
 from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS,
                        ProcessData)
 from .drive_service import Service, TouchProbe, cite
@@ -85,7 +86,7 @@ class DriveEvent:
         return f"t={self.t_us / 1e6:.6f}s [{self.source}] {self.text} ({self.section})"
 
 
-class Drive(Service, ProcessData, Timeline):
+class Drive(Service, CspCycle, ProcessData, Timeline):
     """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``).
 
     *plant*: its switches (none by default), a :class:`DrivePlant`, a dict
@@ -130,6 +131,8 @@ class Drive(Service, ProcessData, Timeline):
         self._motion_i32 = all(
             e is not None and e.dtype == "I32" and (e.low, e.high) == (-2**31, 2**31 - 1)
             for e in (self.od.find(*k) for k in MOTION_KEYS))
+        # perf: the model has all its own objects and the motion group is I32
+        self._plain_motion = self._motion_i32 and len(self._own) == len(OUTPUTS)
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write
@@ -445,10 +448,13 @@ class Drive(Service, ProcessData, Timeline):
         these (:meth:`flush`) where it takes the general path.  Written at
         once when the model lacks one of its own objects or a value does
         not fit its object (publish's other path)."""
+        self._hold(*self._outputs())
+
+    def _hold(self, motion: tuple[int, ...], state: tuple[int, ...]) -> None:
+        """Hold *motion* and *state* (:meth:`_outputs`) as :meth:`publish_deferred` does."""
         # perf: the SYNC's two publishes (at the SYNC, after the cycle's
         # set-points) write the store once; a group equal to the one written
         # last was checked when written
-        motion, state = self._outputs()
         last_motion, last_state = self._published
         store = self.store
         if len(self._own) == len(OUTPUTS) \

@@ -45,7 +45,7 @@ from typing import Any, Optional
 
 import can
 import canopen
-from canopen.network import MessageListener
+from canopen.network import MessageListener, NodeScanner
 
 from ...errors import PlcConfigError
 
@@ -235,6 +235,23 @@ class LocalNetwork(canopen.Network):
             self._plain = listener
             return True
         return False
+
+    def notify(self, can_id: int, data: bytearray, timestamp: float) -> None:
+        """As canopen's ``Network.notify``: the subscribers of *can_id*, then
+        the node scanner."""
+        callbacks = self.subscribers.get(can_id)
+        if callbacks is not None:
+            for callback in callbacks:
+                callback(can_id, data, timestamp)
+        scanner = self.scanner
+        if scanner.__class__ is NodeScanner:
+            # perf: NodeScanner.on_message_received written out (17 frames
+            # per CSP cycle of eight drives)
+            node_id = can_id & 0x7F
+            if node_id and node_id not in scanner.nodes and (can_id & 0x780) in scanner.SERVICES:
+                scanner.nodes.append(node_id)
+        else:
+            scanner.on_message_received(can_id)
 
     def send_message(self, can_id: int, data: bytes, remote: bool = False) -> None:
         """As canopen's, without its send lock: delivery runs receivers, and a

@@ -48,7 +48,7 @@ from .drive_io import OWN_KEYS
 from .od import SdoAbort
 from .pdo import MapEntry, MapLayout, PdoConfig, pack, unpack
 
-__all__ = ["Channel", "CanPdos", "NOT_VALID", "NO_RTR", "Frame"]
+__all__ = ["Channel", "CanPdos", "NOT_VALID", "NO_RTR", "Frame", "SYNCED"]
 
 NOT_VALID = 1 << 31          # CiA 301 §7.5.2.35 Table 56: bit 31 valid (0) / not valid (1)
 NO_RTR = 1 << 30             # bit 30: RTR allowed (0) / not allowed (1)
@@ -58,7 +58,8 @@ RESTRICTED = ((0x000, 0x000), (0x001, 0x07F), (0x101, 0x180), (0x581, 0x5FF),
               (0x601, 0x67F), (0x6E0, 0x6FF), (0x701, 0x77F), (0x780, 0x7FF))
 
 Frame = tuple[int, bytes]    # (CAN-ID, data)
-_SYNCED = range(0, 241)
+#: The synchronous transmission types (CiA 301 §7.5.2.35 Table 57).
+SYNCED = range(0, 241)
 _COM_BITS = {0: 8, 1: 32, 2: 8, 3: 16, 5: 16}   # CiA 301 §7.5.2.35/37 (sub 4 reserved)
 _FMT = {(8, False): "B", (8, True): "b", (16, False): "H", (16, True): "h",
         (32, False): "I", (32, True): "i"}
@@ -173,7 +174,7 @@ class CanPdos:
         if sub == 1:
             return self._write_cob_id(ch, value, where)
         if sub == 2:
-            if not (value in _SYNCED or value in (254, 255)):
+            if not (value in SYNCED or value in (254, 255)):
                 why = ("needs remote frames (RTR), which the drive does not answer"
                        if value in (252, 253) else "is reserved")
                 raise SdoAbort(0x06090030, f"{where}: transmission type {value} {why} "
@@ -216,8 +217,8 @@ class CanPdos:
     def _index(self) -> None:
         valid = [c for c in self.channels if c.valid]
         self.rx_by_id = {c.can_id: c for c in valid if not c.tx}
-        self.sync_rx = tuple(c for c in valid if not c.tx and c.trans in _SYNCED)
-        self.sync_tx = tuple(c for c in valid if c.tx and c.trans in _SYNCED)
+        self.sync_rx = tuple(c for c in valid if not c.tx and c.trans in SYNCED)
+        self.sync_tx = tuple(c for c in valid if c.tx and c.trans in SYNCED)
         self.event_tx = tuple(c for c in valid if c.tx and c.trans >= 254)
 
     def entries(self, ch: Channel) -> tuple[MapEntry, ...]:
@@ -300,7 +301,7 @@ class CanPdos:
                        f"{ch.name} of {len(data)} bytes not processed: its mapping needs "
                        f"{size}")
             return None
-        if ch.trans in _SYNCED:
+        if ch.trans in SYNCED:
             ch.pending = bytes(data)
             return None
         return self.decode(ch, data)

@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from ..motion import US
+from .axis import LinLeg
 from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, _B8, _B10, _B12, _B13,
                        _ESM_OP, _HOOK_INDEXES, _K60B8, _PLAIN_PLANT)
 from .modes import CyclicPosition
@@ -173,7 +174,9 @@ class CspCycle:
         store = self.store
         fit = known or self._fit       # perf: unpacked at the object's width: it fits
         for key, v in changed:
-            if fit:
+            if fit and not store._pending:
+                live[key] = v         # perf: set_known with nothing pending, inline
+            elif fit:
                 store.set_known(key, v)
             else:
                 store.set(key[0], key[1], v)
@@ -186,17 +189,30 @@ class CspCycle:
         if target.__class__ is not int:
             target = self.param(0x607A)
         csp.limit_stop = False
-        ax.linear(t, t + (period if period > 1 else 1), target, v_max, mech)
-        csp.demand = target
-        # publish(): CyclicPosition.bits (no limit stop, no following error
-        # beyond 6065h); the line, if any, starts at t, so the count there is
-        # still mech; moving(t) and velocity(t) of that line written out
-        line = ax._line
-        if line is None:
+        # Axis.linear(t, t1, target, v_max, mech), then publish():
+        # CyclicPosition.bits (no limit stop, no following error beyond
+        # 6065h); the line, if any, starts at t, so the count there is still
+        # mech; moving(t) and velocity(t) of that line written out
+        t1 = t + (period if period > 1 else 1)
+        x1 = target - ax.shift
+        cap = v_max * (t1 - t) // US
+        if x1 > mech + cap:
+            x1 = mech + cap
+        elif x1 < mech - cap:
+            x1 = mech - cap
+        if x1 == mech:
+            ax.linear(t, t1, target, v_max, mech)      # at rest: no line
             bits, vel = _B12 | _B10, 0
         else:
-            num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
+            # perf: Axis.linear's line (its _set(x0, [line])) written out
+            ax._dir = 1 if x1 > mech else -1
+            ax._rest = ax._count = x1
+            ax._line = line = LinLeg(t, t1, mech, x1)
+            ax.legs = [line]
+            ax.version += 1
+            num, den = (x1 - mech) * US, t1 - t
             bits, vel = _B12, num // den if num >= 0 else -(-num // den)
+        csp.demand = target
         sm._mode_bits = bits     # perf: set_mode_bits of bits that are mode bits (8, 10-15)
         if self.probe.function or live.get(_K60B8):
             self._probe_update(t, mech)            # touch probe armed (drive_service.py)
@@ -214,7 +230,12 @@ class CspCycle:
                 group = self._motion_out
                 (group[_K6062], group[_K6064], group[_K606C], group[_K60F4], group[_K6063],
                  group[_K606B]) = motion
-                self.store.set_status_group(group)
+                if store._pending:
+                    store.set_status_group(group)
+                else:
+                    # perf: set_status_group inline: the caller holds the
+                    # store's lock (cycle, exchange, exchange_locked)
+                    live.update(group)
                 self._out.update(group)
                 self._published = (motion, last_state)
         else:

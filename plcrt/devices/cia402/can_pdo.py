@@ -319,10 +319,11 @@ class CanPdos:
             pending = ch.pending
             if pending is not None:
                 ch.pending = None
-                st, keys = (ch.codec[1] or self._codec(ch))[:2]
+                codec = ch.codec[1] or self._codec(ch)
+                st = codec[0]
                 if st is not None:
                     # perf: decode() inline: the pairs go into values, no dict between
-                    values.update(zip(keys, st.unpack_from(pending)))
+                    values.update(zip(codec[1], st.unpack_from(pending)))
                 else:
                     values.update(self.decode(ch, pending))
         for ch in self.sync_tx:

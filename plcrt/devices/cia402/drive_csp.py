@@ -57,6 +57,7 @@ class CspCycle:
     _live: dict[tuple[int, int], Any]
     deferred: Optional[tuple[int, ...]]
     _published: tuple
+    _held_state: Optional[tuple[int, ...]]
     _plain_motion: bool
     _batch: bool
     _qs_wait: bool
@@ -89,8 +90,15 @@ class CspCycle:
                     self._probe_update(t, mech)            # touch probe armed (drive_service.py)
                 inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
                     and plant.home_switch is None else plant.inputs(mech)
-                self._hold((csp.demand, pos, 0, csp.following_error, pos, 0),
-                           (sm.statusword, 8, sm.error_code, sm.error_register, inputs))
+                motion = (csp.demand, pos, 0, csp.following_error, pos, 0)
+                state = (sm.statusword, 8, sm.error_code, sm.error_register, inputs)
+                if (self._plain_motion and I32_LOW <= min(motion) and max(motion) <= I32_HIGH
+                        and (state == self._held_state or state == self._published[1])):
+                    # perf: _hold's case of a state group found in range before
+                    self._held_state = state
+                    self.deferred = motion + state
+                else:
+                    self._hold(motion, state)
                 return
         if t >= self.now and not self._batch and self._eventless():
             self.now = t              # perf: what _advance does when no event can come
@@ -158,8 +166,7 @@ class CspCycle:
                     changed.append(kv)
         else:
             changed = []
-            for kv in values.items():                       # type: ignore[union-attr]
-                key, v = kv
+            for key, v in values.items():                   # type: ignore[union-attr]
                 if key == CW:
                     if v != self.controlword:
                         return False
@@ -168,7 +175,7 @@ class CspCycle:
                 if not cur == v:
                     if cur is MISSING or key[0] in _HOOK_INDEXES or key in _CSP_READS:
                         return False
-                    changed.append(kv)
+                    changed.append((key, v))
         # from here on as _step: the time, then the objects (no hook acts on them)
         self.now = t
         store = self.store

@@ -8,8 +8,8 @@ received objects, the mode's cycle, publish -- for that case), and the two
 steps of a CANopen SYNC for a caller that holds the store's lock
 (:meth:`CspCycle.hold_locked`: the objects at the SYNC, held for its TPDOs;
 the cycle itself is :meth:`~.drive_io.ProcessData.exchange_locked`).  Each
-shortcut gives the values, log and store the general path gives (the tests of
-``tests/devices/cia402/`` hold both paths to the same trajectories).
+shortcut gives the values, log and store the general path gives
+(``tests/devices/cia402/test_bus_cycle.py`` runs both on the same sessions).
 
 What it is not: the general cycle (:mod:`.drive`, :mod:`.drive_time`,
 :mod:`.drive_io`), which every other case takes.  It is a base class of

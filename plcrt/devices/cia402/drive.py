@@ -14,14 +14,16 @@ exact µs, as for the EM253, and the cost does not depend on the speed.
 :meth:`Drive.cycle` is one bus cycle: advance, apply the RxPDO image, run
 the cycle, return the TxPDO image.
 
-The drive is one class in four modules: this one (construction, the
+The drive is one class in five modules: this one (construction, the
 master's SDO side, the write hook, mode selection, the power and EtherCAT
 state machines, the stages of a bus cycle), :mod:`.drive_time` (the time
 line: events in exact µs, :class:`~.drive_time.Timeline`),
 :mod:`.drive_io` (process data in and out, the drive's own objects,
-:class:`~.drive_io.ProcessData`) and :mod:`.drive_service` (the test
-surface: injected faults, the power cycle, digital inputs, P18 display
-values, the touch probe, :class:`~.drive_service.Service`).
+:class:`~.drive_io.ProcessData`), :mod:`.drive_csp` (the steady CSP cycle
+and a SYNC's hold written out, :class:`~.drive_csp.CspCycle`) and
+:mod:`.drive_service` (the test surface: injected faults, the power cycle,
+digital inputs, P18 display values, the touch probe,
+:class:`~.drive_service.Service`).
 
 Every refusal and diagnostic goes to :attr:`Drive.log` with its time and the
 manual section.

@@ -48,7 +48,7 @@ from .drive_io import OWN_KEYS
 from .od import SdoAbort
 from .pdo import MapEntry, MapLayout, PdoConfig, pack, unpack
 
-__all__ = ["Channel", "CanPdos", "NOT_VALID", "NO_RTR", "Frame"]
+__all__ = ["Channel", "CanPdos", "NOT_VALID", "NO_RTR", "Frame", "SYNCED"]
 
 NOT_VALID = 1 << 31          # CiA 301 §7.5.2.35 Table 56: bit 31 valid (0) / not valid (1)
 NO_RTR = 1 << 30             # bit 30: RTR allowed (0) / not allowed (1)
@@ -58,7 +58,8 @@ RESTRICTED = ((0x000, 0x000), (0x001, 0x07F), (0x101, 0x180), (0x581, 0x5FF),
               (0x601, 0x67F), (0x6E0, 0x6FF), (0x701, 0x77F), (0x780, 0x7FF))
 
 Frame = tuple[int, bytes]    # (CAN-ID, data)
-_SYNCED = range(0, 241)
+#: The synchronous transmission types (CiA 301 §7.5.2.35 Table 57).
+SYNCED = range(0, 241)
 _COM_BITS = {0: 8, 1: 32, 2: 8, 3: 16, 5: 16}   # CiA 301 §7.5.2.35/37 (sub 4 reserved)
 _FMT = {(8, False): "B", (8, True): "b", (16, False): "H", (16, True): "h",
         (32, False): "I", (32, True): "i"}
@@ -173,7 +174,7 @@ class CanPdos:
         if sub == 1:
             return self._write_cob_id(ch, value, where)
         if sub == 2:
-            if not (value in _SYNCED or value in (254, 255)):
+            if not (value in SYNCED or value in (254, 255)):
                 why = ("needs remote frames (RTR), which the drive does not answer"
                        if value in (252, 253) else "is reserved")
                 raise SdoAbort(0x06090030, f"{where}: transmission type {value} {why} "
@@ -216,8 +217,8 @@ class CanPdos:
     def _index(self) -> None:
         valid = [c for c in self.channels if c.valid]
         self.rx_by_id = {c.can_id: c for c in valid if not c.tx}
-        self.sync_rx = tuple(c for c in valid if not c.tx and c.trans in _SYNCED)
-        self.sync_tx = tuple(c for c in valid if c.tx and c.trans in _SYNCED)
+        self.sync_rx = tuple(c for c in valid if not c.tx and c.trans in SYNCED)
+        self.sync_tx = tuple(c for c in valid if c.tx and c.trans in SYNCED)
         self.event_tx = tuple(c for c in valid if c.tx and c.trans >= 254)
 
     def entries(self, ch: Channel) -> tuple[MapEntry, ...]:
@@ -226,9 +227,12 @@ class CanPdos:
 
     # ---------------------------------------------------------------- codecs
     def _codec(self, ch: Channel) -> tuple:
-        """(struct or None, keys, entries, size, getter) for the current map
-        (perf: built once per mapping); *getter* takes the values of *keys*
-        from the store's live values as a tuple."""
+        """(struct or None, keys, entries, size, getter, held getter, held
+        picker) for the current map (perf: built once per mapping); *getter*
+        takes the values of *keys* from the store's live values as a tuple,
+        *held getter* from the held values over them (:meth:`sample`), *held
+        picker* from the held values alone (None: a key is not the drive's
+        own, or no struct)."""
         if ch.codec[1] is not None:
             return ch.codec[1]          # perf: built once per mapping (write() clears it)
         entries = self.entries(ch)
@@ -248,8 +252,10 @@ class CanPdos:
             keys.append((e.index, e.sub))
         size = (sum(e.bits for e in entries) + 7) // 8
         keys = tuple(keys)
+        own_only = ok and all(k in OWN_KEYS for k in keys)
         codec = (struct.Struct(fmt) if ok else None, keys, entries, size, _getter(keys),
-                 _held_getter(keys))
+                 _held_getter(keys),
+                 _getter(tuple(OWN_KEYS.index(k) for k in keys)) if own_only else None)
         ch.codec = (entries, codec)
         return codec
 
@@ -258,7 +264,7 @@ class CanPdos:
         drive's own objects as :meth:`~.drive_io.ProcessData.publish_deferred`
         holds them (in the order of OWN_KEYS), over the store's values."""
         codec = ch.codec[1] or self._codec(ch)        # perf: the codec at hand
-        st, keys, entries, _, get, get_held = codec
+        st, keys, entries, _, get, get_held, _ = codec
         live = self.drive._live            # perf: the store's live dict, no property call
         values = get(live) if held is None else get_held(live, held)
         if st is not None:
@@ -295,7 +301,7 @@ class CanPdos:
                        f"{ch.name} of {len(data)} bytes not processed: its mapping needs "
                        f"{size}")
             return None
-        if ch.trans in _SYNCED:
+        if ch.trans in SYNCED:
             ch.pending = bytes(data)
             return None
         return self.decode(ch, data)
@@ -310,9 +316,16 @@ class CanPdos:
         if not self.active:
             return frames, values
         for ch in self.sync_rx:
-            if ch.pending is not None:
-                values.update(self.decode(ch, ch.pending))
+            pending = ch.pending
+            if pending is not None:
                 ch.pending = None
+                codec = ch.codec[1] or self._codec(ch)
+                st = codec[0]
+                if st is not None:
+                    # perf: decode() inline: the pairs go into values, no dict between
+                    values.update(zip(codec[1], st.unpack_from(pending)))
+                else:
+                    values.update(self.decode(ch, pending))
         for ch in self.sync_tx:
             if ch.trans == 0:
                 data = self.sample(ch, held)
@@ -322,7 +335,14 @@ class CanPdos:
             ch.syncs += 1
             if ch.syncs >= ch.trans:
                 ch.syncs = 0
-                data = self.sample(ch, held)
+                codec = ch.codec[1] or self._codec(ch)
+                pick = codec[6]
+                if pick is not None and held is not None:
+                    # perf: sample() inline for a map of the drive's own
+                    # objects: packed straight from the held values
+                    data = codec[0].pack(*pick(held))
+                else:
+                    data = self.sample(ch, held)
                 ch.sent, ch.sent_at = data, t           # perf: _sent inline
                 frames.append((ch.cob_id & 0x7FF, data))
         return frames, values

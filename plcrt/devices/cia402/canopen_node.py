@@ -60,7 +60,7 @@ from canopen.objectdictionary import ODVariable
 
 from ...engine.values import Duration, duration_us, shown_value, step_count
 from ...errors import PlcConfigError
-from .can_pdo import CanPdos, Channel
+from .can_pdo import SYNCED, CanPdos, Channel
 from .can_view import SYNC_ID, can_view, pdo_slots, view_channels
 from .canopen_od import object_dictionary
 from .drive import Drive
@@ -409,8 +409,9 @@ class CanopenDrive:
                 if clock == "sync":
                     t = drive.now + (self._cycle_us or self.period_us)   # perf: _sync_period_us
                     # perf: the objects at the SYNC held for its TPDOs, not
-                    # written: exchange() below writes the cycle's
-                    drive.advance(t, hold=True)
+                    # written: exchange() below writes the cycle's (the
+                    # lock is held: the drive's _locked forms)
+                    drive.hold_locked(t)
                 elif clock == "wall":
                     self._catch_up()
                 t = drive.now
@@ -418,7 +419,7 @@ class CanopenDrive:
                 if values or clock == "sync":
                     if (0x6060, 0) in values:
                         values = self._rx_values(values)
-                    drive.exchange(t, values, True)     # decoded by the RPDOs' maps
+                    drive.exchange_locked(t, values, True)   # decoded by the RPDOs' maps
                 if pdos.event_tx:                  # perf: no event-driven TPDO, no search
                     frames += pdos.events(t)
                 if drive.sm.error_code != self._emcy_code:   # perf: _check_emcy's test
@@ -443,14 +444,20 @@ class CanopenDrive:
     def _on_rpdo(self, can_id: int, data: bytes, timestamp: float) -> None:
         """An RPDO: buffered for the next SYNC (synchronous types) or written
         to the drive at once, 6040h last (event-driven types)."""
-        ch: Optional[Channel] = self.pdos.rx_by_id.get(can_id)
+        pdos = self.pdos
+        ch: Optional[Channel] = pdos.rx_by_id.get(can_id)
         if ch is None:
             return
         try:
             with self._lock:
                 if self.clock == "wall":
                     self._catch_up()
-                values = self.pdos.receive(ch, bytes(data), self.drive.now, self._note)
+                codec = ch.codec[1]
+                if (pdos.active and codec is not None and ch.trans in SYNCED
+                        and len(data) >= codec[3]):
+                    ch.pending = bytes(data)     # perf: receive() of a synchronous RPDO
+                    return
+                values = pdos.receive(ch, bytes(data), self.drive.now, self._note)
                 if values is None:
                     return
                 values = self._rx_values(values)

@@ -14,14 +14,16 @@ exact µs, as for the EM253, and the cost does not depend on the speed.
 :meth:`Drive.cycle` is one bus cycle: advance, apply the RxPDO image, run
 the cycle, return the TxPDO image.
 
-The drive is one class in four modules: this one (construction, the
+The drive is one class in five modules: this one (construction, the
 master's SDO side, the write hook, mode selection, the power and EtherCAT
 state machines, the stages of a bus cycle), :mod:`.drive_time` (the time
 line: events in exact µs, :class:`~.drive_time.Timeline`),
 :mod:`.drive_io` (process data in and out, the drive's own objects,
-:class:`~.drive_io.ProcessData`) and :mod:`.drive_service` (the test
-surface: injected faults, the power cycle, digital inputs, P18 display
-values, the touch probe, :class:`~.drive_service.Service`).
+:class:`~.drive_io.ProcessData`), :mod:`.drive_csp` (the steady CSP cycle
+and a SYNC's hold written out, :class:`~.drive_csp.CspCycle`) and
+:mod:`.drive_service` (the test surface: injected faults, the power cycle,
+digital inputs, P18 display values, the touch probe,
+:class:`~.drive_service.Service`).
 
 Every refusal and diagnostic goes to :attr:`Drive.log` with its time and the
 manual section.
@@ -39,6 +41,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from .axis import Axis
+from .drive_csp import CspCycle
 from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, OUTPUTS, STATE_KEYS,
                        ProcessData)
 from .drive_service import Service, TouchProbe, cite
@@ -85,7 +88,7 @@ class DriveEvent:
         return f"t={self.t_us / 1e6:.6f}s [{self.source}] {self.text} ({self.section})"
 
 
-class Drive(Service, ProcessData, Timeline):
+class Drive(Service, CspCycle, ProcessData, Timeline):
     """One simulated drive of *model* (``hcfa-am0520b``, ``kinco-servo``).
 
     *plant*: its switches (none by default), a :class:`DrivePlant`, a dict
@@ -130,6 +133,8 @@ class Drive(Service, ProcessData, Timeline):
         self._motion_i32 = all(
             e is not None and e.dtype == "I32" and (e.low, e.high) == (-2**31, 2**31 - 1)
             for e in (self.od.find(*k) for k in MOTION_KEYS))
+        # perf: the model has all its own objects and the motion group is I32
+        self._plain_motion = self._motion_i32 and len(self._own) == len(OUTPUTS)
         self._motion_out = dict.fromkeys(MOTION_KEYS, 0)   # perf: refilled by publish
         self._state_out = dict.fromkeys(STATE_KEYS, 0)
         self._hook = self._on_write
@@ -445,10 +450,13 @@ class Drive(Service, ProcessData, Timeline):
         these (:meth:`flush`) where it takes the general path.  Written at
         once when the model lacks one of its own objects or a value does
         not fit its object (publish's other path)."""
+        self._hold(*self._outputs())
+
+    def _hold(self, motion: tuple[int, ...], state: tuple[int, ...]) -> None:
+        """Hold *motion* and *state* (:meth:`_outputs`) as :meth:`publish_deferred` does."""
         # perf: the SYNC's two publishes (at the SYNC, after the cycle's
         # set-points) write the store once; a group equal to the one written
         # last was checked when written
-        motion, state = self._outputs()
         last_motion, last_state = self._published
         store = self.store
         if len(self._own) == len(OUTPUTS) \

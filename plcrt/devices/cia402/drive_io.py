@@ -5,12 +5,12 @@ exchanges process data with a master in each bus cycle: :meth:`cycle` (an
 RxPDO image in, the TxPDO image out, through struct codecs built once per
 mapping), :meth:`exchange` (the same by object, the PLC coupler's path),
 the received objects applied in OP (:meth:`_apply_rx`, :meth:`_apply_values`),
-the steady CSP cycle written out (:meth:`_csp_fast`), and the drive's own
-objects written back to the store (:meth:`publish`).  The objects' keys and
+and the drive's own objects written back to the store (:meth:`publish`).  The objects' keys and
 the constants the drive shares with it are defined here.
 
 What it is not: the cycle's stages (:meth:`Drive._step`: advance, the held
-controlword, the mode's cycle) or the mapping rules (:mod:`.pdo`).  It is a
+controlword, the mode's cycle), the steady CSP cycle written out
+(:mod:`.drive_csp`) or the mapping rules (:mod:`.pdo`).  It is a
 base class of :class:`~.drive.Drive` and works on a drive's attributes.
 """
 
@@ -54,10 +54,6 @@ CW = key(0x6040, 0)
 OE = State.OPERATION_ENABLED
 _ESM_OP = EsmState.OP
 MISSING = object()
-#: Objects the CSP cycle reads besides 607Ah (HCFA §7.5.1): a received one
-#: that changes takes the general cycle.
-_CSP_READS = frozenset({(0x6065, 0), (0x6066, 0), (0x6080, 0), (0x1C32, 2)})
-_K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K60B8 = key(0x60B8, 0)       # touch probe function
 _B10, _B12 = 0x400, 0x1000     # 6041h: target reached, set-point followed (HCFA §7.5.1)
 I32_LOW, I32_HIGH = -0x80000000, 0x7FFFFFFF    # the range of an I32 object
@@ -142,138 +138,26 @@ class ProcessData:
         After :meth:`~.drive.Drive.publish_deferred` (a SYNC), the values it
         holds are written first unless the fast CSP cycle writes its own."""
         with self.store.lock:
-            self._fit = decoded
-            if self.deferred is not None:
-                # perf: the values held at the SYNC stay unwritten when the
-                # fast cycle writes its own and reads none of them
-                if values.keys().isdisjoint(self._own):
-                    if self._csp_fast(t_us, None, values):
-                        self.deferred = None
-                        return
-                    self.flush()
-                    self._step(t_us, None, values)
+            self.exchange_locked(t_us, values, decoded)
+
+    def exchange_locked(self, t_us: int, values: dict[tuple[int, int], int],
+                        decoded: bool = False) -> None:
+        """:meth:`exchange` for a caller that holds the store's lock (a
+        CANopen port at a SYNC; perf: no second acquisition of the lock)."""
+        self._fit = decoded
+        if self.deferred is not None:
+            # perf: the values held at the SYNC stay unwritten when the
+            # fast cycle writes its own and reads none of them
+            if values.keys().isdisjoint(self._own):
+                if self._csp_fast(t_us, None, values):
+                    self.deferred = None
                     return
                 self.flush()
-            if not self._csp_fast(t_us, None, values):
-                self._step(t_us, None, values)   # the same cycle as cycle()
-
-    def _csp_fast(self, t: int, rx: Optional[bytes],
-                  values: Optional[dict[tuple[int, int], int]]) -> bool:
-        """The bus cycle of a drive following CSP set-points, written out:
-        what :meth:`_step` does (advance, received objects, the mode's
-        cycle, publish) when no event can come, no object the drive acts on
-        changes (6040h held; no 6060h, 605Ah, 6084h, 6085h, 6065h, 6066h,
-        6080h, 1C32h), no switch is configured and the following error lies
-        within 6065h.  Returns False, having done nothing, otherwise."""
-        # perf: the steady CSP cycle in one function: no stage calls, no
-        # Result, no Write, only the values that change written
-        sm = self.sm
-        if (sm.state is not OE or self.mode_number != 8 or self._qs_wait or t < self.now
-                or self.esm.state is not _ESM_OP):
-            return False
-        hooked = self.store.hooked
-        if hooked is not self._hooked_ok:
-            if hooked != self._only_hook:
-                return False
-            self._hooked_ok = hooked        # perf: the same subscriptions, seen before
-        plant = self.plant
-        if plant.pos_limit is not None or plant.neg_limit is not None or self.stops is not None:
-            return False
-        ax = self.axis
-        if ax._line is None and ax.legs:
-            return False
-        csp = self.engines[8]
-        if csp.__class__ is not CyclicPosition or csp._last is None:
-            return False
-        live = self._live
-        window, v_max = live.get(_K6065), live.get(_K6080)
-        if window.__class__ is not int or v_max.__class__ is not int:
-            return False
-        held = self.deferred
-        if held is None:
-            mech = ax.mechanical(t)
-            pos = mech + ax.shift
-        else:
-            pos = held[1]               # perf: 6064h at t, as publish_deferred found it
-            mech = pos - ax.shift
-        fe = csp.demand - pos
-        if fe > window or -fe > window:
-            return False
-        known = rx is not None
-        if known:
-            rx_map = self.pdo.active_rx
-            codec = self._csp_codec
-            if codec[0] is not rx_map:
-                codec = self._csp_codec = (rx_map, self._csp_rx_codec(rx_map))
-            codec = codec[1]
-            if codec is None or len(rx) != codec[0]:
-                return False
-            _, objects, keys, cw_st, at = codec
-            if cw_st is not None and cw_st.unpack_from(rx, at)[0] != self.controlword:
-                return False
-            changed = []
-            for kv in zip(keys, objects.unpack(rx)):
-                if live[kv[0]] != kv[1]:
-                    changed.append(kv)
-        else:
-            changed = []
-            for kv in values.items():                       # type: ignore[union-attr]
-                key, v = kv
-                if key == CW:
-                    if v != self.controlword:
-                        return False
-                    continue
-                cur = live.get(key, MISSING)
-                if not cur == v:
-                    if cur is MISSING or key[0] in _HOOK_INDEXES or key in _CSP_READS:
-                        return False
-                    changed.append(kv)
-        # from here on as _step: the time, then the objects (no hook acts on them)
-        self.now = t
-        store = self.store
-        fit = known or self._fit       # perf: unpacked at the object's width: it fits
-        for key, v in changed:
-            if fit:
-                store.set_known(key, v)
-            else:
-                store.set(key[0], key[1], v)
-        # CyclicPosition.cycle with no switch and the following error within 6065h
-        csp.following_error = fe
-        csp._fe_since = None
-        period = t - csp._last
-        csp._last = t
-        target = live.get(_K607A)
-        if target.__class__ is not int:
-            target = self.param(0x607A)
-        csp.limit_stop = False
-        ax.linear(t, t + (period if period > 1 else 1), target, v_max, mech)
-        csp.demand = target
-        # publish(): CyclicPosition.bits (no limit stop, no following error
-        # beyond 6065h); the line, if any, starts at t, so the count there is
-        # still mech; moving(t) and velocity(t) of that line written out
-        line = ax._line
-        if line is None:
-            bits, vel = _B12 | _B10, 0
-        else:
-            num, den = (line.x1 - line.x0) * US, line.t1 - line.t0
-            bits, vel = _B12, num // den if num >= 0 else -(-num // den)
-        sm._mode_bits = bits     # perf: set_mode_bits of bits that are mode bits (8, 10-15)
-        if self.probe.function or live.get(_K60B8):
-            self._probe_update(t, mech)            # touch probe armed (drive_service.py)
-        # a plant without switches gives 60FDh = 0 wherever the axis is
-        inputs = 0 if _PLAIN_PLANT and plant.__class__ is DrivePlant \
-            and plant.home_switch is None else plant.inputs(mech)
-        self._publish_values((target, pos, vel, fe, pos, vel),
-                             (sm.statusword, 8, sm.error_code, sm.error_register, inputs))
-        return True
-
-    def _csp_rx_codec(self, entries: tuple) -> Optional[tuple]:
-        """:meth:`_rx_fast_codec` for :meth:`_csp_fast`: None when the map
-        holds an object the drive acts on besides 6040h and 607Ah."""
-        codec = self._rx_fast_codec(entries)
-        if codec is None or any(k[0] in _HOOK_INDEXES or k in _CSP_READS for k in codec[2]):
-            return None
-        return codec
+                self._step(t_us, None, values)
+                return
+            self.flush()
+        if not self._csp_fast(t_us, None, values):
+            self._step(t_us, None, values)   # the same cycle as cycle()
 
     def _codec(self, entries: tuple) -> Optional[tuple[struct.Struct, list[tuple[int, int]]]]:
         """A struct for a byte-aligned image (the same bytes as pdo.pack /

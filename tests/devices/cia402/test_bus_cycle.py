@@ -14,6 +14,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from plcrt.devices.cia402.drive import Drive
+from plcrt.devices.cia402.drive_io import OWN_KEYS
 from plcrt.devices.cia402.esm import EsmState
 from plcrt.devices.cia402.modes import CyclicPosition, Mode, ProfilePosition, ProfileVelocity
 from plcrt.devices.cia402.od import SdoAbort
@@ -139,6 +140,53 @@ def test_the_written_out_csp_cycle_gives_what_the_general_cycle_gives(seed, by_o
     taken = counting(fast)
     assert play(fast, steps, by_object) == play(slow, steps, by_object)
     assert sum(taken) > 20 and not all(taken)    # both paths ran
+
+
+def play_sync(d: Drive, steps: list[tuple], held: bool) -> list[tuple]:
+    """*steps* as a CANopen port's SYNCs run them (*held*: the drive's own
+    objects held at the SYNC, then the cycle, with the store's lock held,
+    as canopen_node.py does) or as two plain steps (advance, then the
+    cycle by object); each SYNC's own objects and the drive after it."""
+    trace = []
+    for step in steps:
+        if step[0] != "cycle":
+            play(d, [step], True)
+            continue
+        _, t, target, cw, probe = step
+        cw = enable_words(d) if cw is None else cw
+        t, values = max(t, d.now), {CW: cw, TARGET: target, (0x60B8, 0): probe}
+        with d.store.lock:
+            if held:
+                d.hold_locked(t)
+                at_sync = d.deferred or tuple(d.store.get(*k) for k in OWN_KEYS)
+                d.exchange_locked(t, values, True)
+            else:
+                d.advance(t)
+                at_sync = tuple(d.store.get(*k) for k in OWN_KEYS)
+                d.exchange(t, values)
+        trace += [("sync", at_sync), seen(d)]
+    return trace
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_sync_that_holds_the_objects_gives_what_two_plain_steps_give(seed):
+    """The SYNC path of the CAN port (hold_locked, exchange_locked: the CSP
+    line read at its end, the objects held for the TPDOs) gives the TPDOs'
+    values and the drive that advance() and exchange() give, fault, reset,
+    mode and window changes included."""
+    steps = script(100 + seed, 600)
+    held, plain = in_op(), in_op()
+    general = []
+    publish_deferred = held.publish_deferred
+
+    def spy() -> None:
+        general.append(True)
+        publish_deferred()
+
+    held.publish_deferred = spy                    # type: ignore[method-assign]
+    assert play_sync(held, steps, True) == play_sync(plain, steps, False)
+    syncs = sum(s[0] == "cycle" for s in steps)
+    assert 0 < len(general) < syncs - 100          # the written-out hold ran, and the other
 
 
 @settings(max_examples=25, deadline=None)

@@ -258,6 +258,37 @@ def test_a_frame_reaches_every_other_party_of_its_channel_before_send_returns(re
             net.disconnect()
 
 
+def test_the_in_process_network_dispatches_a_frame_as_canopens_network_does(request):
+    """A subscriber gets the frame's data as a bytearray (python-can's
+    type); the node scanner lists the nodes canopen's own Network.notify
+    lists for the same frames; a network with a listener of its own gets
+    each frame through its listeners, as a can.Message."""
+    name = channel(request)
+    a, b, c = cia402.bus(name), cia402.bus(name), cia402.bus(name)
+    reference = canopen.Network()                  # canopen's dispatch, not connected
+    ids = (0x185, 0x605, 0x000, 0x70A, 0x58B, 0x185, 0x08C, 0x7E5)
+    try:
+        got: list = []
+        b.subscribe(0x185, lambda i, d, t: got.append(d))
+        heard: list = []
+
+        class Own(can.Listener):
+            def on_message_received(self, msg: can.Message) -> None:
+                heard.append(msg)
+
+        c.notifier.add_listener(Own())
+        for can_id in ids:
+            a.send_message(can_id, b"\x05")
+            reference.notify(can_id, bytearray(b"\x05"), 0.0)
+        assert [(d.__class__, bytes(d)) for d in got] == [(bytearray, b"\x05")] * 2
+        assert b.scanner.nodes == reference.scanner.nodes == [5, 10, 11, 12]
+        assert c.scanner.nodes == reference.scanner.nodes
+        assert [(m.arbitration_id, bytes(m.data)) for m in heard] == [(i, b"\x05") for i in ids]
+    finally:
+        for net in (a, b, c):
+            net.disconnect()
+
+
 def test_a_receiver_may_send_from_its_callback_and_a_failing_one_is_logged(request, caplog):
     """No lock is held while receivers run: a callback that answers on its
     own network does not deadlock; an exception in a callback is logged as

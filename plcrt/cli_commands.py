@@ -58,6 +58,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         if line.startswith("CPU: "):
             line += f" (runs as {plc.model.name}; --cpu chooses)"
         print(printable(f"{name}: system block: {line}"), file=sys.stderr)
+    for note in getattr(prog, "project_notes", ()):     # names read from the file: escaped
+        print(printable(f"{name}: note: {note}"), file=sys.stderr)
     return EXIT_OK
 
 

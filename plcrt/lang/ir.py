@@ -116,6 +116,9 @@ class Program:
     #: the system block of the project file it was read from (None for an
     #: export): settings for the CPU, not part of the program's IR
     system: Any = field(default=None, compare=False, repr=False)
+    #: what the project file's reader left out or could not map (one line
+    #: each, names read from the file; ``plcrt check`` prints them)
+    project_notes: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def instruction_count(self) -> int:
         return sum(len(n.insns) for p in self.pous for n in p.networks)

@@ -30,7 +30,8 @@ def load_project(path: str, limit: int) -> tuple[ir.Program, Any, Any]:
     project = read_project_file(path, limit)
     program = parse_program(project.awl, path)
     program = ir.Program(program.pous, program.file, program.source, project.encoding,
-                         project.plant, system=project.system)
+                         project.plant, system=project.system,
+                         project_notes=tuple(project.notes))
     symbols = parse_symbols(project.symbols, path) if project.symbols else None
     data = None
     if project.data.strip():

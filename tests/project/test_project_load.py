@@ -192,6 +192,17 @@ def test_a_protected_block_loads_as_its_interface(tmp_path: Path) -> None:
     assert [n.insns for n in sbr.networks] == [()]
 
 
+def test_check_prints_what_the_reader_left_out(tmp_path: Path, capsys) -> None:
+    """plcrt check lists the reader's notes (here a protected block and a
+    missing system block), so nothing it left out goes unsaid."""
+    path = tmp_path / "p.mwp"
+    path.write_bytes(project_bytes(parse_program(EVERY_CODE, "x.awl"), protected=("SBR0",)))
+    assert main(["check", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert f"{path}: note: SBR0 (" in err and "is protected by a password" in err
+    assert f"{path}: note: the system block was not read" in err
+
+
 @pytest.mark.parametrize("smart", [False, True], ids=["mwp", "smart"])
 def test_a_project_with_a_password_is_refused(smart: bool) -> None:
     program = parse_program(EVERY_CODE, "x.awl")

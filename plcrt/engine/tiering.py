@@ -34,7 +34,7 @@ from typing import Any, Callable
 
 from ..compiler.cache import programs
 
-__all__ = ["Tiering", "START_AFTER_S"]
+__all__ = ["Tiering", "START_AFTER_S", "PLAN_FACTOR"]
 
 #: the least wall time a PLC scans in Python before its native build starts
 #: compiling: a short run (a test, ``plcrt run`` of a few seconds of
@@ -45,6 +45,12 @@ START_AFTER_S = 0.05
 LOAD_FACTOR = 2.0
 #: scans between two looks at the background job (a look is a clock read)
 CHUNK_SCANS = 64
+#: a run whose length is known (``scan(n)``, ``run()``, ``plcrt run``)
+#: starts the compile at once, without waiting for :data:`START_AFTER_S`,
+#: when its first scans say that the rest of it would take at least this
+#: many times that wait in Python: the machine code is then ready well
+#: before the end and runs most of the run
+PLAN_FACTOR = 2.0
 
 _log = logging.getLogger("plcrt")
 #: the Python build -> the job compiling its native twin
@@ -97,13 +103,16 @@ def _at_exit() -> None:
 class _Tier:
     """A tiered PLC's state while it runs its Python build."""
 
-    __slots__ = ("key", "make", "start_after", "busy", "future")
+    __slots__ = ("key", "make", "start_after", "busy", "future", "first", "planned")
 
-    def __init__(self, key: Any, make: Callable[[], Any], start_after: float) -> None:
+    def __init__(self, key: Any, make: Callable[[], Any], start_after: float,
+                 first: int) -> None:
         self.key = key
         self.make = make
         self.start_after = start_after
         self.busy = 0.0                     #: wall seconds scanned in Python
+        self.first = first                  #: the scan count when the tier began
+        self.planned = first                #: the scan count the caller asked to reach
         self.future: Future[Any] | None = _jobs.get(key)   # a fork's parent's job
 
 
@@ -117,13 +126,15 @@ class Tiering:
     def _tier_begin(self, make: Callable[[], Any], load_s: float) -> None:
         """Run the Python build now; ``make()`` compiles the native build."""
         # perf: read at the PLC's load, so a test may set them to 0
-        self._tier = _Tier(self._entry, make, max(START_AFTER_S, LOAD_FACTOR * load_s))
+        self._tier = _Tier(self._entry, make, max(START_AFTER_S, LOAD_FACTOR * load_s),
+                           self.scans)
         self._python_scans = self.scans
 
     def _tiered_scan(self, n: int) -> None:
         """``scan(n)`` of a PLC on its Python build: in chunks, looking at
         the native job between them and switching when it is done."""
         clock = time.perf_counter
+        self._tier_plan(n)
         while n > 0:
             tier = self._tier
             if tier is None:
@@ -145,13 +156,29 @@ class Tiering:
                 return                # may restore a snapshot: scans go back)
             n -= k
 
+    def _tier_plan(self, scans: int) -> None:
+        """The caller will run ``scans`` more scans (``plcrt run`` says its
+        whole run before running it in chunks): see :data:`PLAN_FACTOR`."""
+        tier = self._tier
+        if tier is not None:
+            tier.planned = max(tier.planned, self.scans + scans)
+
     def _tier_poll(self, tier: _Tier) -> None:
         if tier.future is None:
-            if tier.busy >= tier.start_after:
+            if tier.busy >= tier.start_after or self._tier_pays(tier):
                 tier.future = _start(tier.key, tier.make)
             return
         if tier.future.done():
             self._tier_switch(tier.future)
+
+    def _tier_pays(self, tier: _Tier) -> bool:
+        """Whether the planned rest of the run, at the rate of the scans run
+        in Python so far, takes :data:`PLAN_FACTOR` times the wait."""
+        done = self.scans - tier.first
+        if done <= 0 or tier.busy <= 0.0:
+            return False
+        rest = tier.planned - self.scans
+        return tier.busy / done * rest >= PLAN_FACTOR * tier.start_after
 
     def _tier_up(self) -> None:
         """Compile the native build now (or wait for the job under way) and

@@ -25,6 +25,13 @@ SEAL_IN = str(PROGRAMS / "seal_in.awl")
 TIMERS = str(PROGRAMS / "timers.awl")
 
 
+@pytest.fixture(autouse=True)
+def _empty_disk_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test runs as on a machine where no run has left machine code
+    (a program marked on disk is native from its first scan)."""
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path / "plcrt-cache"))
+
+
 def write(tmp_path: Path, name: str, text: str) -> str:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")

@@ -10,7 +10,9 @@ pinned here too.
 
 from __future__ import annotations
 
+import os
 import pickle
+import shutil
 import subprocess
 import sys
 import threading
@@ -36,9 +38,17 @@ TIMERS = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\nTON T37, +10\n
 
 
 @pytest.fixture(autouse=True)
-def _no_native_build_cached():
-    """A native build in the program cache is used at once, without tiers."""
+def _no_native_build_cached(tmp_path, monkeypatch):
+    """A native build in the program cache, or a mark of one on disk, is
+    used at once, without tiers: each test starts with neither."""
     programs.clear()
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def _fresh_disk_cache() -> None:
+    """An empty disk cache for one hypothesis example (the machine code and
+    the marks of the previous example gone)."""
+    shutil.rmtree(os.environ["PLCRT_CACHE_DIR"], ignore_errors=True)
 
 
 def _image(plc: plcrt.Plc) -> tuple:
@@ -53,6 +63,7 @@ def _image(plc: plcrt.Plc) -> tuple:
 def test_the_switch_at_any_scan_gives_the_images_of_both_backends(
         program, inputs, initial, scan_ms, switch) -> None:
     programs.clear()    # else the native build of an earlier example is used at once
+    _fresh_disk_cache()
     plcs = [plcrt.load(program, scan_ms=scan_ms, backend=b)
             for b in ("auto", "python", "native")]
     for plc in plcs:
@@ -114,6 +125,30 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
     assert _image(auto) == _image(ref)
     assert not [t for t in threading.enumerate()
                 if t.name == "plcrt-native-compile" and not t.daemon]
+
+
+def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(monkeypatch) -> None:
+    """A run whose length is known starts the native compile as soon as its
+    first chunk of scans says the rest would take PLAN_FACTOR times the
+    wait in Python; a short one waits (here: never, the wait is 0.5 s)."""
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.5)
+    started: list[int] = []
+    real = tiering._start
+    plcs: list[plcrt.Plc] = []
+
+    def start(key, make):
+        started.append(plcs[-1].scans)
+        return real(key, make)
+    monkeypatch.setattr(tiering, "_start", start)
+    plcs.append(plcrt.load(TIMERS, backend="auto"))
+    plcs[-1].scan(500)           # 500 scans of a few µs: far from 1 s
+    assert started == [] and plcs[-1].backend["name"] == "python"
+    programs.clear()
+    plcs.append(plcrt.load(TIMERS, backend="auto"))
+    plcs[-1].run(seconds=2_000_000 * 0.01)   # two million scans: seconds in Python
+    assert started == [tiering.CHUNK_SCANS]
+    assert plcs[-1].backend["name"] == "native"
+    assert 0 < plcs[-1].backend["python_scans"] < plcs[-1].scans
 
 
 def test_snapshot_fork_and_pickle_across_the_switch() -> None:

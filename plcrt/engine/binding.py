@@ -226,7 +226,8 @@ class Binding:
         """How the program runs: ``name`` (``"python"`` or ``"native"``: the
         build running now), with ``backend="auto"`` ``tiered`` (True) and
         ``python_scans`` (the scans run on the Python build before the
-        native one took over, or so far), and
+        native one took over, or so far; 0 with the native build bound at
+        load, its machine code left on disk by an earlier run), and
         for native, ``pieces`` run as machine code, ``python`` (block,
         network, reason) of the pieces left in Python, ``segments``,
         ``compile_s`` and ``cached`` (machine code from the disk cache)."""

@@ -4,10 +4,14 @@ What it is: :class:`Tiering`, a mixin of :class:`plcrt.engine.runtime.Plc`.
 A PLC loaded with ``backend="auto"`` where the native backend works is
 bound first to the Python build of its program (as fast to load as
 ``backend="python"``).  Once it has spent some wall time scanning (about
-twice its load's compile time, at least :data:`START_AFTER_S`), the native
-build is compiled in a background thread (one job per Python build, shared
-by its forks), and the PLC switches to it at the next scan boundary after
-the job is done.  Both builds bind the same objects under the same names
+twice its load's compile time, at least :data:`START_AFTER_S`), or at once
+when a run of known length would outlast that (:data:`PLAN_FACTOR`), the
+native build is compiled in a background thread (one job per Python build,
+shared by its forks), and the PLC switches to it at the next scan boundary
+after the job is done.  The job leaves the machine code on disk with a
+mark of the program (:mod:`plcrt.compiler.tiermarks`), so that a later load
+of it, in any process, binds the native build at once
+(:mod:`.binding`): no tier at all.  Both builds bind the same objects under the same names
 (the code generator numbers them in one order), so the switch keeps this
 PLC's resolved bindings -- edge memories, L buffers, library blocks -- and
 only executes the native build's code objects in a new namespace over

@@ -127,10 +127,13 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
                 if t.name == "plcrt-native-compile" and not t.daemon]
 
 
-def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(monkeypatch) -> None:
+@pytest.mark.parametrize("how", ["run", "in chunks"])
+def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkeypatch) -> None:
     """A run whose length is known starts the native compile as soon as its
     first chunk of scans says the rest would take PLAN_FACTOR times the
-    wait in Python; a short one waits (here: never, the wait is 0.5 s)."""
+    wait in Python; a short one waits (here: never, the wait is 0.5 s).
+    ``plcrt run`` with a progress line or --max-wall runs in chunks of its
+    own and says the whole length first."""
     monkeypatch.setattr(tiering, "START_AFTER_S", 0.5)
     started: list[int] = []
     real = tiering._start
@@ -145,8 +148,14 @@ def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(monkeypatch
     assert started == [] and plcs[-1].backend["name"] == "python"
     programs.clear()
     plcs.append(plcrt.load(TIMERS, backend="auto"))
-    plcs[-1].run(seconds=2_000_000 * 0.01)   # two million scans: seconds in Python
-    assert started == [tiering.CHUNK_SCANS]
+    if how == "run":
+        plcs[-1].run(seconds=2_000_000 * 0.01)   # two million scans: seconds in Python
+        assert started == [tiering.CHUNK_SCANS]
+    else:
+        from plcrt.term.progress import run_with_progress
+        run_with_progress(plcs[-1], scans=2_000_000, quiet=True, max_wall=3600.0)
+        assert len(started) == 1 and started[0] <= 100     # in its first chunk
+    assert plcs[-1].scans == 2_000_000
     assert plcs[-1].backend["name"] == "native"
     assert 0 < plcs[-1].backend["python_scans"] < plcs[-1].scans
 

@@ -96,5 +96,11 @@ def touch(key: tuple[Any, ...]) -> None:
 
 def _limit_is_zero() -> bool:
     """``PLCRT_NATIVE_CACHE_MB=0``: the disk cache keeps nothing, so a mark
-    left from before means nothing either."""
-    return os.environ.get("PLCRT_NATIVE_CACHE_MB", "").strip() in ("0", "0.0")
+    left from before means nothing either (read as
+    :func:`plcrt.compiler.native.diskcache.limit_bytes` reads it)."""
+    raw = os.environ.get("PLCRT_NATIVE_CACHE_MB", "").strip()
+    try:
+        mb = float(raw) if raw else None
+    except ValueError:
+        return False
+    return mb is not None and 0 <= mb <= 1 << 30 and int(mb * 2**20) == 0

@@ -71,3 +71,11 @@ def test_with_options_is_program_key_with_those_options() -> None:
     base = dict(cpu="CPU 224XP", symbols=None, instrument=False, backend="native")
     assert with_options(program_key(program, **base), backend="python") == \
         program_key(program, **{**base, "backend": "python"})
+
+
+@pytest.mark.parametrize("raw", ["", "0", "0.0", " 0 ", "1e-9", "0.5", "256", "-1", "nan",
+                                 "abc", "1e40"])
+def test_a_mark_is_ignored_exactly_when_the_cache_keeps_nothing(
+        raw: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PLCRT_NATIVE_CACHE_MB", raw)
+    assert tiermarks._limit_is_zero() == (diskcache.limit_bytes() == 0)

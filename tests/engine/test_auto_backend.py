@@ -70,6 +70,31 @@ def test_auto_is_the_default_and_native_where_llvmlite_works(
     assert plcrt.load(PROGRAM).backend == {"name": "python"}
 
 
+def test_a_stale_mark_costs_one_native_compile_and_no_cache_follows_no_mark(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A mark whose machine code is gone (trimmed, another llvmlite): the
+    load compiles the native build before its first scan and keeps it on
+    disk; with PLCRT_NATIVE_CACHE_MB=0 a mark is not followed."""
+    programs.clear()
+    plc = plcrt.load(PROGRAM, backend="auto")
+    plc._tier_up()
+    folder = tmp_path / "cache" / "native"
+    marks = [f for f in folder.iterdir() if b"plcrt tier mark" in f.read_bytes()]
+    assert len(marks) == 1
+    for f in folder.iterdir():
+        if f not in marks:
+            f.unlink()                   # the machine code gone, the mark kept
+    programs.clear()
+    again = plcrt.load(PROGRAM, backend="auto")
+    assert again.backend["name"] == "native" and not again.backend["cached"]
+    assert again.backend["python_scans"] == 0
+    assert len(list(folder.iterdir())) == 2       # the machine code kept again
+    programs.clear()
+    monkeypatch.setenv("PLCRT_NATIVE_CACHE_MB", "0")
+    assert plcrt.load(PROGRAM, backend="auto").backend == {
+        "name": "python", "tiered": True, "python_scans": 0}
+
+
 def test_a_bad_backend_names_the_choices() -> None:
     with pytest.raises(plcrt.PlcConfigError, match="'auto', 'python', 'native'"):
         plcrt.load(PROGRAM, backend="fast")

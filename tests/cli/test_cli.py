@@ -207,6 +207,7 @@ def test_run_verbose_says_when_the_native_build_took_over(
     programs.clear()
     monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
     monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
     monkeypatch.setattr(tiering, "CHUNK_SCANS", 1)
     import threading
     real = tiering._start

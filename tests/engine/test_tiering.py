@@ -112,6 +112,7 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
     scan boundary, and its image still equals the Python run's."""
     monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
     monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
     ref = plcrt.load(TIMERS, backend="python", scan_ms=1)
     auto = plcrt.load(TIMERS, backend="auto", scan_ms=1)
     for plc in (ref, auto):
@@ -131,10 +132,10 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
 def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkeypatch) -> None:
     """A run whose length is known starts the native compile as soon as its
     first chunk of scans says the rest would take PLAN_FACTOR times the
-    wait in Python; a short one waits (here: never, the wait is 0.5 s).
+    wait in Python; a short one waits (here: never, the wait is 0.25 s).
     ``plcrt run`` with a progress line or --max-wall runs in chunks of its
     own and says the whole length first."""
-    monkeypatch.setattr(tiering, "START_AFTER_S", 0.5)
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.25)
     started: list[int] = []
     real = tiering._start
     plcs: list[plcrt.Plc] = []
@@ -144,7 +145,7 @@ def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkey
         return real(key, make)
     monkeypatch.setattr(tiering, "_start", start)
     plcs.append(plcrt.load(TIMERS, backend="auto"))
-    plcs[-1].scan(500)           # 500 scans of a few µs: far from 1 s
+    plcs[-1].scan(500)           # 500 scans of a few µs: far from 0.25 s
     assert started == [] and plcs[-1].backend["name"] == "python"
     programs.clear()
     plcs.append(plcrt.load(TIMERS, backend="auto"))
@@ -158,6 +159,33 @@ def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkey
     assert plcs[-1].scans == 2_000_000
     assert plcs[-1].backend["name"] == "native"
     assert 0 < plcs[-1].backend["python_scans"] < plcs[-1].scans
+
+
+def test_a_final_run_compiles_only_when_the_compile_pays_within_it(monkeypatch) -> None:
+    """``plcrt run`` says its run is the PLC's last (final): there the
+    compile starts only by the plan (a rest that pays for it, here never),
+    not by the wait alone, as it does where the program may go on."""
+    from plcrt.term.progress import run_with_progress
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.001)   # 30 000 scans take longer
+    monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
+    monkeypatch.setattr(tiering, "PLAN_FACTOR", 1e9)       # no rest pays
+    started: list[str] = []
+    real = tiering._start
+
+    def start(key, make):
+        started.append(how)
+        return real(key, make)
+    monkeypatch.setattr(tiering, "_start", start)
+    for how in ("final", "not final"):
+        programs.clear()
+        plc = plcrt.load(TIMERS, backend="auto")
+        if how == "final":
+            run_with_progress(plc, scans=30_000, quiet=True)
+        else:
+            plc.run(scans=30_000)
+        assert plc.scans == 30_000
+    assert started == ["not final"]
 
 
 def test_snapshot_fork_and_pickle_across_the_switch() -> None:
@@ -220,7 +248,7 @@ def test_python_and_native_keep_their_meaning() -> None:
 def test_a_process_with_a_job_under_way_exits(tmp_path) -> None:
     """The worker is a daemon; exit waits for a started job and ends."""
     code = ("import plcrt; from plcrt.engine import tiering\n"
-            "tiering.START_AFTER_S = tiering.LOAD_FACTOR = 0.0\n"
+            "tiering.START_AFTER_S = tiering.LOAD_FACTOR = tiering.LLVM_START_S = 0.0\n"
             f"plc = plcrt.load({TIMERS!r}, backend='auto')\n"
             "plc.scan(200)\nprint('ran', plc.scans)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

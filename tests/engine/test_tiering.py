@@ -132,10 +132,10 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
 def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkeypatch) -> None:
     """A run whose length is known starts the native compile as soon as its
     first chunk of scans says the rest would take PLAN_FACTOR times the
-    wait in Python; a short one waits (here: never, the wait is 0.25 s).
+    wait in Python; a short one waits (here: never, the wait is 0.1 s).
     ``plcrt run`` with a progress line or --max-wall runs in chunks of its
     own and says the whole length first."""
-    monkeypatch.setattr(tiering, "START_AFTER_S", 0.25)
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.1)
     started: list[int] = []
     real = tiering._start
     plcs: list[plcrt.Plc] = []
@@ -145,7 +145,7 @@ def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkey
         return real(key, make)
     monkeypatch.setattr(tiering, "_start", start)
     plcs.append(plcrt.load(TIMERS, backend="auto"))
-    plcs[-1].scan(500)           # 500 scans of a few µs: far from 0.25 s
+    plcs[-1].scan(500)           # 500 scans of a few µs: far from 0.1 s
     assert started == [] and plcs[-1].backend["name"] == "python"
     programs.clear()
     plcs.append(plcrt.load(TIMERS, backend="auto"))

@@ -33,6 +33,8 @@ demo: $(BIN)/.installed
 	$(BIN)/plcrt run programs/seal_in.awl --scans 3 --set I0.0=1 --watch I0.0 --watch Q0.0
 	$(BIN)/plcrt run programs/timers.awl --seconds 2.5 --set I0.0=1 --watch T37 --watch Q0.0
 	$(BIN)/plcrt run programs/subroutine.awl --scans 1 --set AIW0=25600 --watch VW10 --watch Q0.0 --json
+	$(BIN)/plcrt run programs/timers.awl --scans 3000000 --set I0.0=1 --watch Q0.0 --verbose
+	$(BIN)/plcrt run programs/timers.awl --seconds 2.5 --set I0.0=1 --watch T37 --watch Q0.0 --json
 	$(BIN)/plcrt run programs/em253/pos_goto_r.awl --plant programs/em253/plant.toml --seconds 18 --set M2.0=1 --watch VW106 --watch VD108
 	$(BIN)/plcrt run programs/events/pto_count.awl --plant programs/events/pto_count_plant.toml --seconds 1.2 --set M0.0=1 --watch VD200 --watch VW204 --watch VD208
 	$(BIN)/plcrt run programs/pid/pid_loop.awl --plant programs/pid/pid_loop_plant.toml --seconds 60 --set I0.0=1 --watch AIW0 --watch AQW0

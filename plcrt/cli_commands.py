@@ -240,8 +240,10 @@ def backend_line(plc: Plc) -> str:
     info = plc.backend
     if info["name"] != "native":
         return "backend: python" + (" (native not ready yet)" if info.get("tiered") else "")
-    after = (f", after {info['python_scans']} scans in Python"
-             if info.get("python_scans") else "")
+    after = ""
+    if info.get("tiered"):       # backend="auto": Python first, or native at once
+        after = (f", after {info['python_scans']} scans in Python" if info["python_scans"]
+                 else ", from the first scan")
     return (f"backend: native ({info['pieces']} pieces as machine code, "
             f"{len(info['python'])} in Python{after})")
 

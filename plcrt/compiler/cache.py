@@ -211,6 +211,16 @@ def _same(cached: Any, program: Any) -> bool:
                                   == getattr(program, "system", None))
 
 
+def with_options(key: tuple[Any, ...], **options: Any) -> tuple[Any, ...]:
+    """``key`` (of :func:`program_key`) with the fingerprints of ``options``
+    replaced: the key of the same program with other values of those
+    options, without hashing the program again (perf: a load of
+    ``backend="auto"`` looks for both builds)."""
+    return tuple((item[0], _fingerprint(options[item[0]]))
+                 if isinstance(item, tuple) and len(item) == 2 and item[0] in options else item
+                 for item in key)
+
+
 class ProgramCache:
     """Compiled programs (:class:`plcrt.compiler.program.CompiledProgram`)
     by :func:`program_key`, least recently used first
@@ -280,4 +290,4 @@ programs = ProgramCache()
 
 
 __all__ = ["CHUNK_LINES", "ProgramCache", "TRIM_SOURCE_CHARS", "compile_chunks", "gc_paused",
-           "program_key", "programs", "release_free_memory"]
+           "program_key", "programs", "release_free_memory", "with_options"]

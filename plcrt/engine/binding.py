@@ -23,7 +23,8 @@ import time
 import zlib
 from typing import Any
 
-from ..compiler.cache import program_key, programs
+from ..compiler import tiermarks
+from ..compiler.cache import program_key, programs, with_options
 from ..compiler.program import CompiledProgram, compile_to_program
 from ..compiler.rt import CODECS, make_indirect
 from ..errors import Diagnostic, PlcCompileError, PlcConfigError, PlcError
@@ -43,6 +44,8 @@ class Binding:
 
     #: seconds this PLC's load spent compiling (0: from the program cache)
     _load_s = 0.0
+    #: the program cache's key of the native build (backend="auto" loads)
+    _native_key: tuple[Any, ...] | None = None
 
     def _compiled_program(self, program: ir.Program,
                           auto_diags: list[Diagnostic]) -> CompiledProgram:
@@ -52,14 +55,22 @@ class Binding:
         options = {name: cfg[name] for name in COMPILE_OPTIONS}
         if options["backend"] == "auto":
             # tiered (engine/tiering.py): the native build if it is made
-            # already, else the Python build now and the native one later
+            # already in this process, or if an earlier run left its
+            # machine code on disk (compiler/tiermarks.py); else the Python
+            # build now and the native one later
             options["backend"] = "native"
-            compiled = programs.peek(program_key(program, cpu=self.model.name, **options),
-                                     program)
+            key = self._native_key = program_key(program, cpu=self.model.name, **options)
+            compiled = programs.peek(key, program)
             if compiled is not None:
                 return compiled
+            if tiermarks.marked(key):
+                compiled = self._marked_native(key, program, options, auto_diags)
+                if compiled is not None:
+                    return compiled
             options["backend"] = "python"
-        key = program_key(program, cpu=self.model.name, **options)
+            key = with_options(key, backend="python")
+        else:
+            key = program_key(program, cpu=self.model.name, **options)
         compiled = programs.get(key, program)
         if compiled is None:
             options["cpu"] = cfg["cpu"]
@@ -76,14 +87,41 @@ class Binding:
             programs.put(key, compiled)
         return compiled
 
+    def _marked_native(self, key: tuple[Any, ...], program: ir.Program,
+                       options: dict[str, Any], auto_diags: list[Diagnostic]
+                       ) -> CompiledProgram | None:
+        """The native build of a program whose machine code an earlier run
+        left on disk (the machine code from the disk cache), or None when
+        LLVM does not work here after all (the Python build then)."""
+        from ..compiler.native.jit import usable
+        if usable() is not None:
+            return None
+        tiermarks.touch(key)
+        t0 = time.perf_counter()
+        try:
+            compiled = compile_to_program(
+                program, self.model, dict(options, cpu=self._config["cpu"]),
+                probes=CoverageMap() if options["instrument"] else None,
+                hooks=self._parts.compile_hooks)
+        except PlcCompileError as e:
+            e.diagnostics[:0] = auto_diags
+            raise
+        except PlcConfigError:        # the machine code could not be made
+            return None
+        self._load_s = time.perf_counter() - t0
+        programs.put(key, compiled)
+        return compiled
+
     def _native_maker(self, python: CompiledProgram) -> Any:
         """What compiles the native twin of ``python`` (in a worker thread:
         it holds the program and options, never this PLC) and keeps it in
         the program cache."""
         program, model, hooks = python.program, self.model, self._parts.compile_hooks
         options = dict(python.options, backend="native")
-        key_options = {name: options[name] for name in COMPILE_OPTIONS}
-        key = program_key(program, cpu=model.name, **key_options)
+        key = self._native_key
+        if key is None or python.program is not self.program:     # a PLC of a given build
+            key_options = {name: options[name] for name in COMPILE_OPTIONS}
+            key = program_key(program, cpu=model.name, **key_options)
 
         def make() -> CompiledProgram | None:
             from ..compiler.native.jit import say_fallback, usable
@@ -97,7 +135,9 @@ class Binding:
                     program, model, options,
                     probes=CoverageMap() if options["instrument"] else None, hooks=hooks)
                 programs.put(key, compiled)
-            compiled.native      # the machine code, made in this thread
+            code = compiled.native      # the machine code, made in this thread
+            if code is not None and getattr(code, "stored", False):
+                tiermarks.mark(key)     # the next run binds it at load
             return compiled
         return make
 
@@ -186,7 +226,8 @@ class Binding:
         """How the program runs: ``name`` (``"python"`` or ``"native"``: the
         build running now), with ``backend="auto"`` ``tiered`` (True) and
         ``python_scans`` (the scans run on the Python build before the
-        native one took over, or so far), and
+        native one took over, or so far; 0 with the native build bound at
+        load, its machine code left on disk by an earlier run), and
         for native, ``pieces`` run as machine code, ``python`` (block,
         network, reason) of the pieces left in Python, ``segments``,
         ``compile_s`` and ``cached`` (machine code from the disk cache)."""

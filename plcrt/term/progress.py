@@ -131,6 +131,9 @@ def run_with_progress(plc: Any, *, seconds: float | None = None, scans: int | No
     # a wall-time limit ends a run of any simulated length
     check_max_wall(max_wall)
     total = scan_count(plc, seconds, scans, bounded=max_wall is None)
+    plan = getattr(plc, "_tier_plan", None)
+    if plan is not None:      # the run in chunks is one run, the command's last
+        plan(total, final=True)   # (engine/tiering.py)
     out = sys.stderr if stream is None else stream
     terminal = _is_terminal(out)
     if terminal and (progress or not quiet and total > MIN_SCANS_FOR_BAR):

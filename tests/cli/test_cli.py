@@ -25,6 +25,13 @@ SEAL_IN = str(PROGRAMS / "seal_in.awl")
 TIMERS = str(PROGRAMS / "timers.awl")
 
 
+@pytest.fixture(autouse=True)
+def _empty_disk_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test runs as on a machine where no run has left machine code
+    (a program marked on disk is native from its first scan)."""
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path / "plcrt-cache"))
+
+
 def write(tmp_path: Path, name: str, text: str) -> str:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
@@ -200,6 +207,7 @@ def test_run_verbose_says_when_the_native_build_took_over(
     programs.clear()
     monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
     monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
     monkeypatch.setattr(tiering, "CHUNK_SCANS", 1)
     import threading
     real = tiering._start

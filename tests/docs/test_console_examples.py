@@ -56,6 +56,9 @@ def workdir(tmp_path: Path) -> tuple[Path, dict[str, str]]:
     env = {k: v for k, v in os.environ.items()
            if k not in ("FORCE_COLOR", "PY_COLORS", "CLICOLOR_FORCE", "PYTEST_ADDOPTS")
            and not k.startswith(("PLCRT_", "PYTEST_XDIST"))}
+    # the disk cache of a fresh install: empty, and the block's own (a
+    # program an earlier run marked is native from its first scan)
+    env["PLCRT_CACHE_DIR"] = str(tmp_path / "plcrt-cache")
     env.update(PATH=f"{bin_dir}{os.pathsep}{env.get('PATH', '')}", PYTHONUNBUFFERED="1",
                COLUMNS="100", LC_ALL="C.UTF-8", PYTHONIOENCODING="utf-8")
     return work, env

@@ -29,6 +29,13 @@ LINE = ("plcrt: the native backend is not available (llvmlite is not installed);
         "running on the Python backend")
 
 
+@pytest.fixture(autouse=True)
+def _empty_disk_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """No machine code, and no mark of it, left on disk by another test
+    (a load of a marked program is native from the first scan)."""
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path / "cache"))
+
+
 @pytest.fixture
 def no_llvmlite(tmp_path: Path) -> dict[str, str]:
     """An environment whose ``import llvmlite`` fails."""
@@ -46,16 +53,46 @@ def test_auto_is_the_default_and_native_where_llvmlite_works(
     monkeypatch.delenv("PLCRT_BACKEND", raising=False)
     assert jit.usable() is None
     with caplog.at_level(logging.INFO, logger="plcrt"):
-        for backend in (None, "auto"):
-            programs.clear()
-            plc = plcrt.load(PROGRAM, backend=backend)   # Python first (engine/tiering.py)
-            assert plc.backend == {"name": "python", "tiered": True, "python_scans": 0}
-            plc._tier_up()
-            assert plc.backend["name"] == "native" and plc.backend["pieces"] == 1
+        programs.clear()
+        plc = plcrt.load(PROGRAM)             # Python first (engine/tiering.py)
+        assert plc.backend == {"name": "python", "tiered": True, "python_scans": 0}
+        plc._tier_up()
+        assert plc.backend["name"] == "native" and plc.backend["pieces"] == 1
+        # the machine code is on disk now: a later load (another process:
+        # the program cache emptied) binds it at once
+        programs.clear()
+        again = plcrt.load(PROGRAM, backend="auto")
+        assert again.backend["name"] == "native" and again.backend["cached"]
+        assert again.backend["tiered"] and again.backend["python_scans"] == 0
     assert caplog.records == []          # nothing to say when native runs
     assert plcrt.load(PROGRAM, backend="python").backend == {"name": "python"}
     monkeypatch.setenv("PLCRT_BACKEND", "python")
     assert plcrt.load(PROGRAM).backend == {"name": "python"}
+
+
+def test_a_stale_mark_costs_one_native_compile_and_no_cache_follows_no_mark(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A mark whose machine code is gone (trimmed, another llvmlite): the
+    load compiles the native build before its first scan and keeps it on
+    disk; with PLCRT_NATIVE_CACHE_MB=0 a mark is not followed."""
+    programs.clear()
+    plc = plcrt.load(PROGRAM, backend="auto")
+    plc._tier_up()
+    folder = tmp_path / "cache" / "native"
+    marks = [f for f in folder.iterdir() if b"plcrt tier mark" in f.read_bytes()]
+    assert len(marks) == 1
+    for f in folder.iterdir():
+        if f not in marks:
+            f.unlink()                   # the machine code gone, the mark kept
+    programs.clear()
+    again = plcrt.load(PROGRAM, backend="auto")
+    assert again.backend["name"] == "native" and not again.backend["cached"]
+    assert again.backend["python_scans"] == 0
+    assert len(list(folder.iterdir())) == 2       # the machine code kept again
+    programs.clear()
+    monkeypatch.setenv("PLCRT_NATIVE_CACHE_MB", "0")
+    assert plcrt.load(PROGRAM, backend="auto").backend == {
+        "name": "python", "tiered": True, "python_scans": 0}
 
 
 def test_a_bad_backend_names_the_choices() -> None:

@@ -10,7 +10,9 @@ pinned here too.
 
 from __future__ import annotations
 
+import os
 import pickle
+import shutil
 import subprocess
 import sys
 import threading
@@ -36,9 +38,17 @@ TIMERS = "ORGANIZATION_BLOCK MAIN:OB1\nBEGIN\nNetwork 1\nLD I0.0\nTON T37, +10\n
 
 
 @pytest.fixture(autouse=True)
-def _no_native_build_cached():
-    """A native build in the program cache is used at once, without tiers."""
+def _no_native_build_cached(tmp_path, monkeypatch):
+    """A native build in the program cache, or a mark of one on disk, is
+    used at once, without tiers: each test starts with neither."""
     programs.clear()
+    monkeypatch.setenv("PLCRT_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def _fresh_disk_cache() -> None:
+    """An empty disk cache for one hypothesis example (the machine code and
+    the marks of the previous example gone)."""
+    shutil.rmtree(os.environ["PLCRT_CACHE_DIR"], ignore_errors=True)
 
 
 def _image(plc: plcrt.Plc) -> tuple:
@@ -53,6 +63,7 @@ def _image(plc: plcrt.Plc) -> tuple:
 def test_the_switch_at_any_scan_gives_the_images_of_both_backends(
         program, inputs, initial, scan_ms, switch) -> None:
     programs.clear()    # else the native build of an earlier example is used at once
+    _fresh_disk_cache()
     plcs = [plcrt.load(program, scan_ms=scan_ms, backend=b)
             for b in ("auto", "python", "native")]
     for plc in plcs:
@@ -101,6 +112,7 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
     scan boundary, and its image still equals the Python run's."""
     monkeypatch.setattr(tiering, "START_AFTER_S", 0.0)
     monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
     ref = plcrt.load(TIMERS, backend="python", scan_ms=1)
     auto = plcrt.load(TIMERS, backend="auto", scan_ms=1)
     for plc in (ref, auto):
@@ -114,6 +126,66 @@ def test_the_background_job_switches_a_running_plc(monkeypatch) -> None:
     assert _image(auto) == _image(ref)
     assert not [t for t in threading.enumerate()
                 if t.name == "plcrt-native-compile" and not t.daemon]
+
+
+@pytest.mark.parametrize("how", ["run", "in chunks"])
+def test_a_long_planned_run_starts_the_compile_after_its_first_chunk(how, monkeypatch) -> None:
+    """A run whose length is known starts the native compile as soon as its
+    first chunk of scans says the rest would take PLAN_FACTOR times the
+    wait in Python; a short one waits (here: never, the wait is 0.1 s).
+    ``plcrt run`` with a progress line or --max-wall runs in chunks of its
+    own and says the whole length first."""
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.1)
+    started: list[int] = []
+    real = tiering._start
+    plcs: list[plcrt.Plc] = []
+
+    def start(key, make):
+        started.append(plcs[-1].scans)
+        return real(key, make)
+    monkeypatch.setattr(tiering, "_start", start)
+    plcs.append(plcrt.load(TIMERS, backend="auto"))
+    plcs[-1].scan(500)           # 500 scans of a few µs: far from 0.1 s
+    assert started == [] and plcs[-1].backend["name"] == "python"
+    programs.clear()
+    plcs.append(plcrt.load(TIMERS, backend="auto"))
+    if how == "run":
+        plcs[-1].run(seconds=2_000_000 * 0.01)   # two million scans: seconds in Python
+        assert started == [tiering.CHUNK_SCANS]
+    else:
+        from plcrt.term.progress import run_with_progress
+        run_with_progress(plcs[-1], scans=2_000_000, quiet=True, max_wall=3600.0)
+        assert len(started) == 1 and started[0] <= 100     # in its first chunk
+    assert plcs[-1].scans == 2_000_000
+    assert plcs[-1].backend["name"] == "native"
+    assert 0 < plcs[-1].backend["python_scans"] < plcs[-1].scans
+
+
+def test_a_final_run_compiles_only_when_the_compile_pays_within_it(monkeypatch) -> None:
+    """``plcrt run`` says its run is the PLC's last (final): there the
+    compile starts only by the plan (a rest that pays for it, here never),
+    not by the wait alone, as it does where the program may go on."""
+    from plcrt.term.progress import run_with_progress
+    monkeypatch.setattr(tiering, "START_AFTER_S", 0.001)   # 30 000 scans take longer
+    monkeypatch.setattr(tiering, "LOAD_FACTOR", 0.0)
+    monkeypatch.setattr(tiering, "LLVM_START_S", 0.0)
+    monkeypatch.setattr(tiering, "PLAN_FACTOR", 1e9)       # no rest pays
+    started: list[str] = []
+    real = tiering._start
+
+    def start(key, make):
+        started.append(how)
+        return real(key, make)
+    monkeypatch.setattr(tiering, "_start", start)
+    for how in ("final", "not final"):
+        programs.clear()
+        plc = plcrt.load(TIMERS, backend="auto")
+        if how == "final":
+            run_with_progress(plc, scans=30_000, quiet=True)
+        else:
+            plc.run(scans=30_000)
+        assert plc.scans == 30_000
+    assert started == ["not final"]
 
 
 def test_snapshot_fork_and_pickle_across_the_switch() -> None:
@@ -176,7 +248,7 @@ def test_python_and_native_keep_their_meaning() -> None:
 def test_a_process_with_a_job_under_way_exits(tmp_path) -> None:
     """The worker is a daemon; exit waits for a started job and ends."""
     code = ("import plcrt; from plcrt.engine import tiering\n"
-            "tiering.START_AFTER_S = tiering.LOAD_FACTOR = 0.0\n"
+            "tiering.START_AFTER_S = tiering.LOAD_FACTOR = tiering.LLVM_START_S = 0.0\n"
             f"plc = plcrt.load({TIMERS!r}, backend='auto')\n"
             "plc.scan(200)\nprint('ran', plc.scans)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

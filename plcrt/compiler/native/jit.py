@@ -140,9 +140,11 @@ class NativeCode:
                                   zlib.ZLIB_VERSION, *modules])
         objects = diskcache.load(key)
         self.cached = objects is not None
+        #: the machine code is in the disk cache (found there, or kept now)
+        self.stored = self.cached
         if objects is None:
             objects = [_object(llvm, tm, m) for m in modules]
-            diskcache.store(key, objects)
+            self.stored = diskcache.store(key, objects)
         self.code_bytes = sum(len(o) for o in objects)
         empty = llvm.parse_assembly("")
         self._engine = llvm.create_mcjit_compiler(empty, tm)

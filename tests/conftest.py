@@ -10,16 +10,29 @@ run and keep the failures they find in ``.hypothesis/``.  Under CI (the
 ``CI`` environment variable set) they draw the same examples every time
 (``derandomize``), so a submission is judged on a fixed set of cases
 rather than on a fresh draw; ``PLCRT_PROPERTY_EXAMPLES`` still scales them.
+
+A test session keeps plcrt's disk cache (native machine code and the marks
+of programs the default backend compiled, docs/native.md "Tiers") in a
+directory of its own unless ``PLCRT_CACHE_DIR`` names one: what earlier
+runs left in the user's cache must not change which backend a test's PLC
+starts on.
 """
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+if "PLCRT_CACHE_DIR" not in os.environ:      # inherited by pytest-xdist's workers
+    os.environ["PLCRT_CACHE_DIR"] = tempfile.mkdtemp(prefix="plcrt-test-cache-")
+    atexit.register(shutil.rmtree, os.environ["PLCRT_CACHE_DIR"], True)
 
 settings.register_profile("ci", derandomize=True, database=None)
 if os.environ.get("CI"):

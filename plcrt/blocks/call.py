@@ -170,8 +170,9 @@ def _bit_reads(g: Any, reads: list[Any]) -> list[str]:
     return out
 
 
-#: a protected block's parameters are matched by size: a project file stores
-#: a local variable's size, not its signedness (docs/project-files.md)
+#: a protected block's parameters in a program read from a project file are
+#: matched by size: a project stores a local variable's size, not its
+#: signedness (docs/project-files.md); an export names the type itself
 _SIZE = {"DINT": "DWORD", "INT": "WORD"}
 
 
@@ -188,12 +189,13 @@ def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
     if entry is None:
         return False
     variants, family = entry
-    own = [(v.decl.section, _SIZE.get(t, t)) for v in callee.local_vars.values()
+    size = _SIZE if getattr(g.unit.program, "from_project", False) else {}
+    own = [(v.decl.section, size.get(t, t)) for v in callee.local_vars.values()
            if v.decl.section != "TEMP" for t in (v.decl.type.upper(),)]
     empty = not any(net.insns for net in callee.pou.networks)
     itfs = [interfaces()[n] for n in variants if n in interfaces()]
     for itf in itfs:
-        if empty and own == [(p.dir, _SIZE.get(p.type, p.type)) for p in itf.params]:
+        if empty and own == [(p.dir, size.get(p.type, p.type)) for p in itf.params]:
             return library_call(g, insn, resolver, name=itf.name)
     once = g.unit.hooks.setdefault("protected-once", set())
     if callee.pou.ident not in once:
@@ -203,7 +205,7 @@ def protected_call(g: Any, insn: Any, resolver: Any, callee: Any) -> bool:
             ("has instructions", not empty),
             ("has the interface " + excerpt(", ".join(f"{d} {t}" for d, t in own) or "(none)")
              + f", not the library's {wanted}",
-             all(own != [(p.dir, _SIZE.get(p.type, p.type)) for p in itf.params]
+             all(own != [(p.dir, size.get(p.type, p.type)) for p in itf.params]
                  for itf in itfs))) if bad]
         g.warn(f"{callee.pou.ident} ({excerpt(callee.pou.name)}) is named like the {family} "
                f"block {name} but {' and '.join(why)}: the program's own subroutine runs, not "

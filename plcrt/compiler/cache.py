@@ -203,12 +203,13 @@ def program_key(program: Any, **options: Any) -> tuple[Any, ...]:
 
 def _same(cached: Any, program: Any) -> bool:
     """Whether a cached build's program is ``program``: equal IR, and the
-    same system block (the settings a PLC of the build powers up with,
-    which the IR's equality leaves out)."""
+    same system block (the settings a PLC of the build powers up with) and
+    origin (a project file's interfaces match library blocks by size),
+    which the IR's equality leaves out."""
     if cached is program:
         return True
-    return cached == program and (getattr(cached, "system", None)
-                                  == getattr(program, "system", None))
+    return cached == program and all(getattr(cached, name, None) == getattr(program, name, None)
+                                     for name in ("system", "from_project"))
 
 
 def with_options(key: tuple[Any, ...], **options: Any) -> tuple[Any, ...]:

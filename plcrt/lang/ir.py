@@ -119,6 +119,9 @@ class Program:
     #: what the project file's reader left out or could not map (one line
     #: each, names read from the file; ``plcrt check`` prints them)
     project_notes: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    #: read from a project file, which stores a local variable's size and
+    #: not its sign (a protected block's interface is matched by size)
+    from_project: bool = field(default=False, compare=False, repr=False)
 
     def instruction_count(self) -> int:
         return sum(len(n.insns) for p in self.pous for n in p.networks)

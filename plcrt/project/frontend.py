@@ -31,7 +31,7 @@ def load_project(path: str, limit: int) -> tuple[ir.Program, Any, Any]:
     program = parse_program(project.awl, path)
     program = ir.Program(program.pous, program.file, program.source, project.encoding,
                          project.plant, system=project.system,
-                         project_notes=tuple(project.notes))
+                         project_notes=tuple(project.notes), from_project=True)
     symbols = parse_symbols(project.symbols, path) if project.symbols else None
     data = None
     if project.data.strip():

@@ -126,6 +126,18 @@ def same_run(a, b, scans: int) -> None:
     assert a.mem.snapshot().areas == b.mem.snapshot().areas
 
 
+def export_round_trip(path: Path, tmp_path: Path):
+    """(the project loaded, its ``plcrt export`` -- .awl, symbols, data --
+    loaded again): the two programs are one IR."""
+    out = [tmp_path / n for n in ("o.awl", "o.txt", "o.db")]
+    assert main(["export", str(path), "--awl", str(out[0]), "--symbols", str(out[1]),
+                 "--data", str(out[2])]) == 0
+    project = plcrt.load(path)
+    again = plcrt.load(out[0], symbols=out[1], data=out[2])
+    assert ir_of(again.program) == ir_of(project.program)
+    return project, again
+
+
 def _write(tmp_path: Path, text: str, smart: bool, **kw) -> Path:
     program = parse_program(text, "x.awl")
     assert encodable(program)
@@ -154,13 +166,9 @@ def test_export_reloads_to_the_same_ir(tmp_path: Path, smart: bool, capsys) -> N
     symbols = [("Start", "I0.0", "start button"), ("Lamp", "Q0.0", "")]
     data = [("VW100", [10, 20], "batch sizes"), ("VB7", [3], "")]
     path = _write(tmp_path, EVERY_CODE, smart, symbols=symbols, data=data)
-    out = [tmp_path / n for n in ("o.awl", "o.txt", "o.db")]
-    assert main(["export", str(path), "--awl", str(out[0]), "--symbols", str(out[1]),
-                 "--data", str(out[2])]) == 0
-    project = plcrt.load(path)
-    again = plcrt.load(out[0], symbols=out[1], data=out[2])
-    assert ir_of(again.program) == ir_of(project.program)
-    assert out[0].read_bytes().count(b"\r\n") == out[0].read_bytes().count(b"\n")
+    project, again = export_round_trip(path, tmp_path)
+    awl = (tmp_path / "o.awl").read_bytes()
+    assert awl.count(b"\r\n") == awl.count(b"\n")
     assert again.read("VW100") == 10 and again.read("VW102") == 20 and again.read("VB7") == 3
     assert project.read("VW100") == 10 and project.read("VB7") == 3
 

@@ -31,7 +31,7 @@ from plcrt.project.smartv3 import MAX_DIRECTORY, MAX_MEMBER, MAX_MEMBERS
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import smartv3_writer as w  # noqa: E402
-from test_project_load import EVERY_CODE, _programs, ir_of, same_run  # noqa: E402
+from test_project_load import EVERY_CODE, _programs, export_round_trip, ir_of, same_run  # noqa: E402
 
 SYMBOLS = [("Start", "I0.0", "start button"), ("Level", "VW10", "tank"),
            ("Flag", "SM0.5", ""), ("Count", "C3", "")]
@@ -145,12 +145,7 @@ def test_export_reloads_to_the_same_ir(tmp_path: Path) -> None:
     """plcrt export writes an .awl, symbols and data that load to what the
     project loads to."""
     path = _write(tmp_path, w.project_bytes(_program(), symbols=SYMBOLS, data=DATA))
-    out = [tmp_path / n for n in ("o.awl", "o.txt", "o.db")]
-    assert main(["export", str(path), "--awl", str(out[0]), "--symbols", str(out[1]),
-                 "--data", str(out[2])]) == 0
-    project = plcrt.load(path)
-    again = plcrt.load(out[0], symbols=out[1], data=out[2])
-    assert ir_of(again.program) == ir_of(project.program)
+    _project, again = export_round_trip(path, tmp_path)
     assert again.read("VW100") == 10 and again.read("VB7") == 3
     assert main(["check", str(path)]) == 0
 

@@ -18,12 +18,12 @@ What it is not: the general cycle (:mod:`.drive`, :mod:`.drive_time`,
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Optional
 
 from ..motion import US
 from .axis import LinLeg
 from .drive_io import (CW, I32_HIGH, I32_LOW, MISSING, MOTION_KEYS, OE, _B8, _B10, _B12, _B13,
-                       _ESM_OP, _HOOK_INDEXES, _K60B8, _PLAIN_PLANT)
+                       _ESM_OP, _HOOK_INDEXES, _K60B8, _PLAIN_PLANT, DriveFields)
 from .modes import CyclicPosition
 from .plant import DrivePlant
 from .store import key
@@ -37,32 +37,14 @@ _K6065, _K607A, _K6080 = key(0x6065, 0), key(0x607A, 0), key(0x6080, 0)
 _K6062, _K6064, _K606C, _K60F4, _K6063, _K606B = MOTION_KEYS
 
 
-class CspCycle:
+class CspCycle(DriveFields):
     """The steady CSP cycle of a :class:`~.drive.Drive` (see the module docstring)."""
 
-    # the attributes it reads of the drive (set by Drive.__init__; it also
-    # calls the drive's methods)
-    now: int
-    controlword: int
-    mode_number: int
-    engines: dict[int, Any]
-    axis: Any
-    sm: Any
-    esm: Any
-    pdo: Any
-    plant: DrivePlant
-    store: Any
-    stops: Any
-    probe: Any
-    _live: dict[tuple[int, int], Any]
-    deferred: Optional[tuple[int, ...]]
+    # the drive's attributes it reads besides DriveFields'
     _published: tuple
-    _held_state: Optional[tuple[int, ...]]
     _plain_motion: bool
     _batch: bool
     _qs_wait: bool
-    _fit: bool
-    _out: dict[tuple[int, int], int]
     _motion_out: dict[tuple[int, int], int]
 
     def hold_locked(self, t: int) -> None:

@@ -74,11 +74,11 @@ def _picker(at: list) -> Callable[[object], tuple]:
     return lambda values: ()
 
 
-class ProcessData:
-    """The process data of a :class:`~.drive.Drive` (see the module docstring)."""
+class DriveFields:
+    """The attributes of a :class:`~.drive.Drive` its process-data and CSP
+    mixins read (set by ``Drive.__init__``; the mixins also call the
+    drive's methods)."""
 
-    # the attributes it reads of the drive (set by Drive.__init__; it also
-    # calls the drive's methods)
     now: int
     controlword: int
     mode_number: int
@@ -95,8 +95,13 @@ class ProcessData:
     deferred: Optional[tuple[int, ...]]
     _held_state: Optional[tuple[int, ...]]
     _fit: bool
-    _motion_i32: bool
     _out: dict[tuple[int, int], int]
+
+
+class ProcessData(DriveFields):
+    """The process data of a :class:`~.drive.Drive` (see the module docstring)."""
+
+    _motion_i32: bool
     _own: frozenset[tuple[int, int]]
     _signed: frozenset[tuple[int, int]]
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import PlcConfigError
+from ..memory.cpu import model_named
 from ..memory.system import (RetentiveRange, SystemSettings, check_range, clipped,
                              default_ranges)
 
@@ -41,6 +42,14 @@ _AREA = {"V": ("V", 1), "M": ("M", 1), "T": ("TV", 2), "C": ("CV", 2)}
 SM0_2 = 0x04
 #: the PPI rates a port runs at (as the plant file's ppi_baud)
 PPI_BAUDS = (9600, 19200, 187500)
+
+
+def project_cpu(program: Any) -> str | None:
+    """The CPU model a project file's system block names (``CPU 224 REL
+    02.01`` runs as CPU224), or None (an export, or a CPU plcrt has no
+    model of: the default CPU226)."""
+    system = getattr(program, "system", None)
+    return model_named(getattr(system, "cpu", "") or "")
 
 
 class PowerCycle:

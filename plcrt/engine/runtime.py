@@ -47,7 +47,7 @@ from .hsc import Encoder, make_counters
 from .interrupts import Interrupts
 from .netjobs import make_ethernet
 from .pid import make_loops
-from .power import PowerCycle
+from .power import PowerCycle, project_cpu
 from .ports import make_ports
 from .pulse import make_outputs
 from .scan import SMB0, ScanLoop
@@ -109,6 +109,8 @@ class Plc(ScanLoop, EventCalls, Faults, Binding, Tiering, Forking, PowerCycle,
             from ..lang.symbols import SYSTEM_SYMBOLS
             system_symbols = dict(SYSTEM_SYMBOLS)
         self.program = program
+        if cpu is None:         # a project file's CPU, where plcrt has its model
+            cpu = project_cpu(program)
         self.model = cpu_model(cpu)
         auto_diags: list[Diagnostic] = []
         if auto_symbols:

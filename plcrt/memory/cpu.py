@@ -8,6 +8,8 @@ accumulators, six high-speed counters, 64 bytes of L memory per program unit.
 
 from __future__ import annotations
 
+import re
+
 from dataclasses import dataclass
 
 from ..errors import PlcConfigError
@@ -55,6 +57,21 @@ CPU_MODELS: dict[str, CpuModel] = {
 }
 
 DEFAULT_CPU = "CPU226"
+
+#: an S7-200 CPU as Micro/WIN names it in a project ("CPU 224 REL 02.01",
+#: "CPU 224XP", "CPU226XM"): the model of the table above it runs as
+_NAMED = re.compile(r"\bCPU\s*(22[1246])(?![0-9])\s*(XP)?", re.IGNORECASE)
+
+
+def model_named(text: str) -> str | None:
+    """The model of :data:`CPU_MODELS` a project's CPU description names,
+    or None (a CPU this table has no model of: an older CPU 21x, a SMART
+    CPU)."""
+    match = _NAMED.search(text[:80]) if isinstance(text, str) else None
+    if match is None:
+        return None
+    name = "CPU" + match.group(1) + ("XP" if match.group(2) else "")
+    return name if name in CPU_MODELS else None
 
 
 def cpu_model(name: str | None) -> CpuModel:

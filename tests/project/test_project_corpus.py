@@ -82,7 +82,7 @@ def test_corpus_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -
     assert main(["export", str(path), "--awl", str(out[0]), "--symbols", str(out[1]),
                  "--data", str(out[2])]) == 0
     again = plcrt.load(out[0], symbols=out[1] if out[1].stat().st_size else None,
-                       data=out[2])
+                       data=out[2], cpu=plc.model.name)     # the project's CPU
     assert ir_of(again.program) == ir_of(plc.program)
     same_run(plc, again, 300)
 

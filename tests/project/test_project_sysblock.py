@@ -237,10 +237,11 @@ def test_port_settings_reach_the_ports_unless_the_plant_file_sets_them(tmp_path:
     """The system block's station address and PPI rate are the port's
     (NETR/NETW, GPA); a [port.N] table of the plant file sets its port."""
     path = _write(tmp_path, False, v4_block(addresses=(4, 9), baud=(4, 0)))
-    plc = plcrt.load(path)
+    plc = plcrt.load(path, cpu="CPU226")        # the project's CPU 224 has one port
     assert [(p.address, p.ppi_baud) for p in plc.ports] == [(4, 187500), (9, 9600)]
     assert plc.station.addresses == {0: 4, 1: 9}
-    plc = plcrt.load(path, plant={"port": {"0": {"address": 6}}})
+    assert [p.address for p in plcrt.load(path).ports] == [4]
+    plc = plcrt.load(path, plant={"port": {"0": {"address": 6}}}, cpu="CPU226")
     assert [(p.address, p.ppi_baud) for p in plc.ports] == [(6, 9600), (9, 9600)]
     assert plc.station.addresses[1] == 9
     plc.power_cycle()
@@ -259,7 +260,7 @@ def test_check_reports_the_system_block_and_the_cpu(tmp_path: Path, capsys) -> N
         "pulse catch: I0.2")]
     path = _write(tmp_path, False, v4_block(), "v4")
     assert main(["check", str(path)]) == 0
-    assert (f"{path}: system block: CPU: CPU 224 REL 02.01 (runs as CPU226; --cpu chooses)"
+    assert (f"{path}: system block: CPU: CPU 224 REL 02.01 (runs as CPU224; --cpu chooses)"
             in capsys.readouterr().err)
 
 
@@ -309,3 +310,25 @@ def test_a_build_is_shared_only_with_the_same_system_block(tmp_path: Path) -> No
     assert [str(r) for r in first.retentive] == ["VB100:2"]
     assert [str(r) for r in again.retentive] == ["VB200:4"]
     assert second.compiled is not first.compiled
+
+
+@pytest.mark.parametrize("text, model", [
+    ("CPU 224 REL 02.01", "CPU224"), ("CPU 224XP REL 02.01", "CPU224XP"),
+    ("CPU221", "CPU221"), ("cpu 222 rel 01.22", "CPU222"), ("CPU 226XM", "CPU226"),
+    ("CPU 216", None), ("CPU ST40", None), ("", None), ("CPU 2245", None)])
+def test_a_project_cpu_names_the_model_it_runs_as(text: str, model: str | None) -> None:
+    from plcrt.memory.cpu import model_named
+    assert model_named(text) == model
+
+
+def test_a_project_runs_on_its_cpu_unless_told_otherwise(tmp_path: Path) -> None:
+    """The writer's projects are for a CPU 224: 8 KiB of V memory and one
+    port; cpu= gives another model; an export of the program runs as the
+    default CPU 226."""
+    path = _write(tmp_path, False, v4_block())
+    plc = plcrt.load(path)
+    assert (plc.model.name, len(plc.ports)) == ("CPU224", 1)
+    with pytest.raises(PlcError, match="VB8192"):
+        plc["VB8192"] = 1
+    assert plcrt.load(path, cpu="CPU226").model.name == "CPU226"
+    assert plcrt.load(ROOT / "programs" / "seal_in.awl").model.name == "CPU226"

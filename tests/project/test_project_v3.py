@@ -85,7 +85,8 @@ def test_v3_project_loads_and_exports_to_itself(name: str, tmp_path: Path) -> No
     plc = plcrt.load(path)
     out, table = tmp_path / "o.awl", tmp_path / "o.txt"
     assert main(["export", str(path), "--awl", str(out), "--symbols", str(table)]) == 0
-    again = plcrt.load(out, symbols=table if project.symbols else None)
+    again = plcrt.load(out, symbols=table if project.symbols else None,
+                       cpu=plc.model.name)                  # the project's CPU
     assert ir_of(again.program) == ir_of(plc.program)
     for line in project.symbols.splitlines():
         name, address = line.split("\t")[:2]

@@ -69,6 +69,8 @@ CALL   SBR1, M0.0, VW200, VW202, VB100
 END_ORGANIZATION_BLOCK
 """ + _WIZARD_SBR.format(name="PWM0_RUN", n=1, ins="RUN:BOOL;\nCycle:WORD;\nDuty_Cycle:WORD;",
                          outs="Error:BYTE;")
+#: the CPU the writer's projects name (CPU 224 REL 02.01) runs as this model
+CPU = "CPU224"
 PLANT = "[pto.0]\nmax_speed = 20000\nss_speed = 200\naccel_ms = 300\ndecel_ms = 300\n"
 
 
@@ -121,11 +123,11 @@ def test_pto_wizard_project_runs_as_its_export_with_the_plant_file(tmp_path: Pat
     assert any("from the project's Position Control wizard configuration [pto.0]" in d.message
                for d in plc.diagnostics)
     from_project = _move(plc)
-    with_plant = _move(plcrt.load(MANUAL, scan_ms=5, plant=PLANT))
+    with_plant = _move(plcrt.load(MANUAL, scan_ms=5, plant=PLANT, cpu=CPU))
     assert from_project == with_plant
     error, pulses, _ = from_project
     assert error == 0 and pulses > 5000           # ramp up, 1 s at 5 kHz, ramp down
-    without = _move(plcrt.load(MANUAL, scan_ms=5))
+    without = _move(plcrt.load(MANUAL, scan_ms=5, cpu=CPU))
     assert without[0] == 1 and without[1] == 0     # Error 1: no configuration
 
 
@@ -133,7 +135,7 @@ def test_plant_file_table_replaces_the_project_wizard(tmp_path: Path) -> None:
     path = _manual_project(tmp_path)
     slow = PLANT.replace("accel_ms = 300", "accel_ms = 2000")
     own = _move(plcrt.load(path, scan_ms=5, plant=slow))
-    assert own == _move(plcrt.load(MANUAL, scan_ms=5, plant=slow))
+    assert own == _move(plcrt.load(MANUAL, scan_ms=5, plant=slow, cpu=CPU))
     assert own[1] != _move(plcrt.load(path, scan_ms=5))[1]
 
 

@@ -14,6 +14,7 @@ import os
 import shutil
 import threading
 from collections.abc import Callable, Iterator
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +63,65 @@ def editor_end_of_line(page: Any, n: int) -> None:
     """Put the editor's cursor at the end of line *n* (1-based) and focus it."""
     page.evaluate(f"() => {{ const v = window.plcrtEditor.view; const l = v.state.doc.line({n});"
                   f" v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
+
+
+def editor_no_errors(page: Any) -> None:
+    """Wait until the editor's check of its text finds no error."""
+    page.wait_for_function("() => document.querySelector('#editor-count')"
+                           ".textContent === 'no errors'")
+
+
+def editor_download(page: Any) -> str:
+    """Click Download and wait for it to be done; the status line."""
+    page.click("#editor-download")
+    page.wait_for_function("() => document.querySelector('#editor-status')"
+                           ".textContent.startsWith('downloaded')")
+    return page.locator("#editor-status").text_content()
+
+
+def editor_download_refused(page: Any) -> None:
+    """Click Download and wait for the refusal of a text with errors."""
+    page.click("#editor-download")
+    page.wait_for_function("() => document.querySelector('#editor-status')"
+                           ".textContent.includes('has errors')")
+
+
+class _OtherSite(BaseHTTPRequestHandler):
+    """A page of another site: no policy of its own."""
+
+    def do_GET(self) -> None:   # noqa: N802 - http.server's name
+        body = b"<!DOCTYPE html><title>another site</title>"
+        self.send_response(200)
+        self.send_header("Content-Type", "text/html")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args: object) -> None:
+        pass
+
+
+def posts_from_another_origin(page: Any, base: str, routes: list[str]) -> dict[str, int]:
+    """The HTTP status of each of ``routes`` (below ``base``, the panel's
+    URL) posted by a page of another origin (another port) as a simple
+    request (no preflight: the browser sends it, with Origin), by the
+    route's last part."""
+    other = ThreadingHTTPServer(("127.0.0.1", 0), _OtherSite)
+    threading.Thread(target=other.serve_forever, daemon=True).start()
+    try:
+        page.goto(f"http://127.0.0.1:{other.server_address[1]}/")
+        seen: dict[str, int] = {}
+        page.on("response", lambda r: seen.__setitem__(r.url.rsplit("/", 1)[1], r.status))
+        page.evaluate("""async ([base, routes]) => {
+            for (const route of routes) {
+              await fetch(base + route, {method: 'POST', mode: 'no-cors',
+                headers: {'Content-Type': 'text/plain'}, body: '{"text": "x"}'});
+            }
+        }""", [base, routes])
+        return seen
+    finally:
+        other.shutdown()
+        other.server_close()
 
 
 def load_sample(text: str = PROGRAM, symbols: str | None = SYMBOLS, **kw: Any) -> plcrt.Plc:

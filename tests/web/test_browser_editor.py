@@ -6,16 +6,15 @@ page of another origin refused."""
 
 from __future__ import annotations
 
-import threading
 import time
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
 import plcrt
 from plcrt.web.editor import ProgramSource
 from plcrt.web.server import Panel
 from plcrt.web.session import PanelSession
 
-from .conftest import editor_end_of_line, editor_text
+from .conftest import (editor_download, editor_download_refused, editor_end_of_line,
+                       editor_no_errors, editor_text, posts_from_another_origin)
 
 PROGRAM = """\
 ORGANIZATION_BLOCK MAIN:OB1
@@ -62,21 +61,15 @@ def test_type_an_error_see_it_fix_it_download_and_run(serve, page, tmp_path) -> 
     assert "Q0.9" in page.locator(".cm-lintRange-error").first.text_content()
     assert page.locator(".cm-gutter-lint .cm-lint-marker-error").count() == 1
     # a download with the error is refused: the ladder keeps one network
-    page.click("#editor-download")
-    page.wait_for_function("() => document.querySelector('#editor-status')"
-                           ".textContent.includes('has errors')")
+    editor_download_refused(page)
     assert page.locator("#networks .net").count() == 1
     # fix it: Q0.9 -> Q0.1
     editor_end_of_line(page, 8)
     page.keyboard.press("Backspace")
     page.keyboard.type("1")
-    page.wait_for_function("() => document.querySelector('#editor-count')"
-                           ".textContent === 'no errors'")
+    editor_no_errors(page)
     assert page.locator(".cm-lintRange-error").count() == 0
-    page.click("#editor-download")
-    page.wait_for_function("() => document.querySelector('#editor-status')"
-                           ".textContent.startsWith('downloaded')")
-    assert page.locator("#editor-status").text_content().startswith("downloaded in STOP")
+    assert editor_download(page).startswith("downloaded in STOP")
     # the ladder shows the new program; running it, I0.0 lights Q0.1
     page.wait_for_function("() => document.querySelectorAll('#networks .net').length === 2")
     page.click("#run")
@@ -169,42 +162,9 @@ def test_a_file_changed_on_disk_is_loaded_again(serve, page, tmp_path) -> None:
 def test_a_page_of_another_origin_cannot_save_or_download(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
-    # a page of another origin (another port; no policy of its own) that
-    # posts to the panel
-    other = ThreadingHTTPServer(("127.0.0.1", 0), _Plain)
-    threading.Thread(target=other.serve_forever, daemon=True).start()
-    try:
-        page.goto(f"http://127.0.0.1:{other.server_address[1]}/")
-        _post_from_other_origin(page, panel, path, served)
-    finally:
-        other.shutdown()
-        other.server_close()
-
-
-class _Plain(BaseHTTPRequestHandler):
-    def do_GET(self) -> None:   # noqa: N802 - http.server's name
-        body = b"<!DOCTYPE html><title>another site</title>"
-        self.send_response(200)
-        self.send_header("Content-Type", "text/html")
-        self.send_header("Content-Length", str(len(body)))
-        self.end_headers()
-        self.wfile.write(body)
-
-    def log_message(self, *args: object) -> None:
-        pass
-
-
-def _post_from_other_origin(page, panel, path, served) -> None:
     before = panel.session
-    seen: dict[str, int] = {}
-    page.on("response", lambda r: seen.__setitem__(r.url.rsplit("/", 1)[1], r.status))
-    page.evaluate("""async (base) => {
-        for (const route of ['editor/save', 'editor/download', 'editor/check']) {
-          // a simple request (no preflight): the browser sends it, with Origin
-          await fetch(base + route, {method: 'POST', mode: 'no-cors',
-            headers: {'Content-Type': 'text/plain'}, body: '{"text": "x"}'});
-        }
-    }""", served.url)
+    seen = posts_from_another_origin(page, served.url,
+                                     ["editor/save", "editor/download", "editor/check"])
     assert seen == {"save": 403, "download": 403, "check": 403}
     assert path.read_text() == PROGRAM and panel.session is before
 
@@ -242,12 +202,8 @@ def test_a_download_while_running_goes_on_with_the_memory(serve, page, tmp_path)
     page.evaluate("() => { const v = window.plcrtEditor.view; const t = v.state.doc.toString(); "
                   "const i = t.indexOf('Q0.0'); "
                   "v.dispatch({changes: {from: i, to: i + 4, insert: 'Q0.1'}}); }")
-    page.wait_for_function("() => document.querySelector('#editor-count')"
-                           ".textContent === 'no errors'")
-    page.click("#editor-download")
-    page.wait_for_function("() => document.querySelector('#editor-status')"
-                           ".textContent.startsWith('downloaded')")
-    assert page.locator("#editor-status").text_content().startswith("downloaded in RUN")
+    editor_no_errors(page)
+    assert editor_download(page).startswith("downloaded in RUN")
     # still running; the switch stayed on; Q0.1 follows it, Q0.0 kept its state
     page.wait_for_function("() => window.plcrtPanel.frame.io['Q0.1'] === 1")
     assert page.evaluate("() => window.plcrtPanel.frame.run") == "running"

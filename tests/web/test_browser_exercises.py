@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import shutil
 
-from .conftest import REPO, editor_end_of_line, editor_text
+from .conftest import (REPO, editor_download, editor_download_refused, editor_end_of_line,
+                       editor_no_errors, editor_text)
 from .test_browser_lessons import lesson_panel, open_panel
 
 COURSE = REPO / "examples/course"
@@ -71,20 +72,15 @@ def test_a_student_edits_the_conveyor_exercise_downloads_it_and_the_machine_reac
     page.wait_for_selector(".cm-lintRange-error")
     assert page.locator("#editor-diags li.error").first.text_content().startswith("line 23:")
     assert "Q0.9" in page.locator(".cm-lintRange-error").first.text_content()
-    page.click("#editor-download")
-    page.wait_for_function("() => document.querySelector('#editor-status')"
-                           ".textContent.includes('has errors')")
+    editor_download_refused(page)
     assert page.locator("#networks .net").count() == 3
     # fixed: Q0.9 -> Q0.2, the diverter
     editor_end_of_line(page, 23)
     page.keyboard.press("Backspace")
     page.keyboard.type("2")
-    page.wait_for_function("() => document.querySelector('#editor-count')"
-                           ".textContent === 'no errors'")
+    editor_no_errors(page)
     assert page.locator(".cm-lintRange-error").count() == 0
-    page.click("#editor-download")
-    page.wait_for_function("() => document.querySelector('#editor-status')"
-                           ".textContent.startsWith('downloaded')")
+    editor_download(page)
     page.wait_for_function("() => document.querySelectorAll('#networks .net').length === 4")
     # the machine reacts: start on the drawing, Run, the belt runs and the
     # diverter follows the new network

@@ -6,16 +6,13 @@ another origin refused on the drawing's endpoints."""
 
 from __future__ import annotations
 
-import threading
-from http.server import ThreadingHTTPServer
 
 import plcrt
 from plcrt.web.editor import ProgramSource
 from plcrt.web.server import Panel
 from plcrt.web.session import PanelSession
 
-from .conftest import editor_text
-from .test_browser_editor import _Plain
+from .conftest import editor_no_errors, editor_text, posts_from_another_origin
 
 PROGRAM = """\
 ORGANIZATION_BLOCK MAIN:OB1
@@ -127,8 +124,7 @@ def test_draw_a_seal_in_rung_with_mouse_and_keyboard_and_save(serve, page, tmp_p
     page.click("#draw-undo")
     _wait_stl(page, SEAL_IN)
     # the editor's check accepts it; Save writes the file
-    page.wait_for_function("() => document.querySelector('#editor-count').textContent "
-                           "=== 'no errors'")
+    editor_no_errors(page)
     page.click("#editor-save")
     page.wait_for_function("() => document.querySelector('#editor-status')"
                            ".textContent.startsWith('saved')")
@@ -183,22 +179,9 @@ def test_operands_with_markup_stay_text(serve, page, tmp_path) -> None:
 def test_a_page_of_another_origin_cannot_draw(serve, page, tmp_path) -> None:
     panel, path = _panel(tmp_path)
     served = serve(panel=panel)
-    other = ThreadingHTTPServer(("127.0.0.1", 0), _Plain)
-    threading.Thread(target=other.serve_forever, daemon=True).start()
-    try:
-        page.goto(f"http://127.0.0.1:{other.server_address[1]}/")
-        seen: dict[str, int] = {}
-        page.on("response", lambda r: seen.__setitem__(r.url.rsplit("/", 1)[1], r.status))
-        page.evaluate("""async (base) => {
-            for (const route of ['networks', 'open', 'edit', 'undo', 'redo']) {
-              await fetch(base + 'ladder/' + route, {method: 'POST', mode: 'no-cors',
-                headers: {'Content-Type': 'text/plain'}, body: '{"text": "x"}'});
-            }
-        }""", served.url)
-        assert seen == {"networks": 403, "open": 403, "edit": 403, "undo": 403, "redo": 403}
-    finally:
-        other.shutdown()
-        other.server_close()
+    seen = posts_from_another_origin(page, served.url, [
+        "ladder/" + route for route in ("networks", "open", "edit", "undo", "redo")])
+    assert seen == {"networks": 403, "open": 403, "edit": 403, "undo": 403, "redo": 403}
 
 
 def test_change_move_and_add_a_box_with_the_keyboard(serve, page, tmp_path) -> None:

@@ -65,6 +65,33 @@ def editor_end_of_line(page: Any, n: int) -> None:
                   f" v.dispatch({{selection: {{anchor: l.to}}}}); v.focus(); }}")
 
 
+#: reference screenshots of the page (golden/NAME.png)
+GOLDEN = Path(__file__).parent / "golden"
+
+
+def matches_golden(locator: Any, name: str) -> None:
+    """The element's screenshot against golden/NAME.png: mean absolute
+    difference under 0.01 and under 1 % of the pixels off by more than 0.1;
+    PLCRT_UPDATE_GOLDEN=1 writes the reference."""
+    import matplotlib.image as mpimg
+    import numpy as np
+    out = GOLDEN.parent / f"_shot_{name}_{os.getpid()}.png"
+    try:
+        locator.screenshot(path=str(out), animations="disabled")
+        ref = GOLDEN / f"{name}.png"
+        if os.environ.get("PLCRT_UPDATE_GOLDEN") == "1" or not ref.exists():
+            if os.environ.get("PLCRT_UPDATE_GOLDEN") != "1":
+                pytest.fail(f"{ref} is missing: run with PLCRT_UPDATE_GOLDEN=1")
+            ref.write_bytes(out.read_bytes())
+        a, b = (mpimg.imread(str(path))[..., :3] for path in (out, ref))
+        assert a.shape == b.shape, f"size {a.shape} != reference {b.shape}"
+        diff = np.abs(a - b)
+        assert diff.mean() < 0.01
+        assert (diff.max(axis=2) > 0.1).mean() < 0.01
+    finally:
+        out.unlink(missing_ok=True)
+
+
 def editor_no_errors(page: Any) -> None:
     """Wait until the editor's check of its text finds no error."""
     page.wait_for_function("() => document.querySelector('#editor-count')"

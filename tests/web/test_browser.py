@@ -4,19 +4,13 @@ screenshot compared with a stored reference."""
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
-import numpy as np
 import pytest
 
 from plcrt.web import course
 from plcrt.web.server import Panel
 from plcrt.web.session import PanelSession
 
-from .conftest import REPO, load_sample
-
-GOLDEN = Path(__file__).parent / "golden"
+from .conftest import REPO, load_sample, matches_golden
 
 
 def open_panel(page, served) -> None:
@@ -135,11 +129,6 @@ def test_lesson_text_and_check_my_program(serve, page) -> None:
     assert "5 passed, 0 failed" in page.locator("#check-results").inner_text()
 
 
-def _image(path: Path) -> np.ndarray:
-    import matplotlib.image as mpimg
-    return mpimg.imread(str(path))[..., :3]
-
-
 def test_screenshot_matches_the_reference(serve, page) -> None:
     """A fixed program after 3 scans with start pressed, stopped: the
     ladder column compared with golden/ladder.png (mean absolute
@@ -152,21 +141,7 @@ def test_screenshot_matches_the_reference(serve, page) -> None:
     page.wait_for_function("() => window.plcrtPanel.frame.scans === 10 && "
                            "window.plcrtPanel.frame.run === 'stopped'")
     page.wait_for_timeout(200)
-    out = GOLDEN.parent / f"_shot_{os.getpid()}.png"
-    try:
-        page.locator("#networks").screenshot(path=str(out), animations="disabled")
-        ref = GOLDEN / "ladder.png"
-        if os.environ.get("PLCRT_UPDATE_GOLDEN") == "1" or not ref.exists():
-            if os.environ.get("PLCRT_UPDATE_GOLDEN") != "1":
-                pytest.fail(f"{ref} is missing: run with PLCRT_UPDATE_GOLDEN=1")
-            ref.write_bytes(out.read_bytes())
-        a, b = _image(out), _image(ref)
-        assert a.shape == b.shape, f"size {a.shape} != reference {b.shape}"
-        diff = np.abs(a - b)
-        assert diff.mean() < 0.01
-        assert (diff.max(axis=2) > 0.1).mean() < 0.01
-    finally:
-        out.unlink(missing_ok=True)
+    matches_golden(page.locator("#networks"), "ladder")
 
 
 def test_trend_exports_csv_and_png(serve, page, tmp_path) -> None:

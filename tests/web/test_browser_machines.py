@@ -13,11 +13,8 @@ machine's state (cleaned: numbers, booleans, short names) and the
 from __future__ import annotations
 
 import json
-import os
 import time
-from pathlib import Path
 
-import numpy as np
 import pytest
 
 import plcrt
@@ -25,9 +22,8 @@ from plcrt.web.machines import MAX_ITEMS, clean
 from plcrt.web.protocol import ProtocolError, validate
 from plcrt.web.session import PanelSession
 
-from .conftest import REPO
+from .conftest import REPO, matches_golden
 
-GOLDEN = Path(__file__).parent / "golden"
 AWL = REPO / "examples" / "machines" / "conveyor.awl"
 TOML = REPO / "examples" / "machines" / "conveyor.toml"
 
@@ -152,11 +148,6 @@ def test_a_teacher_switches_on_a_stuck_eye_and_the_machine_shows_it(serve, page)
     page.wait_for_function("() => window.plcrtPanel.frame.machines[0].faults.length === 0")
 
 
-def _image(path: Path) -> np.ndarray:
-    import matplotlib.image as mpimg
-    return mpimg.imread(str(path))[..., :3]
-
-
 def test_the_conveyor_screenshot_matches_the_reference(serve, page) -> None:
     """Started and run 7.3 s of simulated time before the page opens, the
     PLC stopped: the drawing is a function of that state only (mean
@@ -168,28 +159,7 @@ def test_the_conveyor_screenshot_matches_the_reference(serve, page) -> None:
     open_machines(page, served)
     page.wait_for_selector("[data-machine=conveyor] rect[data-part]")
     page.wait_for_timeout(200)
-    _compare(page.locator("[data-machine=conveyor] svg.machine-svg"), "conveyor")
-
-
-def _compare(svg, name: str) -> None:
-    """The element's screenshot against golden/NAME.png: mean absolute
-    difference under 0.01 and under 1 % of the pixels off by more than 0.1
-    (the ladder's tolerance); PLCRT_UPDATE_GOLDEN=1 writes the reference."""
-    out = GOLDEN.parent / f"_shot_{name}_{os.getpid()}.png"
-    try:
-        svg.screenshot(path=str(out), animations="disabled")
-        ref = GOLDEN / f"{name}.png"
-        if os.environ.get("PLCRT_UPDATE_GOLDEN") == "1" or not ref.exists():
-            if os.environ.get("PLCRT_UPDATE_GOLDEN") != "1":
-                pytest.fail(f"{ref} is missing: run with PLCRT_UPDATE_GOLDEN=1")
-            ref.write_bytes(out.read_bytes())
-        a, b = _image(out), _image(ref)
-        assert a.shape == b.shape, f"size {a.shape} != reference {b.shape}"
-        diff = np.abs(a - b)
-        assert diff.mean() < 0.01
-        assert (diff.max(axis=2) > 0.1).mean() < 0.01
-    finally:
-        out.unlink(missing_ok=True)
+    matches_golden(page.locator("[data-machine=conveyor] svg.machine-svg"), "conveyor")
 
 
 # kind -> (buttons held / pressed before the page opens, a JS check of the
@@ -260,5 +230,5 @@ def test_each_machine_screenshot_matches_its_reference(serve, page, kind) -> Non
                            "window.plcrtPanel.frame.machines.length === 1")
     page.wait_for_function("() => " + OTHERS[kind][1])
     page.wait_for_timeout(200)
-    _compare(page.locator(f"[data-machine={kind}] svg.machine-svg"), kind)
+    matches_golden(page.locator(f"[data-machine={kind}] svg.machine-svg"), kind)
     assert page.errors == []

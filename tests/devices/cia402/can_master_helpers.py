@@ -4,6 +4,7 @@ the CSP trajectory they follow, and waiting for a receiver thread."""
 
 from __future__ import annotations
 
+import threading
 import time
 
 from canopen.profiles.p402 import BaseNode402
@@ -17,6 +18,32 @@ def wait_for(cond, timeout=2.0):
     while not cond() and time.monotonic() < end:
         time.sleep(0.0005)
     return cond()
+
+
+class Frames:
+    """Every frame the master's network receives on the given identifiers."""
+
+    def __init__(self, network, *ids):
+        self.got: dict[int, list[bytes]] = {i: [] for i in ids}
+        self.cond = threading.Condition()
+        for i in ids:
+            network.subscribe(i, self._on)
+
+    def _on(self, can_id, data, timestamp):
+        with self.cond:
+            self.got[can_id].append(bytes(data))
+            self.cond.notify_all()
+
+    def wait(self, can_id, count, timeout=2.0):
+        """The frames of ``can_id`` once there are ``count`` (or at the timeout)."""
+        with self.cond:
+            self.cond.wait_for(lambda: len(self.got[can_id]) >= count, timeout)
+            return list(self.got[can_id])
+
+    def wait_all(self, count, timeout=5.0):
+        """Until every identifier has ``count`` frames (or the timeout)."""
+        with self.cond:
+            self.cond.wait_for(lambda: all(len(v) >= count for v in self.got.values()), timeout)
 
 
 def master(mst, node_id, model="hcfa-am0520b"):

@@ -24,7 +24,7 @@ from plcrt.devices.cia402.plant import DrivePlant  # noqa: E402
 from plcrt.devices.cia402.statemachine import State  # noqa: E402
 from plcrt.errors import PlcConfigError  # noqa: E402
 
-from can_master_helpers import master, remap_sync, trajectory, wait_for  # noqa: E402
+from can_master_helpers import Frames, master, remap_sync, trajectory, wait_for  # noqa: E402
 
 _channels = itertools.count()
 
@@ -51,25 +51,6 @@ def virtual_pair(name: str):
     return dev, mst
 
 
-class Tpdos:
-    """Every TPDO payload the master's network receives, per COB-ID."""
-
-    def __init__(self, network, ids):
-        self.got: dict[int, list[bytes]] = {i: [] for i in ids}
-        self.cond = threading.Condition()
-        for i in ids:
-            network.subscribe(i, self._on)
-
-    def _on(self, can_id, data, timestamp):
-        with self.cond:
-            self.got[can_id].append(bytes(data))
-            self.cond.notify_all()
-
-    def wait(self, count):
-        with self.cond:
-            self.cond.wait_for(lambda: all(len(v) >= count for v in self.got.values()), 5.0)
-
-
 def run_eight_drives(dev, mst):
     """Eight HCFA drives remapped and saved by their masters, SYNC at 1 ms
     (1006h = 1000 µs), CSP along :func:`trajectory`; drive 27 is blocked by
@@ -88,7 +69,7 @@ def run_eight_drives(dev, mst):
             n.sdo[0x6065].raw = 1000
             n.sdo[0x6066].raw = 5
             pdos[i] = remap_sync(n, sims[i])
-        tpdos = Tpdos(mst, [t.cob_id for t, _ in pdos.values()])
+        tpdos = Frames(mst, *(t.cob_id for t, _ in pdos.values()))
         for i in ids:
             nodes[i].nmt.state = "OPERATIONAL"
             assert wait_for(lambda: sims[i].drive.esm.state is EsmState.OP)
@@ -102,7 +83,7 @@ def run_eight_drives(dev, mst):
                 rpdo.transmit()
             mst.sync.transmit()
             late += sum(len(v) < k for v in tpdos.got.values())
-            tpdos.wait(k)
+            tpdos.wait_all(k)
         assert wait_for(lambda: nodes[27].emcy.active)
         got = {pdos[i][0].cob_id: [struct.unpack("<iH", d) for d in tpdos.got[pdos[i][0].cob_id]]
                for i in ids}
@@ -185,7 +166,7 @@ def test_pdos_act_in_operational_only_over_the_in_process_bus(local):
     try:
         n = master(mst, 10)
         tpdo, rpdo = remap_sync(n, sim, tx=(0x6041,))
-        tpdos = Tpdos(mst, [tpdo.cob_id])
+        tpdos = Frames(mst, tpdo.cob_id)
         mst.sync.transmit()
         rpdo[0x6040].raw = 0x06
         rpdo.transmit()

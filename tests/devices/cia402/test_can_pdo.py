@@ -10,7 +10,6 @@ from __future__ import annotations
 import itertools
 import logging
 import struct
-import threading
 import time
 
 import pytest
@@ -25,7 +24,7 @@ from plcrt.devices.cia402.plant import DrivePlant  # noqa: E402
 from plcrt.devices.cia402.reactions import FAULT_CODES  # noqa: E402
 from plcrt.devices.cia402.statemachine import State  # noqa: E402
 
-from can_master_helpers import master, remap_sync, trajectory, wait_for  # noqa: E402
+from can_master_helpers import Frames, master, remap_sync, trajectory, wait_for  # noqa: E402
 
 _channels = itertools.count()
 MODELS = ("hcfa-am0520b", "kinco-servo")
@@ -41,26 +40,6 @@ def bus(request):
     yield dev, mst
     mst.disconnect()
     dev.disconnect()
-
-
-class Frames:
-    """Every frame the master's network receives on the given identifiers."""
-
-    def __init__(self, network, *ids):
-        self.got: dict[int, list[bytes]] = {i: [] for i in ids}
-        self.cond = threading.Condition()
-        for i in ids:
-            network.subscribe(i, self._on)
-
-    def _on(self, can_id, data, timestamp):
-        with self.cond:
-            self.got[can_id].append(bytes(data))
-            self.cond.notify_all()
-
-    def wait(self, can_id, count, timeout=2.0):
-        with self.cond:
-            self.cond.wait_for(lambda: len(self.got[can_id]) >= count, timeout)
-            return list(self.got[can_id])
 
 
 def operational(n, sim):

@@ -3,7 +3,23 @@ does not start with ``test_``)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
 import plcrt
+
+#: the real-file corpus beside the repository (read where it is, never copied)
+CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
+
+
+def corpus_awl_params() -> list:
+    """The corpus's ``.awl`` files as pytest parameters (named by file), or
+    one skipped parameter saying where the corpus was looked for."""
+    files = sorted(CORPUS.glob("*.awl")) if CORPUS.is_dir() else []
+    if not files:
+        return [pytest.param(None, marks=pytest.mark.skip(reason=f"corpus not found at {CORPUS}"))]
+    return [pytest.param(f, id=f.name) for f in files]
 
 
 def ob1_text(*networks: str) -> str:

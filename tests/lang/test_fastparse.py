@@ -25,10 +25,10 @@ from plcrt.lang.fastparse import fast_parse
 from plcrt.lang.ir import Program
 from plcrt.lang.stl import parse_program_lark
 
+from stl_helpers import corpus_awl_params
+
 ROOT = Path(__file__).resolve().parents[2]
 PROGRAMS = sorted((ROOT / "programs").rglob("*.awl"))
-# the shared corpus of real exports beside the repository (never copied in)
-CORPUS = ROOT.parent / "shared" / "corpus"
 EXAMPLES = int(os.environ.get("PLCRT_PROPERTY_EXAMPLES", "200"))
 
 
@@ -70,15 +70,7 @@ def test_sample_programs_exist() -> None:
     assert len(PROGRAMS) >= 10
 
 
-def _corpus_files() -> list:
-    files = sorted(CORPUS.glob("*.awl")) if CORPUS.is_dir() else []
-    if not files:
-        return [pytest.param(None, marks=pytest.mark.skip(
-            reason=f"corpus not found at {CORPUS}"))]
-    return files
-
-
-@pytest.mark.parametrize("path", _corpus_files(), ids=lambda p: getattr(p, "name", "none"))
+@pytest.mark.parametrize("path", corpus_awl_params())
 def test_corpus_files_accepted_and_identical(path: Path) -> None:
     """Every real export of the corpus is accepted, with lark's program
     (CRLF, tab-only lines, CJK names, titles on Network lines...)."""

@@ -30,16 +30,10 @@ from plcrt.view.ladder_edit import check_model
 from plcrt.view.ladder_model import model_from_json, model_to_json
 from plcrt.view.ladder_stl import NoLadder, model_to_stl, network_text, network_to_model
 
+from stl_helpers import corpus_awl_params
+
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = sorted(p for d in ("programs", "examples", "library") for p in (ROOT / d).rglob("*.awl"))
-CORPUS = ROOT.parent / "shared" / "corpus"
-
-
-def _corpus_files() -> list:
-    files = sorted(CORPUS.glob("*.awl")) if CORPUS.is_dir() else []
-    if not files:
-        return [pytest.param(None, marks=pytest.mark.skip(reason=f"corpus not found at {CORPUS}"))]
-    return [pytest.param(f, id=f.name) for f in files]
 
 
 def _ir(net: ir.Network) -> tuple:
@@ -89,7 +83,7 @@ def test_samples_round_trip(path: Path) -> None:
     assert ok > 0
 
 
-@pytest.mark.parametrize("path", _corpus_files())
+@pytest.mark.parametrize("path", corpus_awl_params())
 def test_corpus_round_trip(path: Path) -> None:
     ok, reasons = _round_trip(path)
     assert ok + sum(reasons.values()) > 0

@@ -14,17 +14,11 @@ from plcrt.view.ladder import to_ladder
 from plcrt.view.render import ladder_text, render_program
 from plcrt.view.status import PlcStatus
 
+from stl_helpers import corpus_awl_params
+
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = (sorted((ROOT / "programs").glob("*.awl"))
            + sorted((ROOT / "programs" / "em253").glob("*.awl")))
-CORPUS = ROOT.parent / "shared" / "corpus"
-
-
-def _corpus_files() -> list:
-    files = sorted(CORPUS.glob("*.awl")) if CORPUS.is_dir() else []
-    if not files:
-        return [pytest.param(None, marks=pytest.mark.skip(reason=f"corpus not found at {CORPUS}"))]
-    return [pytest.param(f, id=f.name) for f in files]
 
 
 def _draw_all(path: Path) -> tuple[int, int]:
@@ -50,7 +44,7 @@ def test_samples_draw_as_lad(path: Path) -> None:
     assert stl == 0 and lad > 0  # the samples are written the way Micro/WIN exports LAD
 
 
-@pytest.mark.parametrize("path", _corpus_files())
+@pytest.mark.parametrize("path", corpus_awl_params())
 def test_corpus_draws_without_exceptions(path: Path) -> None:
     lad, stl = _draw_all(path)
     assert lad + stl > 0

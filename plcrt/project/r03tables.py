@@ -20,9 +20,10 @@ code uses, else the network is refused (docs/project-files.md).
 from __future__ import annotations
 
 from ..errors import PlcError
-from .codes import AREAS, CLASSES, WIDTH_LETTER
+from .codes import AREAS, CLASSES
 from .r03 import V3Program
 from .stream import Cursor
+from .tables import address_text
 
 __all__ = ["read_v3_symbols", "check_symbolic_cells"]
 
@@ -77,15 +78,7 @@ def _row(c: Cursor, index: int) -> Row | None:
 
 
 def _address(width: int, area: int, klass: int, offset: int) -> str:
-    prefix = AREAS.get(area) if area else CLASSES.get(klass)
-    if prefix is None:
-        return ""
-    if prefix in ("T", "C", "HC", "AC"):
-        return f"{prefix}{offset}"
-    if width == 1:
-        return f"{prefix}{offset >> 3}.{offset & 7}"
-    letter = WIDTH_LETTER.get(width)
-    return f"{prefix}{letter}{offset}" if letter else ""
+    return address_text(AREAS.get(area) if area else CLASSES.get(klass), width, offset)
 
 
 def check_symbolic_cells(program: V3Program, rows: list[Row], c: Cursor) -> None:

@@ -95,6 +95,13 @@ def _entry(c: Cursor) -> tuple[str, str, str]:
 
 def _address(area: int, location: int, width: int, value: int) -> str:
     prefix = AREAS.get(area) if area else (CLASSES.get(location) or _LOCATIONS.get(location))
+    return address_text(prefix, width, value)
+
+
+def address_text(prefix: str | None, width: int, value: int) -> str:
+    """A symbol row's address as the export writes it (``I0.1``, ``VW10``,
+    ``T37``) from its area letter, width code and offset (a bit address's
+    offset counts bits); "" for an area or width not known."""
     if prefix is None:
         return ""
     if prefix in ("T", "C", "HC", "AC"):

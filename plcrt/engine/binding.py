@@ -73,18 +73,24 @@ class Binding:
             key = program_key(program, cpu=self.model.name, **options)
         compiled = programs.get(key, program)
         if compiled is None:
-            options["cpu"] = cfg["cpu"]
-            t0 = time.perf_counter()
-            try:
-                compiled = compile_to_program(
-                    program, self.model, options,
-                    probes=CoverageMap() if options["instrument"] else None,
-                    hooks=self._parts.compile_hooks)
-            except PlcCompileError as e:
-                e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
-                raise
-            self._load_s = time.perf_counter() - t0
-            programs.put(key, compiled)
+            compiled = self._compile(key, program, options, auto_diags)
+        return compiled
+
+    def _compile(self, key: tuple[Any, ...], program: ir.Program, options: dict[str, Any],
+                 auto_diags: list[Diagnostic]) -> CompiledProgram:
+        """Compile ``program`` with ``options`` now and keep it in the
+        program cache under ``key``."""
+        t0 = time.perf_counter()
+        try:
+            compiled = compile_to_program(
+                program, self.model, dict(options, cpu=self._config["cpu"]),
+                probes=CoverageMap() if options["instrument"] else None,
+                hooks=self._parts.compile_hooks)
+        except PlcCompileError as e:
+            e.diagnostics[:0] = auto_diags     # what was assigned, then what failed
+            raise
+        self._load_s = time.perf_counter() - t0
+        programs.put(key, compiled)
         return compiled
 
     def _marked_native(self, key: tuple[Any, ...], program: ir.Program,
@@ -97,20 +103,10 @@ class Binding:
         if usable() is not None:
             return None
         tiermarks.touch(key)
-        t0 = time.perf_counter()
         try:
-            compiled = compile_to_program(
-                program, self.model, dict(options, cpu=self._config["cpu"]),
-                probes=CoverageMap() if options["instrument"] else None,
-                hooks=self._parts.compile_hooks)
-        except PlcCompileError as e:
-            e.diagnostics[:0] = auto_diags
-            raise
+            return self._compile(key, program, options, auto_diags)
         except PlcConfigError:        # the machine code could not be made
             return None
-        self._load_s = time.perf_counter() - t0
-        programs.put(key, compiled)
-        return compiled
 
     def _native_maker(self, python: CompiledProgram) -> Any:
         """What compiles the native twin of ``python`` (in a worker thread:
